@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# ci/main.sh — the README's first command: set up, build (Release) and run the main
+# job. Today the main job generates a seeded cluttered map and plans on it with A*;
+# later capabilities turn it into `miner fly`. Results go to run/quickstart/.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+bash ci/setup.sh
+cmake --workflow --preset release
+
+out=run/quickstart
+mkdir -p "$out"
+set -x
+build/release/miner map gen --preset sim --seed 7 --out "$out/map.json"
+build/release/miner map info --map "$out/map.json"
+build/release/miner astar --map "$out/map.json" --out "$out/astar.json"

@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# ci/setup.sh — install exactly the Debian (bookworm) packages MINER needs.
+# Idempotent: re-running it installs nothing new. Needs root (or sudo) and apt.
+#
+#   bash ci/setup.sh            # install build + test dependencies
+#
+# The list is the single source of truth for dependencies; docs/layout.md explains
+# the job each package does.
+set -euo pipefail
+
+PACKAGES=(
+  # toolchain
+  g++ cmake ninja-build make git ca-certificates pkg-config
+  # numerics
+  libeigen3-dev        # linear algebra everywhere
+  libceres-dev         # independent optimiser: checks MINCO optimality, refines time allocation
+  libsundials-dev      # CVODE integrates the quadrotor rigid body
+  # world model and I/O
+  liboctomap-dev       # OctoMap .bt import
+  libnanoflann-dev     # k-d tree for planners' nearest-neighbour queries
+  nlohmann-json3-dev   # map / scenario / result JSON
+  libcli11-dev         # the `miner` command line
+  # benchmark peers
+  libompl-dev libboost-filesystem-dev libboost-system-dev libboost-serialization-dev
+  # verification
+  catch2               # unit tests (Catch2 v2)
+  librapidcheck-dev    # property tests
+  gcovr                # coverage reports and thresholds
+  python3              # traceability checker
+)
+
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then
+  if command -v sudo >/dev/null 2>&1; then SUDO="sudo"; else
+    echo "ci/setup.sh: needs root or sudo to install packages" >&2; exit 1; fi
+fi
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ "${#missing[@]}" -eq 0 ]; then
+  echo "ci/setup.sh: all ${#PACKAGES[@]} packages already installed"
+  exit 0
+fi
+
+echo "ci/setup.sh: installing ${#missing[@]} packages: ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"

@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# ci/test.sh — the README test command: set up, build the CI configuration and pass
+# every check. Runs from any folder; needs root or sudo for the package install.
+#
+#   1. ci/setup.sh installs the Debian packages (idempotent)
+#   2. configure + build preset "ci": Debug, ASan + UBSan, gcov, -Werror
+#   3. ctest (labels unit, property, golden, statistical, bench-smoke; not "long")
+#      including the traceability check (build/ci/traceability.md)
+#   4. no sanitizer report anywhere in the test log
+#   5. gcovr: >= 90 % lines and >= 75 % branches over src/ (build/ci/coverage/)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+bash ci/setup.sh
+cmake --preset ci
+cmake --build --preset ci
+
+# Stale counters from an earlier build of a changed file would corrupt coverage.
+find build/ci -name '*.gcda' -delete
+
+export ASAN_OPTIONS="detect_leaks=1:abort_on_error=0:halt_on_error=1"
+export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+status=0
+ctest --preset ci || status=$?
+
+# A test that expects failure (WILL_FAIL, output regex) must not hide a sanitizer report.
+if grep -E -n "ERROR: (AddressSanitizer|LeakSanitizer)|runtime error:" build/ci/Testing/Temporary/LastTest.log; then
+  echo "ci/test.sh: sanitizer report in the test log (above)" >&2
+  status=1
+fi
+[ "$status" -eq 0 ] || { echo "ci/test.sh: tests failed" >&2; exit "$status"; }
+
+mkdir -p build/ci/coverage
+gcovr --config ci/gcovr.cfg
+echo "ci/test.sh: all checks passed (traceability: build/ci/traceability.md, coverage: build/ci/coverage/index.html)"

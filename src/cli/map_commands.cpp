@@ -1,0 +1,220 @@
+// `miner map gen|info|convert` and `miner astar` (REQ-CLI-*, REQ-WORLD-*).
+#include <cmath>
+#include <iomanip>
+#include <memory>
+#include <optional>
+#include <ostream>
+#include <sstream>
+
+#include <CLI/CLI.hpp>
+
+#include "cli/cli.hpp"
+#include "miner/core/error.hpp"
+#include "miner/core/json_io.hpp"
+#include "miner/world/astar.hpp"
+#include "miner/world/map.hpp"
+#include "miner/world/map_generator.hpp"
+#include "miner/world/voxel_grid.hpp"
+
+namespace miner::cli {
+
+namespace {
+
+using world::Map;
+
+Json vec_json(const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); }
+
+Eigen::Vector3d to_vec3(const std::vector<double>& v, const std::string& field) {
+  Eigen::Vector3d p(v.at(0), v.at(1), v.at(2));
+  require_finite(p, field);
+  return p;
+}
+
+/// Options shared by commands that write a result: --json to stdout, --out to a file.
+struct OutputOptions {
+  bool json = false;
+  std::string out;
+};
+
+void emit(const OutputOptions& o, const Json& doc, const std::string& human, std::ostream& out) {
+  if (!o.out.empty()) write_file_atomic(o.out, dump_json(doc));
+  if (o.json) {
+    out << dump_json(doc);
+  } else {
+    out << human;
+  }
+}
+
+struct GenOptions {
+  std::string preset = "sim";
+  std::uint64_t seed = 1;
+  int obstacles = -1;
+  std::string out;
+};
+
+void run_gen(const GenOptions& o, std::ostream& out) {
+  const auto preset = world::generator_preset(o.preset);
+  const Map map = world::generate_map(preset, o.seed,
+                                      o.obstacles >= 0 ? std::optional<int>(o.obstacles) : std::nullopt);
+  map.save(o.out);
+  out << "wrote " << o.out << ": preset " << o.preset << ", seed " << o.seed << ", "
+      << map.obstacles().size() << " obstacles\n";
+}
+
+struct InfoOptions {
+  std::string map;
+  double radius = -1.0;
+  OutputOptions output;
+};
+
+void run_info(const InfoOptions& o, std::ostream& out) {
+  const Map map = Map::load(o.map);
+  const double radius = o.radius >= 0.0 ? o.radius : (map.query() ? map.query()->robot_radius : 0.0);
+  const world::VoxelGrid grid(map, radius);
+  const double occupied = static_cast<double>(grid.occupied_count()) / static_cast<double>(grid.cell_count());
+  Json doc = {{"map", o.map},
+              {"bounds", {{"min", vec_json(map.bounds().min)}, {"max", vec_json(map.bounds().max)}}},
+              {"resolution", map.resolution()},
+              {"obstacles", map.obstacles().size()},
+              {"grid", {{"dims", {grid.dims().x(), grid.dims().y(), grid.dims().z()}},
+                        {"cells", grid.cell_count()},
+                        {"robot_radius", radius},
+                        {"occupied_cells", grid.occupied_count()},
+                        {"occupied_fraction", occupied}}}};
+  if (map.query()) {
+    doc["query"] = {{"start", vec_json(map.query()->start)},
+                    {"goal", vec_json(map.query()->goal)},
+                    {"robot_radius", map.query()->robot_radius}};
+  }
+  std::ostringstream h;
+  h << "map:         " << o.map << "\n"
+    << "bounds:      " << format_point(map.bounds().min) << " - " << format_point(map.bounds().max) << " m\n"
+    << "resolution:  " << map.resolution() << " m\n"
+    << "obstacles:   " << map.obstacles().size() << " boxes\n"
+    << "grid:        " << grid.dims().x() << " x " << grid.dims().y() << " x " << grid.dims().z()
+    << " = " << grid.cell_count() << " cells, " << std::fixed << std::setprecision(1)
+    << 100.0 * occupied << " % occupied for robot radius " << std::defaultfloat << radius << " m\n";
+  if (map.query()) {
+    h << "query:       start " << format_point(map.query()->start) << ", goal "
+      << format_point(map.query()->goal) << ", robot radius " << map.query()->robot_radius << " m\n";
+  }
+  emit(o.output, doc, h.str(), out);
+}
+
+struct ConvertOptions {
+  std::string in, out;
+};
+
+void run_convert(const ConvertOptions& o, std::ostream& out) {
+  const Map map = Map::load(o.in);
+  map.save(o.out);
+  out << "wrote " << o.out << " (" << map.obstacles().size() << " obstacles from " << o.in << ")\n";
+}
+
+struct AstarOptions {
+  std::string map;
+  std::vector<double> start, goal;
+  double radius = -1.0;
+  OutputOptions output;
+};
+
+void run_astar(const AstarOptions& o, std::ostream& out) {
+  const Map map = Map::load(o.map);
+  if ((o.start.empty() || o.goal.empty()) && !map.query()) {
+    throw Error(o.map + ": has no \"query\"; give --start x y z and --goal x y z");
+  }
+  const Eigen::Vector3d start = o.start.empty() ? map.query()->start : to_vec3(o.start, "--start");
+  const Eigen::Vector3d goal = o.goal.empty() ? map.query()->goal : to_vec3(o.goal, "--goal");
+  const double radius = o.radius >= 0.0 ? o.radius : (map.query() ? map.query()->robot_radius : 0.0);
+  const world::VoxelGrid grid(map, radius);
+  const world::GridPath path = world::astar(map, grid, start, goal);
+
+  Json points = Json::array();
+  for (const auto& p : path.points) points.push_back(vec_json(p));
+  const Json doc = {{"map", o.map},
+                    {"start", vec_json(start)},
+                    {"goal", vec_json(goal)},
+                    {"robot_radius", radius},
+                    {"resolution", grid.resolution()},
+                    {"cost", path.cost},
+                    {"grid_cost", path.grid_cost},
+                    {"expanded", path.expanded},
+                    {"points", points}};
+  std::ostringstream h;
+  h << "A* on " << grid.dims().x() << " x " << grid.dims().y() << " x " << grid.dims().z()
+    << " grid (" << grid.resolution() << " m, robot radius " << radius << " m)\n"
+    << "start " << format_point(start) << " -> goal " << format_point(goal) << "\n"
+    << "path: " << path.points.size() << " points, cost " << std::fixed << std::setprecision(3)
+    << path.cost << " m (straight line " << (goal - start).norm() << " m), " << path.expanded
+    << " cells expanded\n";
+  emit(o.output, doc, h.str(), out);
+}
+
+/// A CLI11 validator: the value parses as a finite number >= 0.
+const CLI::Validator kFiniteNonNegative(
+    [](std::string& text) -> std::string {
+      double v = 0.0;
+      if (!CLI::detail::lexical_cast(text, v) || !std::isfinite(v) || v < 0.0) {
+        return "must be a finite number >= 0, got " + text;
+      }
+      return {};
+    },
+    "NONNEGATIVE");
+
+const CLI::Validator kFinite(
+    [](std::string& text) -> std::string {
+      double v = 0.0;
+      if (!CLI::detail::lexical_cast(text, v) || !std::isfinite(v)) {
+        return "must be a finite number, got " + text;
+      }
+      return {};
+    },
+    "FINITE");
+
+void add_output_options(CLI::App* cmd, OutputOptions& o) {
+  cmd->add_flag("--json", o.json, "print the result as JSON");
+  cmd->add_option("--out", o.out, "also write the JSON result to this file");
+}
+
+}  // namespace
+
+void add_map_commands(CLI::App& app, std::ostream& out) {
+  CLI::App* map = app.add_subcommand("map", "generate, inspect and convert maps");
+  map->require_subcommand(1);
+
+  auto gen = std::make_shared<GenOptions>();
+  CLI::App* g = map->add_subcommand("gen", "generate a seeded cluttered map (presets: sim, indoor)");
+  g->add_option("--preset", gen->preset, "map preset: sim (100 m, paper Sec. V-B) or indoor (10 m site, Sec. V-D)")
+      ->capture_default_str();
+  g->add_option("--seed", gen->seed, "random seed")->capture_default_str();
+  g->add_option("--obstacles", gen->obstacles, "number of obstacles (default: the preset's range)")
+      ->check(CLI::NonNegativeNumber);
+  g->add_option("--out", gen->out, "output file (.json, or .bt for OctoMap)")->required();
+  g->callback([gen, &out] { run_gen(*gen, out); });
+
+  auto info = std::make_shared<InfoOptions>();
+  CLI::App* i = map->add_subcommand("info", "summarise a map and its occupancy grid");
+  i->add_option("--map", info->map, "map file (.json or .bt)")->required();
+  i->add_option("--radius", info->radius, "robot radius in m (default: the map's query radius or 0)")
+      ->check(kFiniteNonNegative);
+  add_output_options(i, info->output);
+  i->callback([info, &out] { run_info(*info, out); });
+
+  auto conv = std::make_shared<ConvertOptions>();
+  CLI::App* c = map->add_subcommand("convert", "convert between miner-map-v1 JSON and OctoMap .bt");
+  c->add_option("--in", conv->in, "input map (.json or .bt)")->required();
+  c->add_option("--out", conv->out, "output map (.json or .bt)")->required();
+  c->callback([conv, &out] { run_convert(*conv, out); });
+
+  auto astar = std::make_shared<AstarOptions>();
+  CLI::App* a = app.add_subcommand("astar", "shortest 26-connected grid path (A*) between two points");
+  a->add_option("--map", astar->map, "map file (.json or .bt)")->required();
+  a->add_option("--start", astar->start, "start x y z in m (default: the map's query)")->expected(3)->check(kFinite);
+  a->add_option("--goal", astar->goal, "goal x y z in m (default: the map's query)")->expected(3)->check(kFinite);
+  a->add_option("--radius", astar->radius, "robot radius in m (default: the map's query radius or 0)")
+      ->check(kFiniteNonNegative);
+  add_output_options(a, astar->output);
+  a->callback([astar, &out] { run_astar(*astar, out); });
+}
+
+}  // namespace miner::cli

@@ -1,0 +1,189 @@
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <unistd.h>
+
+#include "cli/cli.hpp"
+#include "miner/core/json_io.hpp"
+
+using Catch::Matchers::Contains;
+
+namespace {
+
+struct Run {
+  int code;
+  std::string out, err;
+};
+
+Run miner_cli(const std::vector<std::string>& args) {
+  std::ostringstream out, err;
+  const int code = miner::cli::run_cli(args, out, err);
+  return {code, out.str(), err.str()};
+}
+
+std::string dir() {
+  static const std::string d = [] {
+    // One folder per process: ctest runs test cases of this binary in parallel.
+    const auto p = std::filesystem::temp_directory_path() /
+                   ("miner_cli_test_" + std::to_string(::getpid()));
+    std::filesystem::remove_all(p);
+    std::filesystem::create_directories(p);
+    return p.string();
+  }();
+  return d;
+}
+
+std::string write(const std::string& name, const std::string& text) {
+  const std::string path = dir() + "/" + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+std::string read(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+const char* kPillarMap = R"({"format": "miner-map-v1",
+  "bounds": {"min": [0,0,0], "max": [10,10,10]}, "resolution": 1.0,
+  "obstacles": [{"type": "box", "min": [4,4,0], "max": [6,6,10]}]})";
+
+}  // namespace
+
+TEST_CASE("miner --help and --version exit 0 and no command is a usage error", "[REQ-CLI-001][REQ-CLI-002]") {
+  const Run help = miner_cli({"--help"});
+  CHECK(help.code == 0);
+  CHECK_THAT(help.out, Contains("astar"));
+  CHECK_THAT(help.out, Contains("map"));
+  const Run sub = miner_cli({"astar", "--help"});
+  CHECK(sub.code == 0);
+  CHECK_THAT(sub.out, Contains("--radius"));
+  CHECK(miner_cli({"--version"}).code == 0);
+  const Run none = miner_cli({});
+  CHECK(none.code == 2);
+  CHECK_THAT(none.err, Contains("miner: usage error"));
+  CHECK(miner_cli({"fly-to-the-moon"}).code == 2);
+  CHECK(miner_cli({"map", "gen"}).code == 2);  // --out is required
+}
+
+TEST_CASE("map gen writes a deterministic map and map info summarises it", "[REQ-CLI-001][REQ-WORLD-009]") {
+  const std::string a = dir() + "/gen-a.json", b = dir() + "/gen-b.json";
+  const Run gen = miner_cli({"map", "gen", "--preset", "indoor", "--seed", "3", "--out", a});
+  REQUIRE(gen.code == 0);
+  CHECK_THAT(gen.out, Contains("wrote " + a));
+  REQUIRE(miner_cli({"map", "gen", "--preset", "indoor", "--seed", "3", "--out", b}).code == 0);
+  CHECK(read(a) == read(b));
+
+  const Run info = miner_cli({"map", "info", "--map", a});
+  CHECK(info.code == 0);
+  CHECK_THAT(info.out, Contains("grid:        100 x 100 x 50 = 500000 cells"));
+  CHECK_THAT(info.out, Contains("query:"));
+  const Run json = miner_cli({"map", "info", "--map", a, "--radius", "0", "--json"});
+  REQUIRE(json.code == 0);
+  const auto doc = miner::parse_json(json.out, "stdout");
+  CHECK(doc["grid"]["cells"] == 500000);
+  CHECK(doc["grid"]["robot_radius"] == 0.0);
+  CHECK(doc["resolution"] == 0.1);
+}
+
+TEST_CASE("astar prints a path, --json gives the documented fields, --out writes them", "[REQ-CLI-001][REQ-WORLD-007]") {
+  const std::string map = write("pillar.json", kPillarMap);
+  const Run human = miner_cli({"astar", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5"});
+  REQUIRE(human.code == 0);
+  CHECK_THAT(human.out, Contains("path:"));
+  const std::string out = dir() + "/path.json";
+  const Run js = miner_cli({"astar", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5",
+                            "--radius", "0.5", "--json", "--out", out});
+  REQUIRE(js.code == 0);
+  const auto doc = miner::parse_json(js.out, "stdout");
+  for (const char* key : {"cost", "grid_cost", "expanded", "points", "start", "goal", "robot_radius"}) {
+    CHECK(doc.contains(key));
+  }
+  CHECK(doc["cost"].get<double>() > 8.0);  // the pillar is in the way
+  CHECK(miner::read_json_file(out) == doc);
+}
+
+TEST_CASE("astar without --start/--goal uses the map's query, or says it needs them", "[REQ-CLI-001]") {
+  const std::string gen = dir() + "/query-map.json";
+  REQUIRE(miner_cli({"map", "gen", "--preset", "indoor", "--seed", "4", "--out", gen}).code == 0);
+  CHECK(miner_cli({"astar", "--map", gen}).code == 0);
+  const std::string plain = write("plain.json", kPillarMap);
+  const Run r = miner_cli({"astar", "--map", plain});
+  CHECK(r.code == 1);
+  CHECK_THAT(r.err, Contains("has no \"query\"; give --start x y z and --goal x y z"));
+}
+
+TEST_CASE("map convert goes to OctoMap and back", "[REQ-CLI-001][REQ-WORLD-003]") {
+  const std::string map = write("pillar-conv.json", kPillarMap);
+  const std::string bt = dir() + "/pillar.bt", back = dir() + "/pillar-back.json";
+  REQUIRE(miner_cli({"map", "convert", "--in", map, "--out", bt}).code == 0);
+  REQUIRE(miner_cli({"map", "convert", "--in", bt, "--out", back}).code == 0);
+  const Run r = miner_cli({"astar", "--map", bt, "--start", "1", "5", "5", "--goal", "9", "5", "5"});
+  CHECK(r.code == 0);
+}
+
+TEST_CASE("Bad input: each case names what is wrong and exits non-zero", "[REQ-CLI-002][REQ-WORLD-002][REQ-WORLD-010]") {
+  const std::string map = write("pillar-bad.json", kPillarMap);
+  struct Case {
+    std::vector<std::string> args;
+    int code;
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      {{"astar", "--map", dir() + "/nope.json"}, 1, "nope.json: cannot open file"},
+      {{"astar", "--map", write("malformed.json", "{\"format\": ")}, 1, "malformed JSON"},
+      {{"astar", "--map", write("tag.json", R"({"format": "miner-map-v0"})")}, 1, "unknown format tag"},
+      {{"astar", "--map", write("inverted.json",
+                                R"({"format": "miner-map-v1", "bounds": {"min": [0,0,5], "max": [1,1,1]},
+                                    "resolution": 1, "obstacles": []})")},
+       1, "bounds: min[2] = 5 must be less than max[2] = 1"},
+      {{"astar", "--map", write("neg-res.json",
+                                R"({"format": "miner-map-v1", "bounds": {"min": [0,0,0], "max": [1,1,1]},
+                                    "resolution": -1, "obstacles": []})")},
+       1, "resolution: must be positive"},
+      {{"astar", "--map", map, "--start", "5", "5", "5", "--goal", "1", "1", "1"}, 1, "start (5, 5, 5) lies inside obstacle 0"},
+      {{"astar", "--map", map, "--start", "1", "1", "1", "--goal", "1", "1", "11"}, 1, "goal (1, 1, 11) lies outside the map bounds"},
+      {{"astar", "--map", map, "--start", "nan", "1", "1", "--goal", "1", "1", "1"}, 2, "must be a finite number"},
+      {{"astar", "--map", map, "--start", "1", "1", "--goal", "1", "1", "1"}, 2, "--start"},
+      {{"astar", "--map", map, "--start", "1", "1", "1", "--goal", "2", "2", "2", "--radius", "-1"}, 2, "must be a finite number >= 0"},
+      {{"astar", "--map", map, "--start", "3.2", "5", "5", "--goal", "9", "9", "9", "--radius", "0.5"}, 1, "lies in an occupied grid cell"},
+      {{"map", "gen", "--preset", "forest", "--out", dir() + "/x.json"}, 1, "unknown map preset \"forest\""},
+      {{"map", "info", "--map", write("garbage.bt", "not an octree")}, 1, "not a readable OctoMap"},
+  };
+  for (const auto& c : cases) {
+    const Run r = miner_cli(c.args);
+    INFO("args: " << c.args.at(0) << " ... expected message: " << c.message << "\nstderr: " << r.err);
+    CHECK(r.code == c.code);
+    CHECK_THAT(r.err, Contains(c.message));
+    CHECK_THAT(r.err, Contains("miner: "));
+  }
+}
+
+TEST_CASE("An unreachable goal exits 3 with the reason", "[REQ-CLI-002][REQ-WORLD-010]") {
+  // A wall across the whole map at x in [4, 6].
+  const std::string map = write("wall.json", R"({"format": "miner-map-v1",
+    "bounds": {"min": [0,0,0], "max": [10,10,10]}, "resolution": 1.0,
+    "obstacles": [{"type": "box", "min": [4,0,0], "max": [6,10,10]}]})");
+  const Run r = miner_cli({"astar", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5"});
+  CHECK(r.code == 3);
+  CHECK_THAT(r.err, Contains("is unreachable from start"));
+}
+
+TEST_CASE("A failing command leaves an existing output file untouched", "[REQ-CLI-003][REQ-CORE-004]") {
+  const std::string map = write("pillar-keep.json", kPillarMap);
+  const std::string out = dir() + "/keep.json";
+  REQUIRE(miner_cli({"astar", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5", "--out", out}).code == 0);
+  const std::string before = read(out);
+  CHECK(miner_cli({"astar", "--map", map, "--start", "5", "5", "5", "--goal", "9", "5", "5", "--out", out}).code == 1);
+  CHECK(read(out) == before);
+  const std::string gen_out = dir() + "/keep-map.json";
+  REQUIRE(miner_cli({"map", "gen", "--preset", "indoor", "--seed", "1", "--out", gen_out}).code == 0);
+  const std::string map_before = read(gen_out);
+  CHECK(miner_cli({"map", "gen", "--preset", "indoor", "--seed", "1", "--obstacles", "-2", "--out", gen_out}).code == 2);
+  CHECK(read(gen_out) == map_before);
+}

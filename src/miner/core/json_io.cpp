@@ -1,0 +1,127 @@
+#include "miner/core/json_io.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <unistd.h>
+
+#include "miner/core/error.hpp"
+
+namespace miner {
+
+Json read_json_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path + ": cannot open file");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return parse_json(ss.str(), path);
+}
+
+Json parse_json(const std::string& text, const std::string& origin) {
+  try {
+    return Json::parse(text);
+  } catch (const Json::parse_error& e) {
+    throw Error(origin + ": malformed JSON at byte " + std::to_string(e.byte) + ": " + e.what());
+  } catch (const Json::exception& e) {  // e.g. out_of_range.406: a number like 1e999
+    throw Error(origin + ": invalid JSON: " + e.what());
+  }
+}
+
+namespace {
+const char* type_name(const Json& j) { return j.type_name(); }
+}  // namespace
+
+void JsonField::fail(const std::string& message) const {
+  throw Error(origin_ + ": " + (path_.empty() ? std::string("(top level)") : path_) + ": " +
+              message);
+}
+
+bool JsonField::has(const std::string& key) const {
+  return value_->is_object() && value_->contains(key);
+}
+
+JsonField JsonField::at(const std::string& key) const {
+  if (!value_->is_object()) fail(std::string("expected an object, got ") + type_name(*value_));
+  const auto it = value_->find(key);
+  const std::string child = path_.empty() ? key : path_ + "." + key;
+  if (it == value_->end()) throw Error(origin_ + ": " + child + ": missing required field");
+  return JsonField(*it, child, origin_);
+}
+
+std::size_t JsonField::array_size() const {
+  if (!value_->is_array()) fail(std::string("expected an array, got ") + type_name(*value_));
+  return value_->size();
+}
+
+JsonField JsonField::at(std::size_t index) const {
+  const std::size_t n = array_size();
+  const std::string child = path_ + "[" + std::to_string(index) + "]";
+  if (index >= n) throw Error(origin_ + ": " + child + ": index out of range (size " +
+                              std::to_string(n) + ")");
+  return JsonField((*value_)[index], child, origin_);
+}
+
+double JsonField::number() const {
+  if (!value_->is_number()) fail(std::string("expected a number, got ") + type_name(*value_));
+  const double v = value_->get<double>();
+  if (!std::isfinite(v)) fail("must be a finite number, got " + value_->dump());
+  return v;
+}
+
+double JsonField::positive_number() const {
+  const double v = number();
+  if (!(v > 0.0)) fail("must be positive, got " + value_->dump());
+  return v;
+}
+
+int JsonField::integer() const {
+  const double v = number();
+  if (std::floor(v) != v || std::fabs(v) > 2147483647.0) fail("expected an integer, got " + value_->dump());
+  return static_cast<int>(v);
+}
+
+std::string JsonField::string() const {
+  if (!value_->is_string()) fail(std::string("expected a string, got ") + type_name(*value_));
+  return value_->get<std::string>();
+}
+
+Eigen::Vector3d JsonField::vec3() const {
+  if (array_size() != 3) {
+    fail("expected an array of 3 numbers [x, y, z], got " + std::to_string(value_->size()) +
+         " elements");
+  }
+  return {at(std::size_t{0}).number(), at(std::size_t{1}).number(), at(std::size_t{2}).number()};
+}
+
+void write_file_atomic(const std::string& path, const std::string& content) {
+  namespace fs = std::filesystem;
+  const fs::path target(path);
+  const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) throw Error(path + ": folder " + dir.string() + " does not exist");
+  const fs::path tmp = dir / ("." + target.filename().string() + ".tmp." + std::to_string(::getpid()));
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw Error(path + ": cannot write (temporary file " + tmp.string() + ")");
+    out << content;
+    out.flush();
+    if (!out) {
+      out.close();
+      fs::remove(tmp, ec);
+      throw Error(path + ": write failed");
+    }
+  }
+  fs::rename(tmp, target, ec);
+  if (ec) {
+    std::error_code ignored;
+    fs::remove(tmp, ignored);
+    throw Error(path + ": cannot replace file: " + ec.message());
+  }
+}
+
+std::string dump_json(const Json& j) { return j.dump(2) + "\n"; }
+
+}  // namespace miner

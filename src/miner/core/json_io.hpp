@@ -1,0 +1,60 @@
+#pragma once
+/// \file
+/// Reading JSON files with messages that name the file and the field at fault, and
+/// writing files atomically so a good file is never half-overwritten (REQ-CORE-003,
+/// REQ-CORE-004).
+
+#include <string>
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+
+namespace miner {
+
+using Json = nlohmann::json;
+
+/// Parses `path` as JSON. Throws Error naming the file on a missing file or a
+/// syntax error (with the byte offset nlohmann reports).
+Json read_json_file(const std::string& path);
+
+/// Parses JSON text; `origin` names it in messages (a path, or "<stdin>").
+Json parse_json(const std::string& text, const std::string& origin);
+
+/// Field access with the dotted path of the field in every message, e.g.
+/// "map.json: bounds.min[2]: expected a number, got string".
+class JsonField {
+ public:
+  JsonField(const Json& value, std::string path, std::string origin)
+      : value_(&value), path_(std::move(path)), origin_(std::move(origin)) {}
+
+  const Json& value() const { return *value_; }
+  const std::string& path() const { return path_; }
+  bool has(const std::string& key) const;
+
+  JsonField at(const std::string& key) const;  ///< required member of an object
+  JsonField at(std::size_t index) const;       ///< element of an array
+  std::size_t array_size() const;              ///< requires an array
+
+  double number() const;                ///< finite number
+  double positive_number() const;       ///< finite and > 0
+  int integer() const;                  ///< an integral number
+  std::string string() const;
+  Eigen::Vector3d vec3() const;         ///< array of 3 finite numbers
+
+  /// Throws Error("<origin>: <path>: <message>").
+  [[noreturn]] void fail(const std::string& message) const;
+
+ private:
+  const Json* value_;
+  std::string path_;
+  std::string origin_;
+};
+
+/// Writes `content` to `path` via a temporary file in the same folder and a rename,
+/// so readers see either the old file or the complete new one, never a mix.
+void write_file_atomic(const std::string& path, const std::string& content);
+
+/// JSON text as the project writes it: 2-space indent, trailing newline.
+std::string dump_json(const Json& j);
+
+}  // namespace miner

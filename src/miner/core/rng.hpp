@@ -1,0 +1,51 @@
+#pragma once
+/// \file
+/// The project's only source of randomness (REQ-CORE-001).
+///
+/// A std::mt19937_64 engine whose seed is derived per stream with SplitMix64, and
+/// uniform / normal transforms written here, because the standard distributions
+/// (std::uniform_real_distribution, std::normal_distribution) are allowed to differ
+/// between standard libraries. The same seed gives the same numbers everywhere.
+
+#include <cstdint>
+#include <random>
+
+namespace miner {
+
+/// SplitMix64 (Steele, Lea, Flood 2014): a bijective 64-bit mixer, used to turn
+/// (master seed, stream) into well-spread engine seeds.
+std::uint64_t splitmix64(std::uint64_t x);
+
+/// Seeded random number generator.
+class Rng {
+ public:
+  /// Stream `stream` of master seed `seed`: engine seeded with SplitMix64(seed ^ stream),
+  /// so trial k of a Monte Carlo campaign is Rng(seed, k) whatever ran before it.
+  explicit Rng(std::uint64_t seed, std::uint64_t stream = 0);
+
+  /// Raw 64-bit output of the engine.
+  std::uint64_t next_u64() { return engine_(); }
+
+  /// Uniform on [0, 1): the top 53 bits of one draw times 2^-53 (exact, no rounding).
+  double uniform01();
+
+  /// Uniform on [lo, hi): lo + (hi - lo) * uniform01().
+  double uniform(double lo, double hi);
+
+  /// Uniform integer on [0, n), n >= 1, unbiased (Lemire 2019, multiply + reject).
+  std::uint64_t uniform_index(std::uint64_t n);
+
+  /// Standard normal N(0, 1) by Marsaglia's polar method (uses only log and sqrt);
+  /// the second variate of each pair is cached.
+  double normal();
+
+  /// N(mean, stddev^2).
+  double normal(double mean, double stddev) { return mean + stddev * normal(); }
+
+ private:
+  std::mt19937_64 engine_;
+  bool has_spare_ = false;
+  double spare_ = 0.0;
+};
+
+}  // namespace miner

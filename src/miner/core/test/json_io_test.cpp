@@ -1,0 +1,98 @@
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+#include <limits>
+#include <fstream>
+#include <sstream>
+
+#include "miner/core/error.hpp"
+#include "miner/core/json_io.hpp"
+
+using miner::Error;
+using miner::Json;
+using miner::JsonField;
+using Catch::Matchers::Contains;
+
+namespace {
+std::string read_all(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+std::filesystem::path temp_dir(const std::string& name) {
+  auto dir = std::filesystem::temp_directory_path() / ("miner_core_test_" + name);
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+}  // namespace
+
+TEST_CASE("Malformed JSON names the file and the byte offset", "[REQ-CORE-003]") {
+  CHECK_THROWS_WITH(miner::parse_json("{\"a\": [1, 2,, 3]}", "x.json"),
+                    Contains("x.json: malformed JSON at byte 13"));
+  CHECK_THROWS_WITH(miner::parse_json("{\"a\": NaN}", "y.json"), Contains("y.json: malformed JSON"));
+  CHECK_THROWS_WITH(miner::parse_json("{\"a\": 1e999}", "z.json"),
+                    Contains("z.json: invalid JSON: [json.exception.out_of_range.406] number overflow"));
+  CHECK_THROWS_WITH(miner::read_json_file("/nonexistent/file.json"),
+                    Contains("/nonexistent/file.json: cannot open file"));
+}
+
+TEST_CASE("Field access names the dotted path and the type found", "[REQ-CORE-003]") {
+  const Json doc = miner::parse_json(
+      R"({"bounds": {"min": [0, "a", 2], "max": [1, 2]}, "r": -1, "n": 2.5, "s": 3})",
+      "m.json");
+  const JsonField root(doc, "", "m.json");
+  CHECK_THROWS_WITH(root.at("bounds").at("min").vec3(),
+                    Contains("m.json: bounds.min[1]: expected a number, got string"));
+  CHECK_THROWS_WITH(root.at("bounds").at("max").vec3(),
+                    Contains("bounds.max: expected an array of 3 numbers [x, y, z], got 2 elements"));
+  CHECK_THROWS_WITH(root.at("missing"), Contains("m.json: missing: missing required field"));
+  CHECK_THROWS_WITH(root.at("r").positive_number(), Contains("r: must be positive, got -1"));
+  CHECK_THROWS_WITH(root.at("n").integer(), Contains("n: expected an integer, got 2.5"));
+  Json with_inf = doc;  // a document built in code (not parsed) can hold an infinity
+  with_inf["big"] = std::numeric_limits<double>::infinity();
+  CHECK_THROWS_WITH(JsonField(with_inf, "", "m.json").at("big").number(), Contains("big: must be a finite number"));
+  CHECK_THROWS_WITH(root.at("s").string(), Contains("s: expected a string, got number"));
+  CHECK_THROWS_WITH(root.at("s").at("x"), Contains("s: expected an object, got number"));
+  CHECK_THROWS_WITH(root.at("bounds").at("max").at(std::size_t{5}),
+                    Contains("bounds.max[5]: index out of range (size 2)"));
+  CHECK(root.at("bounds").at("max").at(std::size_t{1}).integer() == 2);
+  CHECK_FALSE(root.has("missing"));
+  CHECK(root.has("r"));
+  const Json top = miner::parse_json("[1]", "t.json");
+  CHECK_THROWS_WITH(JsonField(top, "", "t.json").fail("bad"), Contains("t.json: (top level): bad"));
+}
+
+TEST_CASE("Atomic write replaces a file whole and leaves no temporary file", "[REQ-CORE-004]") {
+  const auto dir = temp_dir("atomic");
+  const std::string path = (dir / "out.json").string();
+  miner::write_file_atomic(path, "first\n");
+  CHECK(read_all(path) == "first\n");
+  miner::write_file_atomic(path, "second\n");
+  CHECK(read_all(path) == "second\n");
+  int entries = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) {
+    (void)e;
+    ++entries;
+  }
+  CHECK(entries == 1);
+}
+
+TEST_CASE("Atomic write into a missing folder fails and leaves the old file intact", "[REQ-CORE-004]") {
+  CHECK_THROWS_WITH(miner::write_file_atomic("/nonexistent-dir/out.json", "x"),
+                    Contains("folder /nonexistent-dir does not exist"));
+  const auto dir = temp_dir("atomic_fail");
+  const std::string path = (dir / "good.json").string();
+  miner::write_file_atomic(path, "good\n");
+  // A folder where the file should go cannot be replaced by rename: the old content stays.
+  const std::string blocked = (dir / "blocked").string();
+  std::filesystem::create_directories(blocked + "/child");
+  CHECK_THROWS_AS(miner::write_file_atomic(blocked, "new"), Error);
+  CHECK(read_all(path) == "good\n");
+  CHECK(std::filesystem::is_directory(blocked + "/child"));
+}
+
+TEST_CASE("dump_json writes two-space indented JSON with a trailing newline", "[REQ-CORE-003]") {
+  CHECK(miner::dump_json(Json{{"a", 1}}) == "{\n  \"a\": 1\n}\n");
+}

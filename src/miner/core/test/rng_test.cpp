@@ -1,0 +1,80 @@
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <vector>
+
+#include "miner/core/rng.hpp"
+
+using miner::Rng;
+
+TEST_CASE("Same seed and stream give the same sequence and other streams differ", "[REQ-CORE-001]") {
+  Rng a(42, 7), b(42, 7), c(42, 8), d(43, 7);
+  bool differs_c = false, differs_d = false;
+  for (int i = 0; i < 1000; ++i) {
+    const auto x = a.next_u64();
+    REQUIRE(x == b.next_u64());
+    differs_c |= x != c.next_u64();
+    differs_d |= x != d.next_u64();
+  }
+  CHECK(differs_c);
+  CHECK(differs_d);
+}
+
+TEST_CASE("SplitMix64 matches its published reference values", "[REQ-CORE-001]") {
+  // Reference: the SplitMix64 generator of Vigna (prng.di.unimi.it) seeded with 0 gives
+  // 0xE220A8397B1DCDAF first; splitmix64(x) here is one step from state x.
+  CHECK(miner::splitmix64(0) == 0xE220A8397B1DCDAFULL);
+  CHECK(miner::splitmix64(0x9E3779B97F4A7C15ULL) == 0x6E789E6AA1B965F4ULL);
+}
+
+TEST_CASE("uniform01 stays in the half-open unit interval and uniform(lo, hi) below hi", "[REQ-CORE-001]") {
+  Rng rng(1);
+  for (int i = 0; i < 100000; ++i) {
+    const double u = rng.uniform01();
+    REQUIRE(u >= 0.0);
+    REQUIRE(u < 1.0);
+    const double v = rng.uniform(-3.0, 5.0);
+    REQUIRE(v >= -3.0);
+    REQUIRE(v < 5.0);
+  }
+}
+
+TEST_CASE("uniform_index is unbiased over a small range and rejects n = 0", "[REQ-CORE-001]") {
+  Rng rng(2);
+  constexpr int kBins = 7, kDraws = 70000;
+  std::vector<int> counts(kBins, 0);
+  for (int i = 0; i < kDraws; ++i) {
+    const auto k = rng.uniform_index(kBins);
+    REQUIRE(k < kBins);
+    ++counts[k];
+  }
+  // Chi-square with 6 degrees of freedom; 22.46 is its 0.999 quantile, so a correct
+  // generator fails this fixed-seed check with probability 1e-3 — and the seed is fixed.
+  double chi2 = 0.0;
+  const double expected = static_cast<double>(kDraws) / kBins;
+  for (int c : counts) chi2 += (c - expected) * (c - expected) / expected;
+  CHECK(chi2 < 22.46);
+  CHECK_THROWS_AS(rng.uniform_index(0), std::invalid_argument);
+  CHECK(rng.uniform_index(1) == 0);
+}
+
+TEST_CASE("normal() has mean 0, variance 1 and normal tails", "[REQ-CORE-001]") {
+  Rng rng(3);
+  constexpr int kN = 200000;
+  double sum = 0.0, sum2 = 0.0;
+  int beyond2 = 0;
+  for (int i = 0; i < kN; ++i) {
+    const double x = rng.normal();
+    sum += x;
+    sum2 += x * x;
+    beyond2 += std::fabs(x) > 2.0;
+  }
+  const double mean = sum / kN, var = sum2 / kN - mean * mean;
+  // Standard errors: mean 1/sqrt(N) = 0.0022, variance sqrt(2/N) = 0.0032; 5 sigma bounds.
+  CHECK(std::fabs(mean) < 5 * 0.0022);
+  CHECK(std::fabs(var - 1.0) < 5 * 0.0032);
+  // P(|x| > 2) = 0.0455; binomial standard error sqrt(p(1-p)/N) = 0.00047; 5 sigma.
+  CHECK(std::fabs(static_cast<double>(beyond2) / kN - 0.0455) < 5 * 0.00047);
+  Rng shifted(3);
+  CHECK(shifted.normal(10.0, 2.0) == Approx(10.0 + 2.0 * Rng(3).normal()).epsilon(1e-15));
+}

@@ -1,0 +1,42 @@
+#pragma once
+/// \file
+/// A* on the 26-connected voxel grid (Hart, Nilsson, Raphael 1968): the ground truth
+/// path of the sGAN dataset and the reference cost for planners (REQ-WORLD-007,
+/// REQ-WORLD-008).
+
+#include <cstddef>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace miner::world {
+
+class Map;
+class VoxelGrid;
+
+struct GridPath {
+  /// start, the centre of every cell of the grid path (the start's cell to the
+  /// goal's cell), goal.
+  std::vector<Eigen::Vector3d> points;
+  std::vector<Eigen::Vector3i> cells;  ///< the grid cells from the start's to the goal's
+  double grid_cost = 0.0;  ///< length of the cell-centre chain: sum of res * {1, sqrt2, sqrt3}
+  double cost = 0.0;       ///< Euclidean length of `points` (start and goal legs included)
+  std::size_t expanded = 0;  ///< cells taken off the open list
+};
+
+/// Shortest path on the grid's 26-neighbour graph between the cells of `start` and
+/// `goal`, with edge length = distance between cell centres. A diagonal move is allowed
+/// only if every cell of the 2x2 (or 2x2x2) block it crosses is free, so no move cuts a
+/// corner of an occupied cell.
+///
+/// Throws miner::Error if start or goal is out of bounds, in collision (naming the
+/// obstacle) or in an occupied grid cell, and miner::NoSolution if the goal's cell
+/// is not reachable from the start's.
+GridPath astar(const Map& map, const VoxelGrid& grid, const Eigen::Vector3d& start,
+               const Eigen::Vector3d& goal);
+
+/// The grid distance between two cells ignoring obstacles (the consistent heuristic):
+/// res * (sqrt3 d3 + sqrt2 (d2 - d3) + (d1 - d2)) for sorted |deltas| d1 >= d2 >= d3.
+double octile_distance(const Eigen::Vector3i& a, const Eigen::Vector3i& b, double resolution);
+
+}  // namespace miner::world

@@ -1,0 +1,61 @@
+#include "miner/world/box.hpp"
+
+#include <algorithm>
+#include <array>
+
+namespace miner::world {
+
+double squared_distance(const Eigen::Vector3d& p, const Box& box) {
+  double d2 = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    const double below = box.min[k] - p[k];
+    const double above = p[k] - box.max[k];
+    const double e = std::max({below, 0.0, above});
+    d2 += e * e;
+  }
+  return d2;
+}
+
+double squared_distance(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Box& box) {
+  const Eigen::Vector3d d = b - a;
+  // Breakpoints of the piecewise quadratic, kept inside (0, 1), plus the ends.
+  std::array<double, 8> t{};
+  int n = 0;
+  t[n++] = 0.0;
+  t[n++] = 1.0;
+  for (int k = 0; k < 3; ++k) {
+    if (d[k] == 0.0) continue;
+    for (const double face : {box.min[k], box.max[k]}) {
+      const double tk = (face - a[k]) / d[k];
+      if (tk > 0.0 && tk < 1.0) t[n++] = tk;
+    }
+  }
+  std::sort(t.begin(), t.begin() + n);
+
+  const auto f = [&](double s) { return squared_distance(Eigen::Vector3d(a + s * d), box); };
+  double best = f(t[0]);
+  for (int i = 0; i + 1 < n; ++i) {
+    best = std::min(best, f(t[i + 1]));
+    const double lo = t[i], hi = t[i + 1];
+    if (hi <= lo) continue;
+    // On (lo, hi) each axis is entirely below, inside or above the slab: the piece is
+    // q(s) = sum_{active k} (a_k + s d_k - face_k)^2, minimised at s* = -sum(e_k d_k)/sum(d_k^2).
+    const Eigen::Vector3d mid = a + (0.5 * (lo + hi)) * d;
+    double num = 0.0, den = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      double face = 0.0;
+      if (mid[k] < box.min[k]) face = box.min[k];
+      else if (mid[k] > box.max[k]) face = box.max[k];
+      else continue;
+      num += (a[k] - face) * d[k];
+      den += d[k] * d[k];
+    }
+    if (den > 0.0) {
+      const double s = -num / den;
+      if (s > lo && s < hi) best = std::min(best, f(s));
+    }
+  }
+  return best;
+}
+
+}  // namespace miner::world

@@ -1,0 +1,43 @@
+#pragma once
+/// \file
+/// Axis-aligned boxes and exact distance queries (REQ-WORLD-004, REQ-WORLD-005).
+///
+/// A box is the closed set B = [min, max] (a point on its boundary is inside).
+/// A robot of radius r at p collides with B iff dist(p, B) <= r, i.e. p lies in the
+/// Minkowski sum of B and the closed ball of radius r (a rounded box), so queries
+/// with a radius are exact, not a box-inflated approximation.
+
+#include <Eigen/Core>
+
+namespace miner::world {
+
+struct Box {
+  Eigen::Vector3d min;
+  Eigen::Vector3d max;
+
+  /// The box grown by r on every side (a conservative cover of the rounded box).
+  Box inflated(double r) const { return {min.array() - r, max.array() + r}; }
+  bool contains(const Eigen::Vector3d& p) const {
+    return (p.array() >= min.array()).all() && (p.array() <= max.array()).all();
+  }
+  /// Closed boxes overlap (touching counts).
+  bool overlaps(const Box& o) const {
+    return (min.array() <= o.max.array()).all() && (o.min.array() <= max.array()).all();
+  }
+  Eigen::Vector3d center() const { return 0.5 * (min + max); }
+  Eigen::Vector3d extent() const { return max - min; }
+  double volume() const { return extent().prod(); }
+};
+
+/// dist(p, B)^2 = sum_k max(min_k - p_k, 0, p_k - max_k)^2.
+double squared_distance(const Eigen::Vector3d& p, const Box& box);
+
+/// min over t in [0,1] of dist(a + t (b - a), B)^2.
+///
+/// f(t) = dist(a + t d, B)^2 is convex and piecewise quadratic in t, with breakpoints
+/// where a coordinate crosses a face plane (at most 6). Its minimum is attained at
+/// t = 0, t = 1, a breakpoint, or the stationary point of one quadratic piece; all
+/// these candidates are evaluated exactly, so the result is exact up to rounding.
+double squared_distance(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Box& box);
+
+}  // namespace miner::world

@@ -1,0 +1,173 @@
+#include "miner/world/map.hpp"
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "miner/core/error.hpp"
+
+namespace miner::world {
+
+namespace {
+
+std::string axis_name(int k) { return std::string(1, "xyz"[k]); }
+
+void validate_box(const Box& b, const std::string& what) {
+  require_finite(b.min, what + ".min");
+  require_finite(b.max, what + ".max");
+  for (int k = 0; k < 3; ++k) {
+    if (!(b.min[k] < b.max[k])) {
+      std::ostringstream os;
+      os << what << ": min[" << k << "] = " << b.min[k] << " must be less than max[" << k
+         << "] = " << b.max[k] << " (" << axis_name(k) << " axis)";
+      throw Error(os.str());
+    }
+  }
+}
+
+Json vec_json(const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); }
+
+std::string obstacle_name(std::size_t i, const Box& b) {
+  return "obstacle " + std::to_string(i) + " [" + format_point(b.min) + " - " +
+         format_point(b.max) + "]";
+}
+
+}  // namespace
+
+Map::Map(Box bounds, double resolution, std::vector<Box> obstacles, std::optional<Query> query)
+    : bounds_(std::move(bounds)),
+      resolution_(resolution),
+      obstacles_(std::move(obstacles)),
+      query_(std::move(query)) {
+  validate_box(bounds_, "bounds");
+  require_finite(resolution_, "resolution");
+  if (!(resolution_ > 0.0)) {
+    std::ostringstream os;
+    os << "resolution: must be positive, got " << resolution_;
+    throw Error(os.str());
+  }
+  for (std::size_t i = 0; i < obstacles_.size(); ++i) {
+    validate_box(obstacles_[i], "obstacles[" + std::to_string(i) + "]");
+  }
+  if (query_) {
+    require_finite(query_->start, "query.start");
+    require_finite(query_->goal, "query.goal");
+    require_finite(query_->robot_radius, "query.robot_radius");
+    if (query_->robot_radius < 0.0) throw Error("query.robot_radius: must not be negative");
+  }
+}
+
+Map Map::from_json(const Json& doc, const std::string& origin) {
+  const JsonField root(doc, "", origin);
+  if (!doc.is_object()) root.fail("expected a JSON object with \"format\": \"miner-map-v1\"");
+  const std::string format = root.at("format").string();
+  if (format != kMapFormat) {
+    root.at("format").fail("unknown format tag \"" + format + "\", expected \"" + kMapFormat + "\"");
+  }
+  const JsonField jb = root.at("bounds");
+  Box bounds{jb.at("min").vec3(), jb.at("max").vec3()};
+  const double resolution = root.at("resolution").number();
+
+  std::vector<Box> obstacles;
+  const JsonField jo = root.at("obstacles");
+  const std::size_t n = jo.array_size();
+  obstacles.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const JsonField o = jo.at(i);
+    const std::string type = o.at("type").string();
+    if (type != "box") o.at("type").fail("unknown obstacle type \"" + type + "\", expected \"box\"");
+    obstacles.push_back({o.at("min").vec3(), o.at("max").vec3()});
+  }
+
+  std::optional<Query> query;
+  if (root.has("query")) {
+    const JsonField q = root.at("query");
+    query = Query{q.at("start").vec3(), q.at("goal").vec3(),
+                  q.has("robot_radius") ? q.at("robot_radius").number() : 0.0};
+  }
+  try {
+    return Map(bounds, resolution, std::move(obstacles), query);
+  } catch (const Error& e) {
+    throw Error(origin + ": " + e.what());
+  }
+}
+
+Map Map::load(const std::string& path) {
+  const auto ends_with = [&](const std::string& suffix) {
+    return path.size() >= suffix.size() &&
+           path.compare(path.size() - suffix.size(), suffix.size(), suffix) == 0;
+  };
+  if (ends_with(".bt")) return load_octomap(path);
+  return from_json(read_json_file(path), path);
+}
+
+Json Map::to_json() const {
+  Json obstacles = Json::array();
+  for (const Box& b : obstacles_) {
+    obstacles.push_back({{"type", "box"}, {"min", vec_json(b.min)}, {"max", vec_json(b.max)}});
+  }
+  Json doc = {{"format", kMapFormat},
+              {"bounds", {{"min", vec_json(bounds_.min)}, {"max", vec_json(bounds_.max)}}},
+              {"resolution", resolution_},
+              {"obstacles", obstacles}};
+  if (query_) {
+    doc["query"] = {{"start", vec_json(query_->start)},
+                    {"goal", vec_json(query_->goal)},
+                    {"robot_radius", query_->robot_radius}};
+  }
+  return doc;
+}
+
+void Map::save(const std::string& path) const {
+  if (path.size() >= 3 && path.compare(path.size() - 3, 3, ".bt") == 0) {
+    save_octomap(path);
+  } else {
+    write_file_atomic(path, dump_json(to_json()));
+  }
+}
+
+std::optional<std::size_t> Map::point_collision(const Eigen::Vector3d& p, double radius) const {
+  const double r2 = radius * radius;
+  for (std::size_t i = 0; i < obstacles_.size(); ++i) {
+    if (squared_distance(p, obstacles_[i]) <= r2) return i;
+  }
+  return std::nullopt;
+}
+
+std::optional<std::size_t> Map::segment_collision(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                                  double radius) const {
+  const double r2 = radius * radius;
+  const Box sweep{a.cwiseMin(b).array() - radius, a.cwiseMax(b).array() + radius};
+  for (std::size_t i = 0; i < obstacles_.size(); ++i) {
+    if (!sweep.overlaps(obstacles_[i])) continue;  // broad phase: bounding boxes apart
+    if (squared_distance(a, b, obstacles_[i]) <= r2) return i;
+  }
+  return std::nullopt;
+}
+
+double Map::clearance(const Eigen::Vector3d& p) const {
+  double best = std::numeric_limits<double>::infinity();
+  for (const Box& b : obstacles_) best = std::min(best, squared_distance(p, b));
+  return std::sqrt(best);
+}
+
+void Map::require_free(const Eigen::Vector3d& p, double radius, const std::string& what) const {
+  require_finite(p, what);
+  if (!in_bounds(p)) {
+    throw Error(what + " " + format_point(p) + " lies outside the map bounds [" +
+                format_point(bounds_.min) + " - " + format_point(bounds_.max) + "]");
+  }
+  if (const auto hit = point_collision(p, radius)) {
+    const Box& b = obstacles_[*hit];
+    std::ostringstream os;
+    if (squared_distance(p, b) == 0.0) {
+      os << what << " " << format_point(p) << " lies inside " << obstacle_name(*hit, b);
+    } else {
+      os << what << " " << format_point(p) << " is within the robot radius " << radius << " of "
+         << obstacle_name(*hit, b) << " (clearance " << std::sqrt(squared_distance(p, b)) << ")";
+    }
+    throw Error(os.str());
+  }
+}
+
+}  // namespace miner::world

@@ -1,0 +1,92 @@
+#pragma once
+/// \file
+/// The world model: a bounded 3D workspace with box obstacles (paper Sec. III-A:
+/// X = bounds, X_obs = union of boxes, X_free = closure(X \ X_obs)).
+///
+/// File format `miner-map-v1` (REQ-WORLD-001), ENU metres, z up:
+///   {"format": "miner-map-v1",
+///    "bounds": {"min": [0,0,0], "max": [100,100,100]},
+///    "resolution": 0.5,
+///    "obstacles": [{"type": "box", "min": [10,10,0], "max": [20,25,40]}],
+///    "query": {"start": [..], "goal": [..], "robot_radius": 0.5}}   // optional
+/// OctoMap binary trees (`.bt`) are accepted too (REQ-WORLD-003).
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "miner/core/json_io.hpp"
+#include "miner/world/box.hpp"
+
+namespace miner::world {
+
+inline constexpr const char* kMapFormat = "miner-map-v1";
+
+/// A start/goal pair stored with a map (optional extension of miner-map-v1), so a map
+/// generated for a benchmark carries the query it was checked against.
+struct Query {
+  Eigen::Vector3d start;
+  Eigen::Vector3d goal;
+  double robot_radius = 0.0;
+};
+
+class Map {
+ public:
+  /// Validates every argument (REQ-WORLD-002); throws miner::Error naming the fault.
+  Map(Box bounds, double resolution, std::vector<Box> obstacles,
+      std::optional<Query> query = std::nullopt);
+
+  /// Loads a `miner-map-v1` JSON file, or an OctoMap `.bt` file by its extension.
+  static Map load(const std::string& path);
+  /// Parses a `miner-map-v1` document; `origin` names it in error messages.
+  static Map from_json(const Json& doc, const std::string& origin);
+  /// Occupied leaves of an OctoMap binary tree become box obstacles; the bounds are the
+  /// metric bounding box of the tree's known cells, the resolution the tree's.
+  static Map load_octomap(const std::string& path);
+
+  Json to_json() const;
+  /// Writes the map as JSON (atomic), or as an OctoMap `.bt` if `path` ends in .bt.
+  void save(const std::string& path) const;
+  /// Voxelises the obstacles at the map resolution into an OctoMap binary tree; the
+  /// two corner cells of the bounds are stored as free so the bounds survive a round trip.
+  void save_octomap(const std::string& path) const;
+
+  const Box& bounds() const { return bounds_; }
+  double resolution() const { return resolution_; }
+  const std::vector<Box>& obstacles() const { return obstacles_; }
+  const std::optional<Query>& query() const { return query_; }
+
+  bool in_bounds(const Eigen::Vector3d& p) const { return bounds_.contains(p); }
+
+  /// Index of an obstacle within distance `radius` of p (boundary counts), if any.
+  std::optional<std::size_t> point_collision(const Eigen::Vector3d& p, double radius = 0.0) const;
+  /// Index of an obstacle within `radius` of some point of segment [a, b], if any.
+  std::optional<std::size_t> segment_collision(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                               double radius = 0.0) const;
+  /// A robot of `radius` at p is collision-free and p lies inside the bounds.
+  bool is_free(const Eigen::Vector3d& p, double radius = 0.0) const {
+    return in_bounds(p) && !point_collision(p, radius);
+  }
+  /// The segment stays inside the bounds and at distance > radius from every obstacle.
+  bool segment_free(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double radius = 0.0) const {
+    return in_bounds(a) && in_bounds(b) && !segment_collision(a, b, radius);
+  }
+
+  /// Distance from p to the nearest obstacle (+infinity with no obstacles).
+  double clearance(const Eigen::Vector3d& p) const;
+
+  /// Throws miner::Error unless a robot of `radius` can stand at p; `what` names the
+  /// point ("start", "goal") and the message names the offending obstacle.
+  void require_free(const Eigen::Vector3d& p, double radius, const std::string& what) const;
+
+ private:
+  Box bounds_;
+  double resolution_;
+  std::vector<Box> obstacles_;
+  std::optional<Query> query_;
+};
+
+}  // namespace miner::world

@@ -1,0 +1,163 @@
+#include "miner/world/map_generator.hpp"
+
+#include <cmath>
+
+#include "miner/core/error.hpp"
+#include "miner/core/rng.hpp"
+#include "miner/world/astar.hpp"
+#include "miner/world/voxel_grid.hpp"
+
+namespace miner::world {
+
+namespace {
+
+/// Rounds to a multiple of q through an integer count so the printed JSON is short:
+/// round(x / q) / (1 / q) is the double nearest the decimal when 1/q is an integer.
+double quantize(double x, double q) {
+  const double inv = std::round(1.0 / q);
+  return std::round(x * inv) / inv;
+}
+
+Eigen::Vector3d quantize(const Eigen::Vector3d& p, double q) {
+  return {quantize(p.x(), q), quantize(p.y(), q), quantize(p.z(), q)};
+}
+
+Eigen::Vector3d uniform_in(Rng& rng, const Box& b) {
+  return {rng.uniform(b.min.x(), b.max.x()), rng.uniform(b.min.y(), b.max.y()),
+          rng.uniform(b.min.z(), b.max.z())};
+}
+
+/// A box with the given size placed uniformly so it lies inside `bounds`.
+Box place(Rng& rng, const Box& bounds, const Eigen::Vector3d& size, double q) {
+  Eigen::Vector3d lo;
+  for (int k = 0; k < 3; ++k) lo[k] = rng.uniform(bounds.min[k], bounds.max[k] - size[k]);
+  lo = quantize(lo, q);
+  return {lo, quantize(Eigen::Vector3d(lo + size), q)};
+}
+
+bool keeps_clear(const Box& b, const Query& query, double keep_free) {
+  const double r2 = keep_free * keep_free;
+  return squared_distance(query.start, b) > r2 && squared_distance(query.goal, b) > r2;
+}
+
+std::vector<Box> sim_obstacles(Rng& rng, const GeneratorPreset& p, int count, const Query& q) {
+  std::vector<Box> boxes;
+  for (int tries = 0; static_cast<int>(boxes.size()) < count && tries < 100 * count; ++tries) {
+    const Eigen::Vector3d size = quantize(
+        Eigen::Vector3d(rng.uniform(p.min_side, p.max_side), rng.uniform(p.min_side, p.max_side),
+                        rng.uniform(p.min_side, p.max_side)),
+        p.quantum);
+    const Box b = place(rng, p.bounds, size, p.quantum);
+    if (keeps_clear(b, q, p.keep_free)) boxes.push_back(b);
+  }
+  return boxes;
+}
+
+/// Pillars of 0.6 x 1.2 m footprint (either orientation), 1.5 m to full height, plus
+/// a hoop: a ring of diameter 1 m in a vertical plane on a post, built from 16 bars.
+std::vector<Box> indoor_obstacles(Rng& rng, const GeneratorPreset& p, int count, const Query& q) {
+  constexpr double kShort = 0.6, kLong = 1.2;          // pillar footprint (paper Sec. V-D)
+  constexpr double kMinHeight = 1.5;                   // lowest pillar, m
+  constexpr double kHoopDiameter = 1.0, kBar = 0.06;   // hoop and its bar thickness, m
+  constexpr int kHoopBars = 16;
+  const double height = p.bounds.extent().z();
+  std::vector<Box> boxes;
+
+  // The hoop first, so pillars are placed around it.
+  const double hoop_z = 1.6;
+  const Eigen::Vector3d hoop_c = quantize(
+      Eigen::Vector3d(rng.uniform(3.5, 6.5), rng.uniform(3.5, 6.5), hoop_z), p.quantum);
+  const bool along_x = rng.uniform01() < 0.5;  // ring plane: x-z if along_x, else y-z
+  const double radius = 0.5 * kHoopDiameter;
+  for (int i = 0; i < kHoopBars; ++i) {
+    const double th = 2.0 * M_PI * (i + 0.5) / kHoopBars;
+    const double u = radius * std::cos(th), w = radius * std::sin(th);
+    Eigen::Vector3d c = hoop_c + Eigen::Vector3d(along_x ? u : 0.0, along_x ? 0.0 : u, w);
+    const Eigen::Vector3d half(kBar / 2, kBar / 2, kBar / 2);
+    boxes.push_back({quantize(Eigen::Vector3d(c - half), 0.01), quantize(Eigen::Vector3d(c + half), 0.01)});
+  }
+  boxes.push_back({quantize(Eigen::Vector3d(hoop_c.x() - kBar / 2, hoop_c.y() - kBar / 2, 0.0), 0.01),
+                   quantize(Eigen::Vector3d(hoop_c.x() + kBar / 2, hoop_c.y() + kBar / 2,
+                                            hoop_z - radius - kBar / 2), 0.01)});
+  const Box hoop_zone{hoop_c.array() - (radius + 0.6), hoop_c.array() + (radius + 0.6)};
+
+  int pillars = 0;
+  for (int tries = 0; pillars < count && tries < 100 * count; ++tries) {
+    const bool rotate = rng.uniform01() < 0.5;
+    const Eigen::Vector3d size(rotate ? kLong : kShort, rotate ? kShort : kLong,
+                               quantize(rng.uniform(kMinHeight, height), p.quantum));
+    Box b = place(rng, p.bounds, size, p.quantum);
+    b.max.z() = b.max.z() - b.min.z();  // pillars stand on the floor
+    b.min.z() = 0.0;
+    if (!keeps_clear(b, q, p.keep_free) || b.overlaps(hoop_zone)) continue;
+    boxes.push_back(b);
+    ++pillars;
+  }
+  return boxes;
+}
+
+}  // namespace
+
+std::vector<std::string> generator_preset_names() { return {"sim", "indoor"}; }
+
+GeneratorPreset generator_preset(const std::string& name) {
+  if (name == "sim") {
+    return {"sim",
+            Box{{0, 0, 0}, {100, 100, 40}},
+            0.5,
+            45, 60,
+            4.0, 15.0,
+            0.5,
+            3.0,
+            Box{{2, 2, 2}, {10, 10, 10}},
+            Box{{90, 90, 2}, {98, 98, 10}},
+            0.1};
+  }
+  if (name == "indoor") {
+    return {"indoor",
+            Box{{0, 0, 0}, {10, 10, 5}},
+            0.1,
+            15, 20,
+            0.6, 1.2,
+            0.2,
+            0.7,
+            Box{{0.5, 0.5, 0.8}, {1.5, 1.5, 1.5}},
+            Box{{8.5, 8.5, 0.8}, {9.5, 9.5, 1.5}},
+            0.05};
+  }
+  std::string known;
+  for (const auto& n : generator_preset_names()) known += (known.empty() ? "" : ", ") + n;
+  throw Error("preset: unknown map preset \"" + name + "\" (known: " + known + ")");
+}
+
+Map generate_map(const GeneratorPreset& preset, std::uint64_t seed,
+                 std::optional<int> obstacle_count) {
+  if (obstacle_count && *obstacle_count < 0) {
+    throw Error("obstacles: count must not be negative, got " + std::to_string(*obstacle_count));
+  }
+  for (int attempt = 0; attempt < kMaxGeneratorAttempts; ++attempt) {
+    Rng rng(seed, static_cast<std::uint64_t>(attempt));
+    const Query query{quantize(uniform_in(rng, preset.start_region), preset.quantum),
+                      quantize(uniform_in(rng, preset.goal_region), preset.quantum),
+                      preset.robot_radius};
+    const int count =
+        obstacle_count ? *obstacle_count
+                       : preset.min_obstacles + static_cast<int>(rng.uniform_index(
+                             static_cast<std::uint64_t>(preset.max_obstacles - preset.min_obstacles + 1)));
+    std::vector<Box> boxes = preset.name == "indoor" ? indoor_obstacles(rng, preset, count, query)
+                                                     : sim_obstacles(rng, preset, count, query);
+    Map map(preset.bounds, preset.resolution, std::move(boxes), query);
+    try {
+      const VoxelGrid grid(map, query.robot_radius);
+      astar(map, grid, query.start, query.goal);
+      return map;
+    } catch (const Error&) {
+      continue;  // blocked query: draw the next attempt's map
+    }
+  }
+  throw NoSolution("preset \"" + preset.name + "\": no solvable map in " +
+                   std::to_string(kMaxGeneratorAttempts) + " attempts for seed " +
+                   std::to_string(seed) + " (too many obstacles?)");
+}
+
+}  // namespace miner::world

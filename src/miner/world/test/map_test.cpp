@@ -1,0 +1,128 @@
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <limits>
+
+#include "miner/core/error.hpp"
+#include "miner/world/map.hpp"
+#include "test_maps.hpp"
+
+using miner::Error;
+using miner::Json;
+using miner::world::Box;
+using miner::world::Map;
+using Catch::Matchers::Contains;
+using V = Eigen::Vector3d;
+
+namespace {
+Json valid_doc() {
+  return miner::parse_json(R"({"format": "miner-map-v1",
+    "bounds": {"min": [0,0,0], "max": [100,100,100]}, "resolution": 0.5,
+    "obstacles": [{"type": "box", "min": [10,10,0], "max": [20,25,40]}]})",
+                           "doc");
+}
+std::string error_of(const Json& doc) {
+  try {
+    Map::from_json(doc, "m.json");
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+}  // namespace
+
+TEST_CASE("A miner-map-v1 document loads as written in the design contract", "[REQ-WORLD-001]") {
+  const Map map = Map::from_json(valid_doc(), "doc");
+  CHECK(map.bounds().max == V(100, 100, 100));
+  CHECK(map.resolution() == 0.5);
+  REQUIRE(map.obstacles().size() == 1);
+  CHECK(map.obstacles()[0].min == V(10, 10, 0));
+  CHECK(map.obstacles()[0].max == V(20, 25, 40));
+  CHECK_FALSE(map.query());
+}
+
+TEST_CASE("Saving and loading a map gives back the same map and the same bytes", "[REQ-WORLD-001]") {
+  const Map map(Box{{0, 0, 0}, {10, 10, 5}}, 0.1, {Box{{1, 2, 0}, {1.6, 3.2, 4.5}}},
+                miner::world::Query{{0.5, 0.5, 1}, {9, 9, 1}, 0.2});
+  const std::string path = miner::world::test::temp_path("roundtrip.json");
+  map.save(path);
+  const Map back = Map::load(path);
+  CHECK(back.to_json() == map.to_json());
+  REQUIRE(back.query());
+  CHECK(back.query()->robot_radius == 0.2);
+  CHECK(miner::dump_json(back.to_json()) == miner::dump_json(map.to_json()));
+}
+
+TEST_CASE("Bad map documents are refused with the field named", "[REQ-WORLD-002]") {
+  Json d = valid_doc();
+  d["format"] = "miner-map-v2";
+  CHECK_THAT(error_of(d), Contains("m.json: format: unknown format tag \"miner-map-v2\""));
+  d = valid_doc();
+  d.erase("format");
+  CHECK_THAT(error_of(d), Contains("format: missing required field"));
+  d = valid_doc();
+  d["bounds"]["max"][2] = -5;
+  CHECK_THAT(error_of(d), Contains("bounds: min[2] = 0 must be less than max[2] = -5"));
+  d = valid_doc();
+  d["resolution"] = -0.5;
+  CHECK_THAT(error_of(d), Contains("resolution: must be positive, got -0.5"));
+  d = valid_doc();
+  d["resolution"] = 0;
+  CHECK_THAT(error_of(d), Contains("resolution: must be positive"));
+  d = valid_doc();
+  d["resolution"] = std::numeric_limits<double>::infinity();
+  CHECK_THAT(error_of(d), Contains("resolution: must be a finite number"));
+  d = valid_doc();
+  d["obstacles"][0]["type"] = "sphere";
+  CHECK_THAT(error_of(d), Contains("obstacles[0].type: unknown obstacle type \"sphere\""));
+  d = valid_doc();
+  d["obstacles"][0]["max"][0] = 5;
+  CHECK_THAT(error_of(d), Contains("obstacles[0]: min[0] = 10 must be less than max[0] = 5"));
+  d = valid_doc();
+  d["obstacles"][0]["min"][1] = std::numeric_limits<double>::quiet_NaN();
+  CHECK_THAT(error_of(d), Contains("obstacles[0].min[1]"));
+  d = valid_doc();
+  d["obstacles"] = Json::object();
+  CHECK_THAT(error_of(d), Contains("obstacles: expected an array, got object"));
+  d = valid_doc();
+  d["query"] = {{"start", {1, 1, 1}}, {"goal", {2, 2, 2}}, {"robot_radius", -1}};
+  CHECK_THAT(error_of(d), Contains("query.robot_radius: must not be negative"));
+  CHECK_THAT(error_of(Json::array()), Contains("expected a JSON object"));
+  CHECK_THROWS_WITH(Map::load(miner::world::test::temp_path("does-not-exist.json")),
+                    Contains("cannot open file"));
+}
+
+TEST_CASE("Point queries: inside, boundary, within the robot radius, outside the bounds", "[REQ-WORLD-004]") {
+  const Map map = miner::world::test::pillar_map();
+  CHECK(map.point_collision(V(5, 5, 5)) == std::optional<std::size_t>(0));
+  CHECK(map.point_collision(V(6, 5, 5)));  // on the face
+  CHECK_FALSE(map.point_collision(V(6.5, 5, 5)));
+  CHECK(map.point_collision(V(6.5, 5, 5), 0.5));          // exactly at the radius
+  CHECK_FALSE(map.point_collision(V(6.5, 6.5, 5), 0.7));  // corner distance 0.707 > 0.7
+  CHECK(map.point_collision(V(6.5, 6.5, 5), 0.71));
+  CHECK(map.is_free(V(1, 1, 1)));
+  CHECK_FALSE(map.is_free(V(-0.1, 1, 1)));
+  CHECK(map.clearance(V(8, 5, 5)) == 2.0);
+  CHECK(std::isinf(Map(Box{{0, 0, 0}, {1, 1, 1}}, 0.1, {}).clearance(V(0.5, 0.5, 0.5))));
+}
+
+TEST_CASE("Segment queries: blocked through the pillar, free around it, radius counts", "[REQ-WORLD-005]") {
+  const Map map = miner::world::test::pillar_map();
+  CHECK(map.segment_collision(V(1, 5, 5), V(9, 5, 5)));
+  CHECK(map.segment_free(V(1, 7, 5), V(9, 7, 5)));
+  CHECK_FALSE(map.segment_free(V(1, 7, 5), V(9, 7, 5), 1.0));  // distance 1 = radius
+  CHECK(map.segment_free(V(1, 7, 5), V(9, 7, 5), 0.99));
+  CHECK_FALSE(map.segment_free(V(1, 7, 5), V(11, 7, 5)));  // leaves the bounds
+}
+
+TEST_CASE("require_free names the point and the obstacle", "[REQ-WORLD-010]") {
+  const Map map = miner::world::test::pillar_map();
+  CHECK_THROWS_WITH(map.require_free(V(5, 5, 5), 0.0, "start"),
+                    Contains("start (5, 5, 5) lies inside obstacle 0 [(4, 4, 0) - (6, 6, 10)]"));
+  CHECK_THROWS_WITH(map.require_free(V(6.2, 5, 5), 0.5, "goal"),
+                    Contains("goal (6.2, 5, 5) is within the robot radius 0.5 of obstacle 0"));
+  CHECK_THROWS_WITH(map.require_free(V(5, 5, 11), 0.0, "goal"),
+                    Contains("goal (5, 5, 11) lies outside the map bounds"));
+  CHECK_THROWS_WITH(map.require_free(V(5, NAN, 1), 0.0, "start"), Contains("start[1]: must be a finite"));
+  CHECK_NOTHROW(map.require_free(V(1, 1, 1), 0.5, "start"));
+}

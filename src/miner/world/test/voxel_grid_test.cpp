@@ -1,0 +1,62 @@
+#include <catch2/catch.hpp>
+
+#include "miner/core/error.hpp"
+#include "miner/world/map.hpp"
+#include "miner/world/voxel_grid.hpp"
+#include "test_maps.hpp"
+
+using miner::world::Box;
+using miner::world::Map;
+using miner::world::VoxelGrid;
+using Catch::Matchers::Contains;
+using V = Eigen::Vector3d;
+using I = Eigen::Vector3i;
+
+TEST_CASE("A grid-aligned box occupies exactly its cells, not the ones touching it", "[REQ-WORLD-006]") {
+  const Map map = miner::world::test::pillar_map();
+  const VoxelGrid grid(map, 0.0);
+  CHECK(grid.dims() == I(10, 10, 10));
+  CHECK(grid.cell_count() == 1000);
+  CHECK(grid.occupied_count() == 2 * 2 * 10);
+  CHECK(grid.occupied(I(4, 4, 0)));
+  CHECK(grid.occupied(I(5, 5, 9)));
+  CHECK_FALSE(grid.occupied(I(3, 4, 0)));  // shares the face x = 4 only
+  CHECK_FALSE(grid.occupied(I(6, 6, 0)));
+}
+
+TEST_CASE("The robot radius inflates obstacles by whole cells it reaches into", "[REQ-WORLD-006]") {
+  const Map map = miner::world::test::pillar_map();
+  const VoxelGrid grid(map, 0.5);  // inflated box [3.5, 6.5]^2: columns 3..6
+  CHECK(grid.occupied_count() == 4 * 4 * 10);
+  CHECK(grid.occupied(I(3, 3, 5)));
+  CHECK_FALSE(grid.occupied(I(2, 3, 5)));
+  CHECK(grid.robot_radius() == 0.5);
+  CHECK_THROWS_WITH(VoxelGrid(map, -1.0), Contains("robot radius: must not be negative"));
+}
+
+TEST_CASE("Cells whose centre lies outside the bounds are occupied", "[REQ-WORLD-006]") {
+  const Map map(Box{{0, 0, 0}, {2.2, 1, 1}}, 1.0, {});  // 3 cells in x, the last centred at 2.5
+  const VoxelGrid grid(map, 0.0);
+  CHECK(grid.dims() == I(3, 1, 1));
+  CHECK_FALSE(grid.occupied(I(1, 0, 0)));
+  CHECK(grid.occupied(I(2, 0, 0)));
+}
+
+TEST_CASE("Cell lookup: indices, centres, the upper bound, outside points", "[REQ-WORLD-006]") {
+  const VoxelGrid grid(miner::world::test::pillar_map(), 0.0);
+  CHECK(grid.cell_of(V(0.0, 0.0, 0.0)) == std::optional<I>(I(0, 0, 0)));
+  CHECK(grid.cell_of(V(10.0, 10.0, 10.0)) == std::optional<I>(I(9, 9, 9)));
+  CHECK(grid.cell_of(V(2.5, 3.99, 7.0)) == std::optional<I>(I(2, 3, 7)));
+  CHECK_FALSE(grid.cell_of(V(-0.01, 1, 1)));
+  CHECK_FALSE(grid.cell_of(V(1, 10.01, 1)));
+  CHECK(grid.cell_center(I(2, 3, 7)) == V(2.5, 3.5, 7.5));
+  CHECK(grid.coords(grid.index(I(2, 3, 7))) == I(2, 3, 7));
+  CHECK(grid.cell_center(grid.index(2, 3, 7)) == V(2.5, 3.5, 7.5));
+  CHECK(grid.contains(I(9, 9, 9)));
+  CHECK_FALSE(grid.contains(I(10, 0, 0)));
+}
+
+TEST_CASE("A resolution that would need too many cells is refused by name", "[REQ-WORLD-006]") {
+  const Map map(Box{{0, 0, 0}, {1000, 1000, 1000}}, 0.01, {});
+  CHECK_THROWS_WITH(VoxelGrid(map, 0.0), Contains("resolution: 0.01 m gives more than"));
+}

@@ -1,0 +1,108 @@
+#include "miner/world/voxel_grid.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "miner/core/error.hpp"
+#include "miner/world/map.hpp"
+
+namespace miner::world {
+
+namespace {
+/// Snaps in the cell count: a face within 1e-9 cells of a whole number of cells is on
+/// that cell boundary (so 10 m / 0.1 m is 100 cells, not 101).
+constexpr double kGridSnapTolerance = 1e-9;
+
+/// Lower edge of cell i along one axis, computed the one way every query computes it.
+double cell_edge(double origin, double res, int i) { return origin + i * res; }
+
+/// The first and last cell index whose open interval (edge(i), edge(i+1)) meets the
+/// closed interval [lo, hi], clamped to [0, n-1]; first > last when none does. The
+/// estimate from division is corrected against the cell edges themselves, so the
+/// answer is exact for the grid's own floating-point edges.
+std::pair<int, int> cell_span(double origin, double res, int n, double lo, double hi) {
+  int first = static_cast<int>(std::max(0.0, std::min<double>(n - 1, std::floor((lo - origin) / res))));
+  while (first > 0 && cell_edge(origin, res, first) > lo) --first;
+  while (first < n && cell_edge(origin, res, first + 1) <= lo) ++first;
+  int last = static_cast<int>(std::max(0.0, std::min<double>(n - 1, std::ceil((hi - origin) / res) - 1.0)));
+  while (last < n - 1 && cell_edge(origin, res, last + 1) < hi) ++last;
+  while (last >= 0 && cell_edge(origin, res, last) >= hi) --last;
+  return {first, last};
+}
+}  // namespace
+
+VoxelGrid::VoxelGrid(const Map& map, double robot_radius)
+    : origin_(map.bounds().min), resolution_(map.resolution()), robot_radius_(robot_radius) {
+  require_finite(robot_radius, "robot radius");
+  if (robot_radius < 0.0) throw Error("robot radius: must not be negative");
+  const Eigen::Vector3d cells = map.bounds().extent() / resolution_;
+  double total = 1.0;
+  for (int k = 0; k < 3; ++k) {
+    const double n = std::max(1.0, std::ceil(cells[k] - kGridSnapTolerance));
+    total *= n;
+    if (total > static_cast<double>(kMaxCells)) {
+      std::ostringstream os;
+      os << "resolution: " << resolution_ << " m gives more than " << kMaxCells
+         << " grid cells for bounds of extent " << format_point(map.bounds().extent())
+         << " m; use a coarser resolution";
+      throw Error(os.str());
+    }
+    dims_[k] = static_cast<int>(n);
+  }
+  occupancy_.assign(static_cast<std::size_t>(total), 0);
+
+  // Cells whose centre lies outside the bounds (the last layer when extent/res is not whole).
+  for (int k = 0; k < 3; ++k) {
+    for (int i = dims_[k] - 1; i >= 0; --i) {
+      if (origin_[k] + (i + 0.5) * resolution_ <= map.bounds().max[k]) break;
+      Eigen::Vector3i from(0, 0, 0), to = dims_ - Eigen::Vector3i::Ones();
+      from[k] = to[k] = i;
+      for (int z = from.z(); z <= to.z(); ++z)
+        for (int y = from.y(); y <= to.y(); ++y)
+          for (int x = from.x(); x <= to.x(); ++x) occupancy_[index(x, y, z)] = 1;
+    }
+  }
+  for (const Box& obstacle : map.obstacles()) {
+    const Box b = obstacle.inflated(robot_radius);
+    // Cell i's interior (o + i res, o + (i+1) res) meets [lo, hi] iff
+    // o + (i+1) res > lo and o + i res < hi.
+    Eigen::Vector3i lo, hi;
+    bool empty = false;
+    for (int k = 0; k < 3; ++k) {
+      const auto [first, last] = cell_span(origin_[k], resolution_, dims_[k], b.min[k], b.max[k]);
+      if (last < first) { empty = true; break; }
+      lo[k] = first;
+      hi[k] = last;
+    }
+    if (empty) continue;
+    for (int z = lo.z(); z <= hi.z(); ++z)
+      for (int y = lo.y(); y <= hi.y(); ++y)
+        for (int x = lo.x(); x <= hi.x(); ++x) occupancy_[index(x, y, z)] = 1;
+  }
+}
+
+std::size_t VoxelGrid::occupied_count() const {
+  return static_cast<std::size_t>(std::count(occupancy_.begin(), occupancy_.end(), 1));
+}
+
+Eigen::Vector3i VoxelGrid::coords(std::size_t idx) const {
+  const auto nx = static_cast<std::size_t>(dims_.x());
+  const auto ny = static_cast<std::size_t>(dims_.y());
+  return {static_cast<int>(idx % nx), static_cast<int>((idx / nx) % ny),
+          static_cast<int>(idx / (nx * ny))};
+}
+
+Eigen::Vector3d VoxelGrid::cell_center(std::size_t idx) const { return cell_center(coords(idx)); }
+
+std::optional<Eigen::Vector3i> VoxelGrid::cell_of(const Eigen::Vector3d& p) const {
+  Eigen::Vector3i c;
+  for (int k = 0; k < 3; ++k) {
+    const double u = (p[k] - origin_[k]) / resolution_;
+    if (!(u >= 0.0) || u > static_cast<double>(dims_[k])) return std::nullopt;
+    c[k] = std::min(static_cast<int>(std::floor(u)), dims_[k] - 1);
+  }
+  return c;
+}
+
+}  // namespace miner::world

@@ -20,5 +20,7 @@ int run_cli(const std::vector<std::string>& args, std::ostream& out, std::ostrea
 /// Registers `miner map ...` and `miner astar` (map_commands.cpp). The callbacks
 /// write to `out`; errors propagate as miner::Error.
 void add_map_commands(CLI::App& app, std::ostream& out);
+/// Registers `miner traj solve` (traj_commands.cpp).
+void add_traj_commands(CLI::App& app, std::ostream& out);
 
 }  // namespace miner::cli

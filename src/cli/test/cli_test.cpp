@@ -187,3 +187,27 @@ TEST_CASE("A failing command leaves an existing output file untouched", "[REQ-CL
   CHECK(miner_cli({"map", "gen", "--preset", "indoor", "--seed", "1", "--obstacles", "-2", "--out", gen_out}).code == 2);
   CHECK(read(gen_out) == map_before);
 }
+
+TEST_CASE("traj solve answers the problem contract on stdout or in --out", "[REQ-TRAJ-006][REQ-CLI-001]") {
+  const std::string problem = write("problem.json", R"({"order": 4,
+    "points": [[0,0,0],[2,1,0],[4,0,1]],
+    "head": [[0,0,0],[0,0,0],[0,0,0],[0,0,0]], "tail": [[4,0,1],[0,0,0],[0,0,0],[0,0,0]],
+    "limits": {"v_max": 2.0, "a_max": 1.0}})");
+  const Run r = miner_cli({"traj", "solve", "--problem", problem});
+  REQUIRE(r.code == 0);
+  const auto doc = miner::parse_json(r.out, "stdout");
+  CHECK(doc["coefficients"].size() == 2);
+  CHECK(doc["coefficients"][1].size() == 8);
+  CHECK(doc["durations"].size() == 2);
+  CHECK(doc["cost"].get<double>() > 0.0);
+  const std::string out = dir() + "/answer.json";
+  const Run w = miner_cli({"traj", "solve", "--problem", problem, "--out", out});
+  REQUIRE(w.code == 0);
+  CHECK(miner::read_json_file(out) == doc);
+  const std::string bad = write("bad-problem.json", R"({"order": 3, "points": [[0,0,0],[0,0,0]],
+    "head": [[0,0,0],[0,0,0],[0,0,0]], "tail": [[0,0,0],[0,0,0],[0,0,0]], "durations": [1]})");
+  const Run e = miner_cli({"traj", "solve", "--problem", bad, "--out", out});
+  CHECK(e.code == 1);
+  CHECK_THAT(e.err, Contains("bad-problem.json: points[0] and points[1] coincide"));
+  CHECK(miner::read_json_file(out) == doc);  // the good answer is kept
+}

@@ -30,7 +30,13 @@ double squared_distance(const Eigen::Vector3d& a, const Eigen::Vector3d& b, cons
       if (tk > 0.0 && tk < 1.0) t[n++] = tk;
     }
   }
-  std::sort(t.begin(), t.begin() + n);
+  // Insertion sort: at most 8 values (and std::sort trips a GCC 12 -Warray-bounds false positive).
+  for (int i = 1; i < n; ++i) {
+    const double v = t[i];
+    int j = i;
+    for (; j > 0 && t[j - 1] > v; --j) t[j] = t[j - 1];
+    t[j] = v;
+  }
 
   const auto f = [&](double s) { return squared_distance(Eigen::Vector3d(a + s * d), box); };
   double best = f(t[0]);

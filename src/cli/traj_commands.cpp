@@ -1,0 +1,41 @@
+// `miner traj solve` (REQ-TRAJ-006).
+#include <ostream>
+
+#include <CLI/CLI.hpp>
+
+#include "cli/cli.hpp"
+#include "miner/core/json_io.hpp"
+#include "miner/traj/problem_io.hpp"
+
+namespace miner::cli {
+
+namespace {
+struct SolveOptions {
+  std::string problem;
+  std::string out;
+};
+
+void run_solve(const SolveOptions& o, std::ostream& out) {
+  const auto problem = traj::problem_from_json(read_json_file(o.problem), o.problem);
+  const Json answer = traj::answer_to_json(traj::solve_minco(problem));
+  if (o.out.empty()) {
+    out << dump_json(answer);
+  } else {
+    write_file_atomic(o.out, dump_json(answer));
+    out << "wrote " << o.out << ": " << answer["durations"].size() << " segments, order "
+        << problem.order << ", cost " << answer["cost"].get<double>() << "\n";
+  }
+}
+}  // namespace
+
+void add_traj_commands(CLI::App& app, std::ostream& out) {
+  CLI::App* traj = app.add_subcommand("traj", "minimum-jerk/snap trajectories (MINCO)");
+  traj->require_subcommand(1);
+  auto solve = std::make_shared<SolveOptions>();
+  CLI::App* s = traj->add_subcommand("solve", "solve a trajectory problem file (docs/traj.md)");
+  s->add_option("--problem", solve->problem, "problem JSON: order, points, head, tail, durations or limits")->required();
+  s->add_option("--out", solve->out, "write the answer JSON here (default: stdout)");
+  s->callback([solve, &out] { run_solve(*solve, out); });
+}
+
+}  // namespace miner::cli

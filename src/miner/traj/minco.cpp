@@ -1,0 +1,362 @@
+#include "miner/traj/minco.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+
+#include "miner/core/error.hpp"
+
+namespace miner::traj {
+
+namespace {
+
+/// Constant matrices of the unit interval for order S (computed once).
+template <int S>
+struct UnitHermite {
+  static constexpr int N = 2 * S;
+  Eigen::Matrix<double, N, N> K;  ///< stiffness: x^T K x = int_0^1 |q^{(S)}|^2 for Hermite data x
+  Eigen::Matrix<double, N, N> G;  ///< monomial coefficients of q = G x on [0, 1]
+
+  UnitHermite() {
+    // E maps monomial coefficients a to Hermite data: rows k (at 0) and S + k (at 1).
+    Eigen::Matrix<double, N, N> E = Eigen::Matrix<double, N, N>::Zero();
+    for (int k = 0; k < S; ++k) {
+      for (int j = k; j < N; ++j) {
+        double f = 1.0;
+        for (int i = 0; i < k; ++i) f *= j - i;
+        if (j == k) E(k, j) = f;
+        E(S + k, j) = f;
+      }
+    }
+    G = E.fullPivLu().inverse();
+    Eigen::Matrix<double, N, N> Qm = Eigen::Matrix<double, N, N>::Zero();
+    for (int a = S; a < N; ++a)
+      for (int b = S; b < N; ++b) {
+        double fa = 1.0, fb = 1.0;
+        for (int i = 0; i < S; ++i) {
+          fa *= a - i;
+          fb *= b - i;
+        }
+        Qm(a, b) = fa * fb / (a + b - 2 * S + 1);
+      }
+    K = G.transpose() * Qm * G;
+    K = 0.5 * (K + K.transpose()).eval();
+  }
+  static const UnitHermite& get() {
+    static const UnitHermite h;
+    return h;
+  }
+};
+
+template <int S>
+using SegmentMatrix = Eigen::Matrix<double, 2 * S, 2 * S>;
+template <int S>
+using Block = Eigen::Matrix<double, S - 1, S - 1>;
+template <int S>
+using Rhs = Eigen::Matrix<double, S - 1, 3>;
+
+/// Q(T)_{ab} = K_ab T^{1 - 2S + k(a) + k(b)}, k(r) = r mod S (derivative order of row r).
+template <int S>
+void segment_cost_matrix(double T, SegmentMatrix<S>& Q) {
+  const auto& K = UnitHermite<S>::get().K;
+  double pw[2 * S - 1];  // pw[e] = T^{e + 1 - 2S}, e = k(a) + k(b) in [0, 2S - 2]
+  const double inv = 1.0 / T;
+  pw[2 * S - 2] = inv;
+  for (int e = 2 * S - 3; e >= 0; --e) pw[e] = pw[e + 1] * inv;
+  for (int a = 0; a < 2 * S; ++a)
+    for (int b = 0; b < 2 * S; ++b) Q(a, b) = K(a, b) * pw[a % S + b % S];
+}
+
+/// dQ/dT: exponent times Q / T.
+template <int S>
+void segment_cost_matrix_derivative(double T, SegmentMatrix<S>& dQ) {
+  segment_cost_matrix<S>(T, dQ);
+  for (int a = 0; a < 2 * S; ++a)
+    for (int b = 0; b < 2 * S; ++b) dQ(a, b) *= (1.0 - 2 * S + a % S + b % S) / T;
+}
+
+}  // namespace
+
+struct MincoSolver::Workspace {
+  // Fixed-size storage sized for the largest order (S = 4); order 3 uses leading blocks.
+  std::vector<Eigen::Matrix<double, 8, 8>> Q;  // per segment, normalised time
+  std::vector<Eigen::Matrix<double, 3, 3>> A;  // diagonal blocks of the reduced Hessian
+  std::vector<Eigen::Matrix<double, 3, 3>> B;  // sub-diagonal blocks (B_j couples z_j to z_{j-1})
+  std::vector<Eigen::Matrix<double, 3, 3>> L;  // Cholesky factors of the Schur complements
+  std::vector<Eigen::Matrix<double, 3, 3>> W;  // B_j S_{j-1}^{-1}
+  std::vector<Eigen::Matrix<double, 3, 3>> r;  // right-hand sides
+  std::vector<Eigen::Matrix<double, 3, 3>> y;  // forward-substituted right-hand sides
+  std::vector<Eigen::Matrix<double, 3, 3>> z;  // derivatives 1..S-1 per waypoint (rows) per axis
+  std::vector<Eigen::Matrix<double, 3, 3>> d;  // refinement correction
+  std::vector<Eigen::Matrix<double, 8, 3>> x;  // Hermite data per segment (real time)
+};
+
+MincoSolver::MincoSolver() : ws_(std::make_unique<Workspace>()) {}
+MincoSolver::~MincoSolver() = default;
+MincoSolver::MincoSolver(MincoSolver&&) noexcept = default;
+MincoSolver& MincoSolver::operator=(MincoSolver&&) noexcept = default;
+
+namespace {
+
+/// Block tridiagonal SPD solve on the workspace: unknowns j = 1..M-1 with
+/// B_j z_{j-1} + A_j z_j + B_{j+1}^T z_{j+1} = rhs_j (block Cholesky / block Thomas).
+template <int S>
+struct ReducedSystem {
+  static constexpr int F = S - 1;
+  MincoSolver::Workspace& ws;
+  int M;
+
+  auto blk(std::vector<Eigen::Matrix<double, 3, 3>>& v, int j) { return v[j].template topLeftCorner<F, F>(); }
+  auto col(std::vector<Eigen::Matrix<double, 3, 3>>& v, int j) { return v[j].template topRows<F>(); }
+
+  /// Schur complements S_j = A_j - B_j S_{j-1}^{-1} B_j^T, factored as L_j L_j^T.
+  void factor() {
+    for (int j = 1; j < M; ++j) {
+      Block<S> Sj = blk(ws.A, j);
+      if (j > 1) {
+        const Block<S> Bj = blk(ws.B, j);
+        const auto Lp = blk(ws.L, j - 1).template triangularView<Eigen::Lower>();
+        // W = B_j S_{j-1}^{-1} = (S_{j-1}^{-1} B_j^T)^T.
+        Block<S> Wt = Bj.transpose();
+        Lp.solveInPlace(Wt);
+        Lp.transpose().solveInPlace(Wt);
+        blk(ws.W, j) = Wt.transpose();
+        Sj -= blk(ws.W, j) * Bj.transpose();
+      }
+      blk(ws.L, j) = Eigen::LLT<Block<S>>(Sj).matrixL();
+    }
+  }
+
+  /// Solves for `out` given right-hand sides `in` (both indexed 1..M-1).
+  void solve(std::vector<Eigen::Matrix<double, 3, 3>>& in, std::vector<Eigen::Matrix<double, 3, 3>>& out) {
+    for (int j = 1; j < M; ++j) {
+      col(ws.y, j) = col(in, j);
+      if (j > 1) col(ws.y, j) -= blk(ws.W, j) * col(ws.y, j - 1);
+    }
+    for (int j = M - 1; j >= 1; --j) {
+      Rhs<S> v = col(ws.y, j);
+      if (j < M - 1) v -= blk(ws.B, j + 1).transpose() * col(out, j + 1);
+      const auto Lj = blk(ws.L, j).template triangularView<Eigen::Lower>();
+      Lj.solveInPlace(v);
+      Lj.transpose().solveInPlace(v);
+      col(out, j) = v;
+    }
+  }
+
+  /// in_j - (B_j z_{j-1} + A_j z_j + B_{j+1}^T z_{j+1}) for interior j (z_0, z_M fixed).
+  void residual(std::vector<Eigen::Matrix<double, 3, 3>>& res) {
+    for (int j = 1; j < M; ++j) {
+      Rhs<S> v = col(ws.r, j) - blk(ws.A, j) * col(ws.z, j);
+      if (j > 1) v -= blk(ws.B, j) * col(ws.z, j - 1);
+      if (j < M - 1) v -= blk(ws.B, j + 1).transpose() * col(ws.z, j + 1);
+      col(res, j) = v;
+    }
+  }
+};
+
+template <int S>
+void solve_order(const MincoProblem& p, MincoSolver::Workspace& ws, PolynomialTrajectory& out) {
+  constexpr int F = S - 1;  // free derivatives per waypoint
+  constexpr int N = 2 * S;
+  const int M = static_cast<int>(p.durations.size());
+  ws.Q.resize(M);
+  ws.x.resize(M);
+  for (auto* v : {&ws.A, &ws.B, &ws.L, &ws.W, &ws.r, &ws.y, &ws.z, &ws.d}) v->resize(M + 1);
+
+  // Work in normalised time t / tau with tau the mean duration: by the time-scaling
+  // law the optimum is the same curve, and the blocks no longer carry factors
+  // T^{1-2s} (1e21 for s = 4, T = 1e-3).
+  double tau = 0.0;
+  for (double T : p.durations) tau += T;
+  tau /= M;
+  double tau_pow[S];  // tau^k
+  tau_pow[0] = 1.0;
+  for (int k = 1; k < S; ++k) tau_pow[k] = tau_pow[k - 1] * tau;
+  for (int i = 0; i < M; ++i) {
+    SegmentMatrix<S> Q;
+    segment_cost_matrix<S>(p.durations[i] / tau, Q);
+    ws.Q[i].template topLeftCorner<N, N>() = Q;
+  }
+  auto Q = [&](int seg) { return ws.Q[seg].template topLeftCorner<N, N>(); };
+  // Known derivatives at the ends, in normalised time: d^k/ds^k = tau^k d^k/dt^k.
+  for (int k = 1; k < S; ++k) {
+    ws.z[0].row(k - 1) = p.head.row(k) * tau_pow[k];
+    ws.z[M].row(k - 1) = p.tail.row(k) * tau_pow[k];
+  }
+
+  // Equation of interior waypoint j (segments j-1 ending and j starting there):
+  //   dJ/dz_j = 0  <=>  B_j z_{j-1} + A_j z_j + B_{j+1}^T z_{j+1} = r_j.
+  for (int j = 1; j < M; ++j) {
+    const auto Qa = Q(j - 1), Qb = Q(j);
+    ws.A[j].template topLeftCorner<F, F>() = Qa.template block<F, F>(S + 1, S + 1) + Qb.template block<F, F>(1, 1);
+    ws.B[j].template topLeftCorner<F, F>() = Qa.template block<F, F>(S + 1, 1);
+    Rhs<S> r = -(Qa.template block<F, 1>(S + 1, 0) * p.points.row(j - 1) +
+                 (Qa.template block<F, 1>(S + 1, S) + Qb.template block<F, 1>(1, 0)) * p.points.row(j) +
+                 Qb.template block<F, 1>(1, S) * p.points.row(j + 1));
+    if (j == 1) r -= Qa.template block<F, F>(S + 1, 1) * ws.z[0].template topRows<F>();
+    if (j == M - 1) r -= Qb.template block<F, F>(1, S + 1) * ws.z[M].template topRows<F>();
+    ws.r[j].template topRows<F>() = r;
+  }
+  if (M > 1) {
+    ReducedSystem<S> sys{ws, M};
+    sys.factor();
+    sys.solve(ws.r, ws.z);
+    // One step of iterative refinement: the stationarity residual is the jump of
+    // derivatives s..2s-2 at the waypoints, so this buys continuity to working accuracy.
+    sys.residual(ws.d);
+    sys.solve(ws.d, ws.d);
+    for (int j = 1; j < M; ++j) ws.z[j].template topRows<F>() += ws.d[j].template topRows<F>();
+  }
+
+  // Coefficients c_i(j, :) = sum_r G(j, r) T^{k(r) - j} x_i(r, :).
+  const auto& G = UnitHermite<S>::get().G;
+  Eigen::MatrixX3d& c = out.mutable_coefficients();
+  c.resize(N * M, 3);
+  out.mutable_durations() = p.durations;
+  for (int i = 0; i < M; ++i) {
+    auto x = ws.x[i].template topRows<N>();
+    x.row(0) = p.points.row(i);
+    x.template middleRows<F>(1) = ws.z[i].template topRows<F>();
+    x.row(S) = p.points.row(i + 1);
+    x.template middleRows<F>(S + 1) = ws.z[i + 1].template topRows<F>();
+    const double Tn = p.durations[i] / tau, T = p.durations[i];
+    double tn[S], tp[N];  // tn[k] = Tn^k, tp[j] = T^j
+    tn[0] = tp[0] = 1.0;
+    for (int k = 1; k < S; ++k) tn[k] = tn[k - 1] * Tn;
+    for (int j = 1; j < N; ++j) tp[j] = tp[j - 1] * T;
+    Eigen::Matrix<double, N, 3> scaled;  // unit-interval Hermite data
+    for (int r = 0; r < N; ++r) scaled.row(r) = x.row(r) * tn[r % S];
+    Eigen::Matrix<double, N, 3> a = G * scaled;
+    for (int j = 0; j < N; ++j) a.row(j) /= tp[j];
+    c.template middleRows<N>(N * i) = a;
+    // Keep the Hermite data in real time for cost_and_gradients().
+    for (int k = 1; k < S; ++k) {
+      x.row(k) /= tau_pow[k];
+      x.row(S + k) /= tau_pow[k];
+    }
+  }
+}
+
+template <int S>
+double cost_order(const MincoProblem& p, const std::vector<Eigen::Matrix<double, 8, 3>>& xs,
+                  MincoGradients* g) {
+  constexpr int N = 2 * S;
+  const int M = static_cast<int>(p.durations.size());
+  double J = 0.0;
+  if (g) {
+    g->points = Eigen::MatrixX3d::Zero(M + 1, 3);
+    g->durations = Eigen::VectorXd::Zero(M);
+  }
+  for (int i = 0; i < M; ++i) {
+    SegmentMatrix<S> Q;
+    segment_cost_matrix<S>(p.durations[i], Q);
+    const auto x = xs[i].template topRows<N>();
+    const Eigen::Matrix<double, N, 3> Qx = Q * x;
+    J += (x.transpose() * Qx).trace();
+    if (g) {
+      SegmentMatrix<S> dQ;
+      segment_cost_matrix_derivative<S>(p.durations[i], dQ);
+      g->durations[i] = (x.transpose() * dQ * x).trace();
+      g->points.row(i) += 2.0 * Qx.row(0);
+      g->points.row(i + 1) += 2.0 * Qx.row(S);
+    }
+  }
+  return J;
+}
+
+std::string row_text(const Eigen::MatrixX3d& m, Eigen::Index r) {
+  return format_point(Eigen::Vector3d(m.row(r).transpose()));
+}
+
+}  // namespace
+
+void MincoSolver::solve(const MincoProblem& p, PolynomialTrajectory& out) {
+  out.set_order(p.order);
+  if (p.order == 3) {
+    solve_order<3>(p, *ws_, out);
+  } else if (p.order == 4) {
+    solve_order<4>(p, *ws_, out);
+  } else {
+    throw Error("order: must be 3 (minimum jerk) or 4 (minimum snap), got " + std::to_string(p.order));
+  }
+}
+
+double MincoSolver::cost_and_gradients(const MincoProblem& p, MincoGradients* gradients) const {
+  if (ws_->x.size() < p.durations.size()) throw Error("MincoSolver: cost_and_gradients needs a solve() first");
+  return p.order == 3 ? cost_order<3>(p, ws_->x, gradients)
+                      : cost_order<4>(p, ws_->x, gradients);
+}
+
+MincoProblem rest_to_rest(int order, const Eigen::MatrixX3d& points, std::vector<double> durations) {
+  MincoProblem p;
+  p.order = order;
+  p.points = points;
+  p.durations = std::move(durations);
+  const int s = order > 0 ? order : 1;
+  p.head = Eigen::MatrixX3d::Zero(s, 3);
+  p.tail = Eigen::MatrixX3d::Zero(s, 3);
+  if (points.rows() > 0) {
+    p.head.row(0) = points.row(0);
+    p.tail.row(0) = points.row(points.rows() - 1);
+  }
+  return p;
+}
+
+void validate(const MincoProblem& p) {
+  if (p.order != 3 && p.order != 4) {
+    throw Error("order: must be 3 (minimum jerk) or 4 (minimum snap), got " + std::to_string(p.order));
+  }
+  const Eigen::Index n = p.points.rows();
+  if (n < 2) throw Error("points: need at least 2 points (start and end), got " + std::to_string(n));
+  for (Eigen::Index i = 0; i < n; ++i) {
+    require_finite(Eigen::Vector3d(p.points.row(i).transpose()), "points[" + std::to_string(i) + "]");
+  }
+  for (Eigen::Index i = 1; i < n; ++i) {
+    if (p.points.row(i) == p.points.row(i - 1)) {
+      throw Error("points[" + std::to_string(i - 1) + "] and points[" + std::to_string(i) +
+                  "] coincide at " + row_text(p.points, i) +
+                  ": remove the duplicate waypoint (a segment needs two distinct ends)");
+    }
+  }
+  const auto M = static_cast<std::size_t>(n - 1);
+  if (p.durations.size() != M) {
+    throw Error("durations: expected " + std::to_string(M) + " values (one per segment), got " +
+                std::to_string(p.durations.size()));
+  }
+  for (std::size_t i = 0; i < M; ++i) {
+    if (!std::isfinite(p.durations[i]) || !(p.durations[i] > 0.0)) {
+      std::ostringstream os;
+      os << "durations[" << i << "]: must be positive and finite, got " << p.durations[i];
+      throw Error(os.str());
+    }
+  }
+  for (const auto& [m, name] : {std::pair<const Eigen::MatrixX3d*, const char*>{&p.head, "head"}, {&p.tail, "tail"}}) {
+    if (m->rows() != p.order) {
+      throw Error(std::string(name) + ": expected " + std::to_string(p.order) +
+                  " rows (derivatives 0.." + std::to_string(p.order - 1) + " for order " +
+                  std::to_string(p.order) + "), got " + std::to_string(m->rows()));
+    }
+    for (Eigen::Index r = 0; r < m->rows(); ++r) {
+      require_finite(Eigen::Vector3d(m->row(r).transpose()), std::string(name) + "[" + std::to_string(r) + "]");
+    }
+  }
+  // The head/tail positions are the first/last point; a mismatch is a contradiction.
+  constexpr double kSamePoint = 1e-9;  // m: JSON round-off only
+  if ((p.head.row(0) - p.points.row(0)).norm() > kSamePoint) {
+    throw Error("head[0]: must equal points[0] " + row_text(p.points, 0) + ", got " + row_text(p.head, 0));
+  }
+  if ((p.tail.row(0) - p.points.row(n - 1)).norm() > kSamePoint) {
+    throw Error("tail[0]: must equal the last point " + row_text(p.points, n - 1) + ", got " + row_text(p.tail, 0));
+  }
+}
+
+PolynomialTrajectory solve_minco(const MincoProblem& problem) {
+  validate(problem);
+  PolynomialTrajectory out;
+  MincoSolver().solve(problem, out);
+  return out;
+}
+
+}  // namespace miner::traj

@@ -1,0 +1,80 @@
+#pragma once
+/// \file
+/// MINCO: the minimum-control-effort trajectory of paper Eq. (minco1)-(minco5)
+/// (Wang et al. 2022), for s = 3 (minimum jerk) and s = 4 (minimum snap), solved in
+/// O(M) time and memory (REQ-TRAJ-002, REQ-TRAJ-003).
+///
+/// Method. Parametrise segment i by its Hermite data x_i = (p(0), ..., p^{(s-1)}(0),
+/// p(T_i), ..., p^{(s-1)}(T_i)). With tau = t / T_i the control effort of a segment is
+///   J_i = T_i^{1-2s} x_i^T D(T_i) K D(T_i) x_i,   D(T) = diag(T^k) (k = derivative order),
+/// K the constant 2s x 2s Hermite stiffness on [0, 1]. Positions are fixed at every
+/// waypoint and the head/tail states are given, so the only unknowns are the
+/// derivatives 1..s-1 at the M - 1 interior waypoints. dJ/dz_j = 0 couples z_j only
+/// with z_{j-1} and z_{j+1}: a symmetric positive definite block-tridiagonal system with
+/// (s-1) x (s-1) blocks, solved by block Cholesky (block Thomas) in O(M (s-1)^3).
+/// Stationarity in z_j is exactly continuity of derivatives s..2s-2 at waypoint j, so
+/// the result satisfies the optimality condition of the paper (A c = b) with
+/// derivatives 0..2s-2 continuous; the coefficients follow as c_i = diag(T^-j) G D x_i
+/// with G the inverse of the unit-interval endpoint matrix.
+
+#include <memory>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "miner/traj/polynomial_trajectory.hpp"
+
+namespace miner::traj {
+
+/// The trajectory problem of `miner traj solve` (../shared/design.md).
+struct MincoProblem {
+  int order = 3;                 ///< s: 3 minimum jerk, 4 minimum snap
+  Eigen::MatrixX3d points;       ///< M + 1 rows: start, M - 1 waypoints, end
+  std::vector<double> durations; ///< M positive durations T_i
+  Eigen::MatrixX3d head;         ///< s rows: derivatives 0..s-1 at the start
+  Eigen::MatrixX3d tail;         ///< s rows: derivatives 0..s-1 at the end
+};
+
+/// A problem at rest at both ends: head = (points[0], 0, ...), tail likewise.
+MincoProblem rest_to_rest(int order, const Eigen::MatrixX3d& points, std::vector<double> durations);
+
+/// Throws miner::Error naming the field: order not 3 or 4, fewer than 2 points, wrong
+/// number of durations, a duration that is not positive and finite, a non-finite
+/// value, coinciding consecutive points, head/tail with the wrong number of rows or a
+/// head/tail position different from the first/last point.
+void validate(const MincoProblem& problem);
+
+/// Gradients of the optimal cost J*(points, durations) (envelope theorem: the
+/// interior derivatives are at their optimum).
+struct MincoGradients {
+  Eigen::MatrixX3d points;  ///< dJ*/dp_j, M + 1 rows (rows 0 and M: the head/tail positions)
+  Eigen::VectorXd durations;  ///< dJ*/dT_i
+};
+
+/// Reusable solver: keeps its workspace, so repeated solves of the same size do not
+/// allocate (what the benchmark times).
+class MincoSolver {
+ public:
+  MincoSolver();
+  ~MincoSolver();
+  MincoSolver(MincoSolver&&) noexcept;
+  MincoSolver& operator=(MincoSolver&&) noexcept;
+
+  /// Solves a validated problem into `out` (resized as needed).
+  void solve(const MincoProblem& problem, PolynomialTrajectory& out);
+  /// The optimal cost and, if `gradients` is given, its gradients; needs a solve() of
+  /// the same problem just before.
+  double cost_and_gradients(const MincoProblem& problem, MincoGradients* gradients) const;
+
+ private:
+ public:
+  struct Workspace;  // fixed-size blocks reused across solves (minco.cpp)
+
+ private:
+  std::unique_ptr<Workspace> ws_;
+};
+
+/// validate() + MincoSolver().solve().
+PolynomialTrajectory solve_minco(const MincoProblem& problem);
+
+}  // namespace miner::traj

@@ -1,0 +1,57 @@
+#pragma once
+/// \file
+/// A piecewise polynomial trajectory in flat output space (paper Eq. for p_i(t)):
+///   p_i(t) = c_i^T rho(t),  rho(t) = (1, t, ..., t^{2s-1})^T,  t in [0, T_i] (local time),
+/// c_i in R^{2s x 3}. Evaluation of position and derivatives up to snap, the control
+/// effort J = sum_i int_0^{T_i} |p_i^{(s)}(t)|^2 dt (no 1/2 factor) and its gradient with
+/// respect to the coefficients (REQ-TRAJ-004, REQ-TRAJ-005).
+
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace miner::traj {
+
+class PolynomialTrajectory {
+ public:
+  PolynomialTrajectory() = default;
+  /// `coefficients` stacks the M blocks c_i (2s rows each) into a (2s M) x 3 matrix.
+  PolynomialTrajectory(int order, std::vector<double> durations, Eigen::MatrixX3d coefficients);
+
+  int order() const { return order_; }  ///< s
+  int segments() const { return static_cast<int>(durations_.size()); }
+  const std::vector<double>& durations() const { return durations_; }
+  double total_duration() const;
+  const Eigen::MatrixX3d& coefficients() const { return coefficients_; }
+  /// c_i, 2s x 3 (segment index i from 0).
+  Eigen::Block<const Eigen::MatrixX3d, Eigen::Dynamic, 3> segment_coefficients(int i) const {
+    return coefficients_.middleRows(2 * order_ * i, 2 * order_);
+  }
+  Eigen::MatrixX3d& mutable_coefficients() { return coefficients_; }
+  /// For solvers refilling a trajectory in place (keeps the allocations).
+  void set_order(int order) { order_ = order; }
+  std::vector<double>& mutable_durations() { return durations_; }
+
+  /// The k-th derivative (k = 0 position ... 4 snap, any k >= 0) of segment i at local
+  /// time tau (Horner's rule on the differentiated coefficients).
+  Eigen::Vector3d evaluate_segment(int i, double tau, int k = 0) const;
+  /// The k-th derivative at global time t, clamped to [0, total_duration()]; at a
+  /// junction the later segment is used.
+  Eigen::Vector3d evaluate(double t, int k = 0) const;
+
+  /// J = sum_i c_i^T Q(T_i) c_i (summed over axes), Q_ab = int_0^T (d^s t^a)(d^s t^b) dt.
+  double cost() const;
+  /// dJ/dc_i = 2 Q(T_i) c_i, stacked like coefficients().
+  Eigen::MatrixX3d cost_gradient_coefficients() const;
+
+ private:
+  int order_ = 3;
+  std::vector<double> durations_;
+  Eigen::MatrixX3d coefficients_;
+};
+
+/// Q(T) of the control effort in the monomial basis of degree 2s - 1:
+/// Q_ab = a!/(a-s)! b!/(b-s)! T^{a+b-2s+1} / (a+b-2s+1) for a, b >= s, else 0.
+Eigen::MatrixXd monomial_cost_matrix(int order, double duration);
+
+}  // namespace miner::traj

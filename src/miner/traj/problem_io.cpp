@@ -1,0 +1,58 @@
+#include "miner/traj/problem_io.hpp"
+
+#include "miner/core/error.hpp"
+
+namespace miner::traj {
+
+namespace {
+Eigen::MatrixX3d rows_of(const JsonField& f) {
+  const std::size_t n = f.array_size();
+  Eigen::MatrixX3d m(static_cast<Eigen::Index>(n), 3);
+  for (std::size_t i = 0; i < n; ++i) m.row(static_cast<Eigen::Index>(i)) = f.at(i).vec3().transpose();
+  return m;
+}
+}  // namespace
+
+MincoProblem problem_from_json(const Json& doc, const std::string& origin) {
+  const JsonField root(doc, "", origin);
+  if (!doc.is_object()) root.fail("expected a JSON object (a trajectory problem)");
+  MincoProblem p;
+  p.order = root.at("order").integer();
+  p.points = rows_of(root.at("points"));
+  p.head = rows_of(root.at("head"));
+  p.tail = rows_of(root.at("tail"));
+  if (root.has("durations")) {
+    const JsonField d = root.at("durations");
+    for (std::size_t i = 0; i < d.array_size(); ++i) p.durations.push_back(d.at(i).number());
+  } else {
+    if (!root.has("limits")) root.fail("needs \"durations\" or \"limits\" (for trapezoidal allocation)");
+    const JsonField l = root.at("limits");
+    const Limits limits{l.at("v_max").number(), l.at("a_max").number()};
+    try {
+      validate(limits);
+    } catch (const Error& e) {
+      throw Error(origin + ": " + e.what());
+    }
+    p.durations = trapezoidal_allocation(p.points, limits);
+  }
+  try {
+    validate(p);
+  } catch (const Error& e) {
+    throw Error(origin + ": " + e.what());
+  }
+  return p;
+}
+
+Json answer_to_json(const PolynomialTrajectory& t) {
+  Json coefficients = Json::array();
+  for (int i = 0; i < t.segments(); ++i) {
+    Json seg = Json::array();
+    const auto c = t.segment_coefficients(i);
+    for (Eigen::Index r = 0; r < c.rows(); ++r) seg.push_back({c(r, 0), c(r, 1), c(r, 2)});
+    coefficients.push_back(seg);
+  }
+  return {{"order", t.order()}, {"durations", t.durations()}, {"cost", t.cost()},
+          {"coefficients", coefficients}};
+}
+
+}  // namespace miner::traj

@@ -1,0 +1,138 @@
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+#include <Eigen/LU>
+
+#include "miner/core/error.hpp"
+#include "miner/traj/minco.hpp"
+#include "miner/traj/optimality_system.hpp"
+
+using namespace miner::traj;
+using Catch::Matchers::Contains;
+
+namespace {
+Eigen::MatrixX3d line(std::initializer_list<double> xs) {
+  Eigen::MatrixX3d m(static_cast<Eigen::Index>(xs.size()), 3);
+  Eigen::Index i = 0;
+  for (double x : xs) m.row(i++) << x, 0.0, 0.0;
+  return m;
+}
+// Coefficients of order 1 built from exact small rationals: a few ulps.
+constexpr double kKnownAnswer = 1e-12;
+}  // namespace
+
+TEST_CASE("One rest-to-rest segment is the classic 10t^3 - 15t^4 + 6t^5 (jerk) and 35t^4 - 84t^5 + 70t^6 - 20t^7 (snap)", "[REQ-TRAJ-002]") {
+  const auto jerk = solve_minco(rest_to_rest(3, line({0, 1}), {1.0}));
+  const Eigen::VectorXd cj = jerk.coefficients().col(0);
+  Eigen::VectorXd ej(6);
+  ej << 0, 0, 0, 10, -15, 6;
+  CHECK((cj - ej).norm() < kKnownAnswer * 100);
+  CHECK(jerk.cost() == Approx(720.0).epsilon(1e-12));  // int (60 - 360 t + 360 t^2)^2 dt
+  const auto snap = solve_minco(rest_to_rest(4, line({0, 1}), {1.0}));
+  Eigen::VectorXd es(8);
+  es << 0, 0, 0, 0, 35, -84, 70, -20;
+  CHECK((snap.coefficients().col(0) - es).norm() < kKnownAnswer * 1000);
+}
+
+TEST_CASE("MINCO agrees with the dense pivoted LU solve of A c = b", "[REQ-TRAJ-003]") {
+  for (int s : {3, 4}) {
+    Eigen::MatrixX3d pts(5, 3);
+    pts << 0, 0, 0, 1, 2, 0, 3, 1, 1, 4, 4, 2, 6, 3, 1;
+    MincoProblem p = rest_to_rest(s, pts, {1.0, 2.0, 0.5, 1.5});
+    p.head.row(1) << 0.5, 0, 0;  // a moving start
+    p.tail.row(2) << 0, 0.1, 0;
+    const auto t = solve_minco(p);
+    const auto sys = optimality_system(p);
+    const Eigen::MatrixX3d dense = sys.A.partialPivLu().solve(sys.b);
+    INFO("s = " << s);
+    CHECK((t.coefficients() - dense).norm() <= 1e-9 * dense.norm());
+    CHECK(relative_residual(sys, t.coefficients()) < 1e-12);  // REQ-TRAJ-003 target
+  }
+}
+
+TEST_CASE("A solver object gives the same answer when reused on different sizes", "[REQ-TRAJ-002]") {
+  MincoSolver solver;
+  PolynomialTrajectory a, b, c;
+  const auto p1 = rest_to_rest(4, line({0, 1, 3, 6}), {1, 1, 1});
+  const auto p2 = rest_to_rest(3, line({0, 2}), {2});
+  solver.solve(p1, a);
+  solver.solve(p2, b);
+  solver.solve(p1, c);
+  CHECK(a.coefficients() == c.coefficients());
+  CHECK(b.segments() == 1);
+  CHECK(b.order() == 3);
+}
+
+TEST_CASE("Evaluation: position and derivatives at segment ends and in between", "[REQ-TRAJ-004]") {
+  const auto t = solve_minco(rest_to_rest(3, line({0, 1, 3}), {1.0, 2.0}));
+  CHECK(t.total_duration() == 3.0);
+  CHECK(t.evaluate(0.0).x() == Approx(0.0).margin(1e-15));
+  CHECK(t.evaluate(1.0).x() == Approx(1.0));
+  CHECK(t.evaluate(3.0).x() == Approx(3.0));
+  CHECK(t.evaluate(10.0).x() == Approx(3.0));  // clamped
+  CHECK(t.evaluate(3.0, 1).norm() < 1e-12);    // at rest
+  // Derivative k by central differences of derivative k - 1, up to snap.
+  for (int k = 1; k <= 4; ++k) {
+    const double h = 1e-5, tt = 1.7;
+    const double fd = (t.evaluate(tt + h, k - 1).x() - t.evaluate(tt - h, k - 1).x()) / (2 * h);
+    INFO("k = " << k);
+    CHECK(t.evaluate(tt, k).x() == Approx(fd).epsilon(1e-6).margin(1e-6));
+  }
+  CHECK(t.evaluate(0.5, 6).norm() == 0.0);  // degree 5: the 6th derivative vanishes
+}
+
+TEST_CASE("Cost from the coefficients equals the solver's Hermite-form cost", "[REQ-TRAJ-005]") {
+  Eigen::MatrixX3d pts(4, 3);
+  pts << 0, 0, 0, 1, 2, 3, -1, 2, 0, 2, 2, 2;
+  const auto p = rest_to_rest(4, pts, {0.7, 1.3, 2.1});
+  MincoSolver solver;
+  PolynomialTrajectory t;
+  solver.solve(p, t);
+  MincoGradients g;
+  CHECK(solver.cost_and_gradients(p, &g) == Approx(t.cost()).epsilon(1e-12));
+  CHECK(g.points.rows() == 4);
+  CHECK(g.durations.size() == 3);
+  CHECK_THROWS_WITH(MincoSolver().cost_and_gradients(p, nullptr), Contains("needs a solve() first"));
+}
+
+TEST_CASE("Bad problems are refused with the field named", "[REQ-TRAJ-007]") {
+  const auto good = rest_to_rest(3, line({0, 1, 2}), {1, 1});
+  CHECK_NOTHROW(validate(good));
+  auto p = good;
+  p.durations[1] = 0.0;
+  CHECK_THROWS_WITH(validate(p), Contains("durations[1]: must be positive and finite, got 0"));
+  p = good;
+  p.durations[0] = -1.0;
+  CHECK_THROWS_WITH(validate(p), Contains("durations[0]: must be positive and finite, got -1"));
+  p = good;
+  p.durations[0] = NAN;
+  CHECK_THROWS_WITH(validate(p), Contains("durations[0]: must be positive and finite, got nan"));
+  p = good;
+  p.durations.pop_back();
+  CHECK_THROWS_WITH(validate(p), Contains("durations: expected 2 values (one per segment), got 1"));
+  CHECK_THROWS_WITH(validate(rest_to_rest(3, line({0}), {})), Contains("points: need at least 2 points"));
+  CHECK_THROWS_WITH(validate(rest_to_rest(3, line({0, 1, 1}), {1, 1})), Contains("points[1] and points[2] coincide"));
+  CHECK_THROWS_WITH(validate(rest_to_rest(5, line({0, 1}), {1})), Contains("order: must be 3 (minimum jerk) or 4 (minimum snap), got 5"));
+  p = good;
+  p.head = Eigen::MatrixX3d::Zero(4, 3);
+  CHECK_THROWS_WITH(validate(p), Contains("head: expected 3 rows (derivatives 0..2 for order 3), got 4"));
+  p = good;
+  p.tail.row(0) << 5, 0, 0;
+  CHECK_THROWS_WITH(validate(p), Contains("tail[0]: must equal the last point"));
+  p = good;
+  p.head.row(0) << 0.5, 0, 0;
+  CHECK_THROWS_WITH(validate(p), Contains("head[0]: must equal points[0]"));
+  p = good;
+  p.head(2, 1) = INFINITY;
+  CHECK_THROWS_WITH(validate(p), Contains("head[2][1]: must be a finite number"));
+  p = good;
+  p.points(1, 2) = NAN;
+  CHECK_THROWS_WITH(validate(p), Contains("points[1][2]: must be a finite number"));
+  PolynomialTrajectory out;
+  p = good;
+  p.order = 2;
+  CHECK_THROWS_WITH(MincoSolver().solve(p, out), Contains("order: must be 3"));
+  CHECK_THROWS_WITH(PolynomialTrajectory(3, {1.0}, Eigen::MatrixX3d::Zero(5, 3)), Contains("expected 6 coefficient rows"));
+  CHECK_THROWS_WITH(PolynomialTrajectory().evaluate(0.0), Contains("has no segments"));
+}

@@ -1,0 +1,58 @@
+#include <catch2/catch.hpp>
+
+#include "miner/core/error.hpp"
+#include "miner/traj/problem_io.hpp"
+
+using namespace miner::traj;
+using Catch::Matchers::Contains;
+
+namespace {
+const char* kProblem = R"({"order": 3,
+  "points": [[0,0,0],[1,2,0],[3,3,1]],
+  "head": [[0,0,0],[0,0,0],[0,0,0]], "tail": [[3,3,1],[0,0,0],[0,0,0]],
+  "limits": {"v_max": 2.0, "a_max": 1.0}})";
+miner::Json problem() { return miner::parse_json(kProblem, "p.json"); }
+}  // namespace
+
+TEST_CASE("A problem without durations gets trapezoidal ones; the answer has the contract's fields", "[REQ-TRAJ-006][REQ-TRAJ-001]") {
+  const MincoProblem p = problem_from_json(problem(), "p.json");
+  REQUIRE(p.durations.size() == 2);
+  CHECK(p.durations[0] == Approx(trapezoidal_duration(std::sqrt(5.0), Limits{2, 1})));
+  const auto answer = answer_to_json(solve_minco(p));
+  CHECK(answer["order"] == 3);
+  CHECK(answer["durations"].size() == 2);
+  CHECK(answer["coefficients"].size() == 2);
+  CHECK(answer["coefficients"][0].size() == 6);
+  CHECK(answer["coefficients"][0][0].size() == 3);
+  CHECK(answer["cost"].get<double>() > 0.0);
+}
+
+TEST_CASE("Explicit durations are used as given", "[REQ-TRAJ-006]") {
+  auto doc = problem();
+  doc["durations"] = {1.5, 2.5};
+  doc.erase("limits");
+  const MincoProblem p = problem_from_json(doc, "p.json");
+  CHECK(p.durations == std::vector<double>{1.5, 2.5});
+}
+
+TEST_CASE("Problem file errors name the file and the field", "[REQ-TRAJ-007]") {
+  auto doc = problem();
+  doc.erase("limits");
+  CHECK_THROWS_WITH(problem_from_json(doc, "p.json"), Contains("p.json: (top level): needs \"durations\" or \"limits\""));
+  doc = problem();
+  doc["limits"]["v_max"] = -2;
+  CHECK_THROWS_WITH(problem_from_json(doc, "p.json"), Contains("p.json: limits.v_max: must be positive"));
+  doc = problem();
+  doc["durations"] = {1.0, 0.0};
+  CHECK_THROWS_WITH(problem_from_json(doc, "p.json"), Contains("p.json: durations[1]: must be positive and finite"));
+  doc = problem();
+  doc["order"] = 3.5;
+  CHECK_THROWS_WITH(problem_from_json(doc, "p.json"), Contains("order: expected an integer"));
+  doc = problem();
+  doc["head"] = {{0, 0, 0}};
+  CHECK_THROWS_WITH(problem_from_json(doc, "p.json"), Contains("head: expected 3 rows"));
+  doc = problem();
+  doc["points"][1] = {1, 2};
+  CHECK_THROWS_WITH(problem_from_json(doc, "p.json"), Contains("points[1]: expected an array of 3 numbers"));
+  CHECK_THROWS_WITH(problem_from_json(miner::Json::array(), "p.json"), Contains("expected a JSON object"));
+}

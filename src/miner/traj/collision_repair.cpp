@@ -1,0 +1,82 @@
+#include "miner/traj/collision_repair.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "miner/core/error.hpp"
+
+namespace miner::traj {
+
+std::vector<int> colliding_segments(const PolynomialTrajectory& t, const world::Map& map, double radius,
+                                    double step) {
+  std::vector<int> hits;
+  for (int i = 0; i < t.segments(); ++i) {
+    const double T = t.durations()[i];
+    // Bound the speed on the segment by sampling it coarsely, then pick the sample count
+    // so that consecutive samples are at most `step` apart.
+    double v_max = 0.0;
+    constexpr int kSpeedProbes = 16;
+    for (int k = 0; k <= kSpeedProbes; ++k) v_max = std::max(v_max, t.evaluate_segment(i, T * k / kSpeedProbes, 1).norm());
+    const int n = std::max(2, static_cast<int>(std::ceil(2.0 * v_max * T / step)));
+    Eigen::Vector3d prev = t.evaluate_segment(i, 0.0);
+    for (int k = 1; k <= n; ++k) {
+      const Eigen::Vector3d cur = t.evaluate_segment(i, T * k / n);
+      if (!map.segment_free(prev, cur, radius)) {
+        hits.push_back(i);
+        break;
+      }
+      prev = cur;
+    }
+  }
+  return hits;
+}
+
+RepairResult repair_collisions(const world::Map& map, const Eigen::MatrixX3d& path, const RepairOptions& o) {
+  validate(o.limits);
+  require_finite(o.robot_radius, "robot radius");
+  if (o.max_iterations < 0) throw Error("max_iterations: must not be negative");
+  const double step = o.sample_step > 0.0 ? o.sample_step : 0.5 * map.resolution();
+  for (Eigen::Index i = 1; i < path.rows(); ++i) {
+    const Eigen::Vector3d a = path.row(i - 1).transpose(), b = path.row(i).transpose();
+    if (!map.segment_free(a, b, o.robot_radius)) {
+      std::ostringstream os;
+      os << "path segment " << i - 1 << " from " << format_point(a) << " to " << format_point(b)
+         << " is itself in collision for robot radius " << o.robot_radius
+         << " m: collision repair needs a collision-free path";
+      throw Error(os.str());
+    }
+  }
+  RepairResult r;
+  r.waypoints = path;
+  MincoSolver solver;
+  for (;; ++r.iterations) {
+    const MincoProblem p = rest_to_rest(o.order, r.waypoints, trapezoidal_allocation(r.waypoints, o.limits));
+    validate(p);
+    solver.solve(p, r.trajectory);
+    const std::vector<int> hits = colliding_segments(r.trajectory, map, o.robot_radius, step);
+    if (hits.empty()) return r;
+    if (r.iterations == o.max_iterations) {
+      std::ostringstream os;
+      os << "collision repair: " << hits.size() << " trajectory segment(s) still collide after "
+         << o.max_iterations << " iterations (first: segment " << hits.front() << " from "
+         << format_point(r.waypoints.row(hits.front()).transpose()) << ")";
+      throw NoSolution(os.str());
+    }
+    // Insert the halfway point of each colliding straight segment (back to front so the
+    // indices stay valid).
+    Eigen::MatrixX3d next(r.waypoints.rows() + static_cast<Eigen::Index>(hits.size()), 3);
+    Eigen::Index row = 0;
+    std::size_t h = 0;
+    for (Eigen::Index i = 0; i < r.waypoints.rows(); ++i) {
+      next.row(row++) = r.waypoints.row(i);
+      if (h < hits.size() && hits[h] == i) {
+        next.row(row++) = 0.5 * (r.waypoints.row(i) + r.waypoints.row(i + 1));
+        ++h;
+      }
+    }
+    r.inserted += static_cast<int>(hits.size());
+    r.waypoints = std::move(next);
+  }
+}
+
+}  // namespace miner::traj

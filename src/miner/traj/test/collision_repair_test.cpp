@@ -1,0 +1,71 @@
+#include <catch2/catch.hpp>
+
+#include "miner/core/error.hpp"
+#include "miner/traj/collision_repair.hpp"
+#include "miner/world/astar.hpp"
+#include "miner/world/voxel_grid.hpp"
+
+using namespace miner::traj;
+using miner::world::Box;
+using miner::world::Map;
+using Catch::Matchers::Contains;
+
+namespace {
+// An L-shaped path and a box just outside the corner, 0.1 m from the path: the
+// rest-to-rest snap trajectory through the corner bulges 0.7 m outward into the box,
+// the straight path does not touch it.
+Map corner_map() { return Map(Box{{-1, -1, 0}, {7, 7, 2}}, 0.1, {Box{{3.0, -0.9, 0}, {4.9, -0.1, 2}}}); }
+Eigen::MatrixX3d corner_path() {
+  Eigen::MatrixX3d p(3, 3);
+  p << 0, 0, 1, 5, 0, 1, 5, 5, 1;
+  return p;
+}
+}  // namespace
+
+TEST_CASE("Repair inserts halfway points until the trajectory clears the obstacle", "[REQ-TRAJ-008]") {
+  const Map map = corner_map();
+  RepairOptions o;
+  o.limits = Limits{2.0, 1.0};
+  const auto first = solve_minco(rest_to_rest(4, corner_path(), trapezoidal_allocation(corner_path(), o.limits)));
+  REQUIRE_FALSE(colliding_segments(first, map, 0.0, 0.05).empty());  // the premise
+  const RepairResult r = repair_collisions(map, corner_path(), o);
+  CHECK(r.inserted >= 1);
+  CHECK(r.iterations >= 1);
+  CHECK(r.waypoints.rows() == 3 + r.inserted);
+  CHECK(colliding_segments(r.trajectory, map, 0.0, 0.01).empty());  // finer check than the repair's
+  // The original waypoints are kept, in order.
+  CHECK(r.waypoints.row(0) == corner_path().row(0));
+  CHECK(r.waypoints.row(r.waypoints.rows() - 1) == corner_path().row(2));
+}
+
+TEST_CASE("Repair refuses an infeasible path and gives up after its iteration bound", "[REQ-TRAJ-008]") {
+  const Map map = corner_map();
+  Eigen::MatrixX3d through(2, 3);
+  through << 3, -0.5, 1, 3, 3, 1;
+  RepairOptions o;
+  CHECK_THROWS_WITH(repair_collisions(map, through, o), Contains("path segment 0 from (3, -0.5, 1) to (3, 3, 1) is itself in collision"));
+  o.max_iterations = 0;
+  CHECK_THROWS_AS(repair_collisions(map, corner_path(), o), miner::NoSolution);
+  o.max_iterations = -1;
+  CHECK_THROWS_WITH(repair_collisions(map, corner_path(), o), Contains("max_iterations: must not be negative"));
+}
+
+TEST_CASE("An A* path on an indoor map is repaired into a collision-free snap trajectory", "[REQ-TRAJ-008]") {
+  // A small indoor-like site: three pillars between start and goal.
+  const Map map(Box{{0, 0, 0}, {6, 6, 3}}, 0.1,
+                {Box{{1.5, 1.0, 0}, {2.1, 2.2, 3}}, Box{{3.0, 2.5, 0}, {4.2, 3.1, 3}}, Box{{2.0, 4.0, 0}, {2.6, 5.2, 3}}});
+  const miner::world::VoxelGrid grid(map, 0.2);
+  const auto path = miner::world::astar(map, grid, {0.5, 0.5, 1.0}, {5.5, 5.5, 1.2});
+  Eigen::MatrixX3d pts(static_cast<Eigen::Index>(path.points.size()), 3);
+  for (std::size_t i = 0; i < path.points.size(); ++i) pts.row(static_cast<Eigen::Index>(i)) = path.points[i].transpose();
+  // Drop consecutive duplicates (the start may sit on its cell centre).
+  Eigen::MatrixX3d uniq(pts.rows(), 3);
+  Eigen::Index n = 0;
+  for (Eigen::Index i = 0; i < pts.rows(); ++i)
+    if (n == 0 || (pts.row(i) - uniq.row(n - 1)).norm() > 1e-9) uniq.row(n++) = pts.row(i);
+  RepairOptions o;
+  o.limits = Limits{1.0, 0.5};
+  o.robot_radius = 0.2;
+  const RepairResult r = repair_collisions(map, uniq.topRows(n), o);
+  CHECK(colliding_segments(r.trajectory, map, 0.2, 0.01).empty());
+}

@@ -23,7 +23,8 @@ endfunction()
 # Unit tests live in a test/ folder beside the code they test (Drake style).
 macro(miner_add_tests_from_subdirs)
   file(GLOB _miner_test_dirs LIST_DIRECTORIES true
-       ${PROJECT_SOURCE_DIR}/src/miner/*/test ${PROJECT_SOURCE_DIR}/src/cli/test)
+       ${PROJECT_SOURCE_DIR}/src/miner/*/test ${PROJECT_SOURCE_DIR}/src/cli/test
+       ${PROJECT_SOURCE_DIR}/src/bench/test)
   foreach(_dir ${_miner_test_dirs})
     if(EXISTS ${_dir}/CMakeLists.txt)
       add_subdirectory(${_dir})

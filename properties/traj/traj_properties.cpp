@@ -11,6 +11,7 @@
 
 #include "miner/core/rng.hpp"
 #include "miner/testing/property.hpp"
+#include "miner/traj/baselines.hpp"
 #include "miner/traj/minco.hpp"
 #include "miner/traj/optimality_system.hpp"
 #include "miner/traj/trapezoidal_allocation.hpp"
@@ -243,7 +244,7 @@ TEST_CASE("No feasible perturbation lowers the MINCO cost and the first-order co
   });
 }
 
-TEST_CASE("MINCO agrees with the dense pivoted LU solve and with Ceres", "[REQ-TRAJ-003]") {
+TEST_CASE("MINCO agrees with the dense pivoted LU solve, the KKT QP and Ceres", "[REQ-TRAJ-003][REQ-TRAJ-009]") {
   property("three routes, one optimum", [](std::uint64_t seed) {
     // Durations within a factor 4 of each other, as trapezoidal allocation gives for
     // segments within a factor 16 in length: the conditioning of the effort grows like
@@ -253,6 +254,13 @@ TEST_CASE("MINCO agrees with the dense pivoted LU solve and with Ceres", "[REQ-T
     const auto sys = optimality_system(p);
     const Eigen::MatrixX3d dense = sys.A.partialPivLu().solve(sys.b);
     RC_ASSERT((t.coefficients() - dense).norm() <= 1e-8 * dense.norm());
+    // The Mellinger QP through its KKT system: an independent optimiser, 1e-8 in states.
+    const PolynomialTrajectory qp(p.order, p.durations, solve_kkt_qp(p));
+    for (int i = 0; i < t.segments(); ++i)
+      for (int k = 0; k < p.order; ++k) {
+        const double tau = 0.37 * p.durations[i];
+        RC_ASSERT((t.evaluate_segment(i, tau, k) - qp.evaluate_segment(i, tau, k)).norm() <= 1e-8 * scale_of(t, k));
+      }
     const auto z = ceres_optimum(p);
     const int s = p.order;
     for (int j = 1; j < t.segments(); ++j)

@@ -15,6 +15,7 @@ int run_cli(const std::vector<std::string>& args, std::ostream& out, std::ostrea
   app.set_version_flag("--version", "miner 0.1.0");
   add_map_commands(app, out);
   add_traj_commands(app, out);
+  add_bench_commands(app, out);
 
   // CLI11 parses in reverse order of the vector it is given.
   std::vector<std::string> reversed(args.rbegin(), args.rend());

@@ -22,5 +22,7 @@ int run_cli(const std::vector<std::string>& args, std::ostream& out, std::ostrea
 void add_map_commands(CLI::App& app, std::ostream& out);
 /// Registers `miner traj solve` (traj_commands.cpp).
 void add_traj_commands(CLI::App& app, std::ostream& out);
+/// Registers `miner bench ...` (bench_commands.cpp).
+void add_bench_commands(CLI::App& app, std::ostream& out);
 
 }  // namespace miner::cli

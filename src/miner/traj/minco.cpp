@@ -57,16 +57,17 @@ using Block = Eigen::Matrix<double, S - 1, S - 1>;
 template <int S>
 using Rhs = Eigen::Matrix<double, S - 1, 3>;
 
-/// Q(T)_{ab} = K_ab T^{1 - 2S + k(a) + k(b)}, k(r) = r mod S (derivative order of row r).
+/// Q(T)_{ab} = K_ab T^{1 - 2S + k(a) + k(b)}, k(r) = r mod S (derivative order of row r),
+/// i.e. Q = T^{1-2S} (d d^T) o K with d_r = T^{k(r)}.
 template <int S>
 void segment_cost_matrix(double T, SegmentMatrix<S>& Q) {
   const auto& K = UnitHermite<S>::get().K;
-  double pw[2 * S - 1];  // pw[e] = T^{e + 1 - 2S}, e = k(a) + k(b) in [0, 2S - 2]
-  const double inv = 1.0 / T;
-  pw[2 * S - 2] = inv;
-  for (int e = 2 * S - 3; e >= 0; --e) pw[e] = pw[e + 1] * inv;
-  for (int a = 0; a < 2 * S; ++a)
-    for (int b = 0; b < 2 * S; ++b) Q(a, b) = K(a, b) * pw[a % S + b % S];
+  Eigen::Matrix<double, 2 * S, 1> d;
+  d[0] = d[S] = 1.0;
+  for (int k = 1; k < S; ++k) d[k] = d[S + k] = d[k - 1] * T;
+  double scale = 1.0 / T;  // T^{1-2S}
+  for (int k = 1; k < 2 * S - 1; ++k) scale /= T;
+  Q.noalias() = (scale * d * d.transpose()).cwiseProduct(K);
 }
 
 /// dQ/dT: exponent times Q / T.
@@ -75,6 +76,38 @@ void segment_cost_matrix_derivative(double T, SegmentMatrix<S>& dQ) {
   segment_cost_matrix<S>(T, dQ);
   for (int a = 0; a < 2 * S; ++a)
     for (int b = 0; b < 2 * S; ++b) dQ(a, b) *= (1.0 - 2 * S + a % S + b % S) / T;
+}
+
+/// Cholesky factor L (lower, diagonal stored as 1 / L_jj) of a small SPD matrix, written out: for (s-1) x (s-1)
+/// blocks Eigen's general triangular kernels (packing, blocking) cost more than the math.
+template <int F>
+Eigen::Matrix<double, F, F> small_cholesky(const Eigen::Matrix<double, F, F>& A) {
+  Eigen::Matrix<double, F, F> L = Eigen::Matrix<double, F, F>::Zero();
+  for (int j = 0; j < F; ++j) {
+    double d = A(j, j);
+    for (int k = 0; k < j; ++k) d -= L(j, k) * L(j, k);
+    const double inv = 1.0 / std::sqrt(d);
+    L(j, j) = inv;  // stored inverted: the solves multiply instead of divide
+    for (int i = j + 1; i < F; ++i) {
+      double v = A(i, j);
+      for (int k = 0; k < j; ++k) v -= L(i, k) * L(j, k);
+      L(i, j) = v * inv;
+    }
+  }
+  return L;
+}
+
+/// X <- (L L^T)^{-1} X by forward and back substitution.
+template <int F, int C>
+void small_cholesky_solve(const Eigen::Matrix<double, F, F>& L, Eigen::Matrix<double, F, C>& X) {
+  for (int i = 0; i < F; ++i) {
+    for (int k = 0; k < i; ++k) X.row(i) -= L(i, k) * X.row(k);
+    X.row(i) *= L(i, i);
+  }
+  for (int i = F - 1; i >= 0; --i) {
+    for (int k = i + 1; k < F; ++k) X.row(i) -= L(k, i) * X.row(k);
+    X.row(i) *= L(i, i);
+  }
 }
 
 }  // namespace
@@ -89,7 +122,6 @@ struct MincoSolver::Workspace {
   std::vector<Eigen::Matrix<double, 3, 3>> r;  // right-hand sides
   std::vector<Eigen::Matrix<double, 3, 3>> y;  // forward-substituted right-hand sides
   std::vector<Eigen::Matrix<double, 3, 3>> z;  // derivatives 1..S-1 per waypoint (rows) per axis
-  std::vector<Eigen::Matrix<double, 3, 3>> d;  // refinement correction
   std::vector<Eigen::Matrix<double, 8, 3>> x;  // Hermite data per segment (real time)
 };
 
@@ -117,15 +149,13 @@ struct ReducedSystem {
       Block<S> Sj = blk(ws.A, j);
       if (j > 1) {
         const Block<S> Bj = blk(ws.B, j);
-        const auto Lp = blk(ws.L, j - 1).template triangularView<Eigen::Lower>();
         // W = B_j S_{j-1}^{-1} = (S_{j-1}^{-1} B_j^T)^T.
         Block<S> Wt = Bj.transpose();
-        Lp.solveInPlace(Wt);
-        Lp.transpose().solveInPlace(Wt);
+        small_cholesky_solve<F, F>(blk(ws.L, j - 1), Wt);
         blk(ws.W, j) = Wt.transpose();
-        Sj -= blk(ws.W, j) * Bj.transpose();
+        Sj.noalias() -= blk(ws.W, j) * Bj.transpose();
       }
-      blk(ws.L, j) = Eigen::LLT<Block<S>>(Sj).matrixL();
+      blk(ws.L, j) = small_cholesky<F>(Sj);
     }
   }
 
@@ -138,22 +168,11 @@ struct ReducedSystem {
     for (int j = M - 1; j >= 1; --j) {
       Rhs<S> v = col(ws.y, j);
       if (j < M - 1) v -= blk(ws.B, j + 1).transpose() * col(out, j + 1);
-      const auto Lj = blk(ws.L, j).template triangularView<Eigen::Lower>();
-      Lj.solveInPlace(v);
-      Lj.transpose().solveInPlace(v);
+      small_cholesky_solve<F, 3>(blk(ws.L, j), v);
       col(out, j) = v;
     }
   }
 
-  /// in_j - (B_j z_{j-1} + A_j z_j + B_{j+1}^T z_{j+1}) for interior j (z_0, z_M fixed).
-  void residual(std::vector<Eigen::Matrix<double, 3, 3>>& res) {
-    for (int j = 1; j < M; ++j) {
-      Rhs<S> v = col(ws.r, j) - blk(ws.A, j) * col(ws.z, j);
-      if (j > 1) v -= blk(ws.B, j) * col(ws.z, j - 1);
-      if (j < M - 1) v -= blk(ws.B, j + 1).transpose() * col(ws.z, j + 1);
-      col(res, j) = v;
-    }
-  }
 };
 
 template <int S>
@@ -163,7 +182,7 @@ void solve_order(const MincoProblem& p, MincoSolver::Workspace& ws, PolynomialTr
   const int M = static_cast<int>(p.durations.size());
   ws.Q.resize(M);
   ws.x.resize(M);
-  for (auto* v : {&ws.A, &ws.B, &ws.L, &ws.W, &ws.r, &ws.y, &ws.z, &ws.d}) v->resize(M + 1);
+  for (auto* v : {&ws.A, &ws.B, &ws.L, &ws.W, &ws.r, &ws.y, &ws.z}) v->resize(M + 1);
 
   // Work in normalised time t / tau with tau the mean duration: by the time-scaling
   // law the optimum is the same curve, and the blocks no longer carry factors
@@ -203,11 +222,6 @@ void solve_order(const MincoProblem& p, MincoSolver::Workspace& ws, PolynomialTr
     ReducedSystem<S> sys{ws, M};
     sys.factor();
     sys.solve(ws.r, ws.z);
-    // One step of iterative refinement: the stationarity residual is the jump of
-    // derivatives s..2s-2 at the waypoints, so this buys continuity to working accuracy.
-    sys.residual(ws.d);
-    sys.solve(ws.d, ws.d);
-    for (int j = 1; j < M; ++j) ws.z[j].template topRows<F>() += ws.d[j].template topRows<F>();
   }
 
   // Coefficients c_i(j, :) = sum_r G(j, r) T^{k(r) - j} x_i(r, :).
@@ -227,10 +241,19 @@ void solve_order(const MincoProblem& p, MincoSolver::Workspace& ws, PolynomialTr
     for (int k = 1; k < S; ++k) tn[k] = tn[k - 1] * Tn;
     for (int j = 1; j < N; ++j) tp[j] = tp[j - 1] * T;
     Eigen::Matrix<double, N, 3> scaled;  // unit-interval Hermite data
-    for (int r = 0; r < N; ++r) scaled.row(r) = x.row(r) * tn[r % S];
-    Eigen::Matrix<double, N, 3> a = G * scaled;
-    for (int j = 0; j < N; ++j) a.row(j) /= tp[j];
-    c.template middleRows<N>(N * i) = a;
+    for (int r = 0; r < S; ++r) {
+      scaled.row(r) = x.row(r) * tn[r];
+      scaled.row(S + r) = x.row(S + r) * tn[r];
+    }
+    // Rows j < S of G are the Taylor terms q^{(j)}(0) / j!; only rows S..2S-1 mix the ends.
+    auto ci = c.template middleRows<N>(N * i);
+    double factorial = 1.0;
+    for (int j = 0; j < S; ++j) {
+      if (j > 0) factorial *= j;
+      ci.row(j) = x.row(j) / factorial / tau_pow[j];
+    }
+    ci.template bottomRows<S>().noalias() = G.template bottomRows<S>() * scaled;
+    for (int j = S; j < N; ++j) ci.row(j) /= tp[j];
     // Keep the Hermite data in real time for cost_and_gradients().
     for (int k = 1; k < S; ++k) {
       x.row(k) /= tau_pow[k];

@@ -1,0 +1,157 @@
+#include "bench/backend_bench.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <functional>
+#include <iomanip>
+#include <map>
+#include <ostream>
+#include <sstream>
+
+#include "miner/core/error.hpp"
+#include "miner/core/rng.hpp"
+#include "miner/traj/baselines.hpp"
+#include "miner/traj/minco.hpp"
+#include "miner/traj/trapezoidal_allocation.hpp"
+
+namespace miner::bench {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+/// Waypoints of a 100 m map (paper Sec. V-B), durations by trapezoidal allocation.
+traj::MincoProblem bench_problem(int order, int segments, std::uint64_t seed) {
+  Rng rng(seed, static_cast<std::uint64_t>(segments * 10 + order));
+  Eigen::MatrixX3d pts(segments + 1, 3);
+  for (int i = 0; i <= segments; ++i) pts.row(i) << rng.uniform(0, 100), rng.uniform(0, 100), rng.uniform(0, 40);
+  return traj::rest_to_rest(order, pts, traj::trapezoidal_allocation(pts, traj::Limits{2.0, 1.0}));
+}
+
+/// Times `solve` in `samples` batches sized to fill the budget; returns (median, min) us.
+std::pair<double, double> time_solves(const std::function<void()>& solve, const BackendBenchOptions& o,
+                                      int& samples, long& reps) {
+  const auto t0 = Clock::now();
+  solve();  // warm-up, and a first estimate
+  const double first = std::chrono::duration<double>(Clock::now() - t0).count();
+  const double per_sample = o.budget_s / o.samples;
+  reps = std::max(1L, static_cast<long>(per_sample / std::max(first, 1e-9)));
+  samples = first > per_sample ? std::max(1, static_cast<int>(o.budget_s / first)) : o.samples;
+  samples = std::max(samples, 3);
+  std::vector<double> us;
+  for (int k = 0; k < samples; ++k) {
+    const auto a = Clock::now();
+    for (long r = 0; r < reps; ++r) solve();
+    us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - a).count() / static_cast<double>(reps));
+  }
+  std::sort(us.begin(), us.end());
+  return {us[us.size() / 2], us.front()};
+}
+
+}  // namespace
+
+std::vector<BackendRecord> run_backend_bench(const BackendBenchOptions& o) {
+  const std::vector<std::string> known{"minco", "dense-lu", "closed-form", "kkt-qp"};
+  for (const auto& m : o.methods) {
+    if (std::find(known.begin(), known.end(), m) == known.end()) {
+      throw Error("--methods: unknown method \"" + m + "\" (known: minco, dense-lu, closed-form, kkt-qp)");
+    }
+  }
+  for (int s : o.orders) {
+    if (s != 3 && s != 4) throw Error("--orders: must be 3 or 4, got " + std::to_string(s));
+  }
+  for (int m : o.segments) {
+    if (m < 1) throw Error("--segments: must be at least 1, got " + std::to_string(m));
+  }
+  if (!(o.budget_s > 0.0) || o.samples < 1) throw Error("--budget and --samples: must be positive");
+
+  std::vector<BackendRecord> records;
+  for (int s : o.orders)
+    for (int M : o.segments) {
+      const traj::MincoProblem p = bench_problem(s, M, o.seed);
+      traj::MincoSolver solver;
+      traj::PolynomialTrajectory out;
+      solver.solve(p, out);
+      const Eigen::MatrixX3d reference = out.coefficients();
+      double minco_us = 0.0;
+      for (const auto& method : o.methods) {
+        BackendRecord r;
+        r.method = method;
+        r.order = s;
+        r.segments = M;
+        if (method != "minco" && M > o.max_dense_segments) {
+          r.skipped = true;
+          records.push_back(r);
+          continue;
+        }
+        Eigen::MatrixX3d c;
+        std::function<void()> solve;
+        if (method == "minco") {
+          solve = [&] { solver.solve(p, out); };
+        } else if (method == "dense-lu") {
+          solve = [&] { c = traj::solve_dense_lu(p); };
+        } else if (method == "closed-form") {
+          solve = [&] { c = traj::solve_closed_form(p); };
+        } else {
+          solve = [&] { c = traj::solve_kkt_qp(p); };
+        }
+        const auto [median, fastest] = time_solves(solve, o, r.samples, r.reps_per_sample);
+        r.us_per_solve = median;
+        r.min_us = fastest;
+        if (method == "minco") {
+          minco_us = median;
+          c = out.coefficients();
+        }
+        r.max_rel_diff = (c - reference).norm() / reference.norm();
+        r.ratio_to_minco = minco_us > 0.0 ? median / minco_us : 0.0;
+        records.push_back(r);
+      }
+    }
+  return records;
+}
+
+nlohmann::json to_json(const std::vector<BackendRecord>& records) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& r : records) {
+    nlohmann::json j = {{"method", r.method}, {"order", r.order}, {"segments", r.segments}, {"skipped", r.skipped}};
+    if (r.skipped) {
+      j["us_per_solve"] = nullptr;
+    } else {
+      j.update({{"us_per_solve", r.us_per_solve}, {"min_us", r.min_us}, {"samples", r.samples},
+                {"reps_per_sample", r.reps_per_sample}, {"ratio_to_minco", r.ratio_to_minco},
+                {"max_rel_diff", r.max_rel_diff}});
+    }
+    out.push_back(j);
+  }
+  return out;
+}
+
+void print_table(const std::vector<BackendRecord>& records, std::ostream& out) {
+  std::vector<std::string> methods;
+  std::map<std::pair<int, int>, std::map<std::string, const BackendRecord*>> rows;
+  for (const auto& r : records) {
+    if (std::find(methods.begin(), methods.end(), r.method) == methods.end()) methods.push_back(r.method);
+    rows[{r.order, r.segments}][r.method] = &r;
+  }
+  out << "microseconds per solve (median), ratio to MINCO in brackets\n";
+  out << std::left << std::setw(6) << "s" << std::setw(7) << "M";
+  for (const auto& m : methods) out << std::setw(24) << m;
+  out << "\n";
+  for (const auto& [key, by_method] : rows) {
+    out << std::left << std::setw(6) << key.first << std::setw(7) << key.second;
+    for (const auto& m : methods) {
+      std::ostringstream cell;
+      const auto it = by_method.find(m);
+      if (it == by_method.end() || it->second->skipped) {
+        cell << "skipped";
+      } else {
+        cell << std::fixed << std::setprecision(it->second->us_per_solve < 100 ? 2 : 0) << it->second->us_per_solve;
+        if (m != "minco") cell << " (" << std::setprecision(1) << it->second->ratio_to_minco << "x)";
+      }
+      out << std::setw(24) << cell.str();
+    }
+    out << "\n";
+  }
+}
+
+}  // namespace miner::bench

@@ -11,17 +11,6 @@ namespace miner::traj {
 
 namespace {
 
-/// Row of d^k/dt^k (1, t, ..., t^{n-1}).
-Eigen::RowVectorXd derivative_row(int n, int k, double t) {
-  Eigen::RowVectorXd r = Eigen::RowVectorXd::Zero(n);
-  for (int a = k; a < n; ++a) {
-    double f = 1.0;
-    for (int i = 0; i < k; ++i) f *= a - i;
-    r(a) = f * std::pow(t, a - k);
-  }
-  return r;
-}
-
 /// Block-diagonal Q of the whole trajectory (dense, as the baselines use it).
 Eigen::MatrixXd stacked_cost(const MincoProblem& p) {
   const int n = 2 * p.order, M = static_cast<int>(p.durations.size());
@@ -43,8 +32,8 @@ Eigen::MatrixX3d solve_closed_form(const MincoProblem& p) {
   Eigen::MatrixXd A = Eigen::MatrixXd::Zero(n * M, n * M);
   for (int i = 0; i < M; ++i)
     for (int k = 0; k < s; ++k) {
-      A.block(n * i + k, n * i, 1, n) = derivative_row(n, k, 0.0);
-      A.block(n * i + s + k, n * i, 1, n) = derivative_row(n, k, p.durations[i]);
+      A.block(n * i + k, n * i, 1, n) = monomial_derivative_row(n, k, 0.0);
+      A.block(n * i + s + k, n * i, 1, n) = monomial_derivative_row(n, k, p.durations[i]);
     }
   // Unknown vector [d_F; d_P]: d_F = positions of all M+1 waypoints, head and tail
   // derivatives 1..s-1; d_P = derivatives 1..s-1 at the M-1 interior waypoints.
@@ -86,19 +75,19 @@ Eigen::MatrixX3d solve_kkt_qp(const MincoProblem& p) {
   Eigen::MatrixX3d beq = Eigen::MatrixX3d::Zero(rows, 3);
   int r = 0;
   for (int k = 0; k < s; ++k, ++r) {
-    Aeq.block(r, 0, 1, n) = derivative_row(n, k, 0.0);
+    Aeq.block(r, 0, 1, n) = monomial_derivative_row(n, k, 0.0);
     beq.row(r) = p.head.row(k);
   }
   for (int i = 0; i + 1 < M; ++i) {
-    Aeq.block(r, n * i, 1, n) = derivative_row(n, 0, p.durations[i]);
+    Aeq.block(r, n * i, 1, n) = monomial_derivative_row(n, 0, p.durations[i]);
     beq.row(r++) = p.points.row(i + 1);
     for (int k = 0; k < s; ++k, ++r) {
-      Aeq.block(r, n * i, 1, n) = derivative_row(n, k, p.durations[i]);
-      Aeq.block(r, n * (i + 1), 1, n) = -derivative_row(n, k, 0.0);
+      Aeq.block(r, n * i, 1, n) = monomial_derivative_row(n, k, p.durations[i]);
+      Aeq.block(r, n * (i + 1), 1, n) = -monomial_derivative_row(n, k, 0.0);
     }
   }
   for (int k = 0; k < s; ++k, ++r) {
-    Aeq.block(r, n * (M - 1), 1, n) = derivative_row(n, k, p.durations[M - 1]);
+    Aeq.block(r, n * (M - 1), 1, n) = monomial_derivative_row(n, k, p.durations[M - 1]);
     beq.row(r) = p.tail.row(k);
   }
   Eigen::MatrixXd K = Eigen::MatrixXd::Zero(vars + rows, vars + rows);

@@ -2,20 +2,10 @@
 
 #include <cmath>
 
+#include "miner/traj/polynomial_trajectory.hpp"
+
 namespace miner::traj {
 
-namespace {
-/// Row of d^k/dt^k rho(t) for degree n - 1: entries a!/(a-k)! t^{a-k}.
-Eigen::RowVectorXd derivative_row(int n, int k, double t) {
-  Eigen::RowVectorXd r = Eigen::RowVectorXd::Zero(n);
-  for (int a = k; a < n; ++a) {
-    double f = 1.0;
-    for (int i = 0; i < k; ++i) f *= a - i;
-    r(a) = f * std::pow(t, a - k);
-  }
-  return r;
-}
-}  // namespace
 
 LinearSystem optimality_system(const MincoProblem& p) {
   const int s = p.order, n = 2 * s;
@@ -23,20 +13,20 @@ LinearSystem optimality_system(const MincoProblem& p) {
   LinearSystem sys{Eigen::MatrixXd::Zero(n * M, n * M), Eigen::MatrixX3d::Zero(n * M, 3)};
   int row = 0;
   for (int k = 0; k < s; ++k, ++row) {
-    sys.A.block(row, 0, 1, n) = derivative_row(n, k, 0.0);
+    sys.A.block(row, 0, 1, n) = monomial_derivative_row(n, k, 0.0);
     sys.b.row(row) = p.head.row(k);
   }
   for (int i = 0; i + 1 < M; ++i) {
     const double T = p.durations[i];
-    sys.A.block(row, n * i, 1, n) = derivative_row(n, 0, T);
+    sys.A.block(row, n * i, 1, n) = monomial_derivative_row(n, 0, T);
     sys.b.row(row++) = p.points.row(i + 1);
     for (int k = 0; k <= 2 * s - 2; ++k, ++row) {
-      sys.A.block(row, n * i, 1, n) = derivative_row(n, k, T);
-      sys.A.block(row, n * (i + 1), 1, n) = -derivative_row(n, k, 0.0);
+      sys.A.block(row, n * i, 1, n) = monomial_derivative_row(n, k, T);
+      sys.A.block(row, n * (i + 1), 1, n) = -monomial_derivative_row(n, k, 0.0);
     }
   }
   for (int k = 0; k < s; ++k, ++row) {
-    sys.A.block(row, n * (M - 1), 1, n) = derivative_row(n, k, p.durations[M - 1]);
+    sys.A.block(row, n * (M - 1), 1, n) = monomial_derivative_row(n, k, p.durations[M - 1]);
     sys.b.row(row) = p.tail.row(k);
   }
   return sys;

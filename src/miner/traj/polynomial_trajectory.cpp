@@ -8,14 +8,17 @@
 
 namespace miner::traj {
 
-namespace {
-/// a! / (a - k)!: the factor of t^{a-k} in the k-th derivative of t^a.
 double falling_factorial(int a, int k) {
   double f = 1.0;
   for (int i = 0; i < k; ++i) f *= a - i;
   return f;
 }
-}  // namespace
+
+Eigen::RowVectorXd monomial_derivative_row(int n, int k, double t) {
+  Eigen::RowVectorXd r = Eigen::RowVectorXd::Zero(n);
+  for (int a = k; a < n; ++a) r(a) = falling_factorial(a, k) * std::pow(t, a - k);
+  return r;
+}
 
 PolynomialTrajectory::PolynomialTrajectory(int order, std::vector<double> durations,
                                            Eigen::MatrixX3d coefficients)

@@ -65,8 +65,9 @@ void segment_cost_matrix(double T, SegmentMatrix<S>& Q) {
   Eigen::Matrix<double, 2 * S, 1> d;
   d[0] = d[S] = 1.0;
   for (int k = 1; k < S; ++k) d[k] = d[S + k] = d[k - 1] * T;
-  double scale = 1.0 / T;  // T^{1-2S}
-  for (int k = 1; k < 2 * S - 1; ++k) scale /= T;
+  const double inv = 1.0 / T;
+  double scale = inv;  // T^{1-2S}
+  for (int k = 1; k < 2 * S - 1; ++k) scale *= inv;
   Q.noalias() = (scale * d * d.transpose()).cwiseProduct(K);
 }
 
@@ -110,19 +111,28 @@ void small_cholesky_solve(const Eigen::Matrix<double, F, F>& L, Eigen::Matrix<do
   }
 }
 
+/// Storage of one order, every block at its true size.
+template <int S>
+struct OrderWorkspace {
+  static constexpr int F = S - 1;
+  std::vector<Eigen::Matrix<double, F, F>> A;  // diagonal blocks of the reduced Hessian
+  std::vector<Eigen::Matrix<double, F, F>> B;  // sub-diagonal blocks (B_j couples z_j to z_{j-1})
+  std::vector<Eigen::Matrix<double, F, F>> L;  // Cholesky factors of the Schur complements
+  std::vector<Eigen::Matrix<double, F, F>> W;  // B_j S_{j-1}^{-1}
+  std::vector<Eigen::Matrix<double, F, 3>> r;  // right-hand sides
+  std::vector<Eigen::Matrix<double, F, 3>> z;  // derivatives 1..S-1 per waypoint (rows) per axis
+  std::vector<Eigen::Matrix<double, 2 * S, 3>> x;  // Hermite data per segment (real time)
+};
+
 }  // namespace
 
 struct MincoSolver::Workspace {
-  // Fixed-size storage sized for the largest order (S = 4); order 3 uses leading blocks.
-  std::vector<Eigen::Matrix<double, 8, 8>> Q;  // per segment, normalised time
-  std::vector<Eigen::Matrix<double, 3, 3>> A;  // diagonal blocks of the reduced Hessian
-  std::vector<Eigen::Matrix<double, 3, 3>> B;  // sub-diagonal blocks (B_j couples z_j to z_{j-1})
-  std::vector<Eigen::Matrix<double, 3, 3>> L;  // Cholesky factors of the Schur complements
-  std::vector<Eigen::Matrix<double, 3, 3>> W;  // B_j S_{j-1}^{-1}
-  std::vector<Eigen::Matrix<double, 3, 3>> r;  // right-hand sides
-  std::vector<Eigen::Matrix<double, 3, 3>> y;  // forward-substituted right-hand sides
-  std::vector<Eigen::Matrix<double, 3, 3>> z;  // derivatives 1..S-1 per waypoint (rows) per axis
-  std::vector<Eigen::Matrix<double, 8, 3>> x;  // Hermite data per segment (real time)
+  OrderWorkspace<3> jerk;
+  OrderWorkspace<4> snap;
+  template <int S>
+  OrderWorkspace<S>& get() {
+    if constexpr (S == 3) return jerk; else return snap;
+  }
 };
 
 MincoSolver::MincoSolver() : ws_(std::make_unique<Workspace>()) {}
@@ -132,57 +142,44 @@ MincoSolver& MincoSolver::operator=(MincoSolver&&) noexcept = default;
 
 namespace {
 
-/// Block tridiagonal SPD solve on the workspace: unknowns j = 1..M-1 with
-/// B_j z_{j-1} + A_j z_j + B_{j+1}^T z_{j+1} = rhs_j (block Cholesky / block Thomas).
+/// Block tridiagonal SPD solve, unknowns j = 1..M-1:
+/// B_j z_{j-1} + A_j z_j + B_{j+1}^T z_{j+1} = r_j (block Cholesky / block Thomas), in place
+/// on z (r is consumed as the forward-substituted right-hand side).
 template <int S>
-struct ReducedSystem {
-  static constexpr int F = S - 1;
-  MincoSolver::Workspace& ws;
-  int M;
-
-  auto blk(std::vector<Eigen::Matrix<double, 3, 3>>& v, int j) { return v[j].template topLeftCorner<F, F>(); }
-  auto col(std::vector<Eigen::Matrix<double, 3, 3>>& v, int j) { return v[j].template topRows<F>(); }
-
-  /// Schur complements S_j = A_j - B_j S_{j-1}^{-1} B_j^T, factored as L_j L_j^T.
-  void factor() {
-    for (int j = 1; j < M; ++j) {
-      Block<S> Sj = blk(ws.A, j);
-      if (j > 1) {
-        const Block<S> Bj = blk(ws.B, j);
-        // W = B_j S_{j-1}^{-1} = (S_{j-1}^{-1} B_j^T)^T.
-        Block<S> Wt = Bj.transpose();
-        small_cholesky_solve<F, F>(blk(ws.L, j - 1), Wt);
-        blk(ws.W, j) = Wt.transpose();
-        Sj.noalias() -= blk(ws.W, j) * Bj.transpose();
-      }
-      blk(ws.L, j) = small_cholesky<F>(Sj);
+void solve_reduced(OrderWorkspace<S>& w, int M) {
+  constexpr int F = S - 1;
+  for (int j = 1; j < M; ++j) {
+    // Schur complement S_j = A_j - B_j S_{j-1}^{-1} B_j^T; y_j = r_j - W_j y_{j-1}.
+    Eigen::Matrix<double, F, F> Sj = w.A[j];
+    if (j > 1) {
+      Eigen::Matrix<double, F, F> Wt = w.B[j].transpose();
+      small_cholesky_solve<F, F>(w.L[j - 1], Wt);  // S_{j-1}^{-1} B_j^T
+      w.W[j] = Wt.transpose();
+      Sj.noalias() -= w.W[j] * w.B[j].transpose();
+      w.r[j].noalias() -= w.W[j] * w.r[j - 1];
     }
+    w.L[j] = small_cholesky<F>(Sj);
   }
-
-  /// Solves for `out` given right-hand sides `in` (both indexed 1..M-1).
-  void solve(std::vector<Eigen::Matrix<double, 3, 3>>& in, std::vector<Eigen::Matrix<double, 3, 3>>& out) {
-    for (int j = 1; j < M; ++j) {
-      col(ws.y, j) = col(in, j);
-      if (j > 1) col(ws.y, j) -= blk(ws.W, j) * col(ws.y, j - 1);
-    }
-    for (int j = M - 1; j >= 1; --j) {
-      Rhs<S> v = col(ws.y, j);
-      if (j < M - 1) v -= blk(ws.B, j + 1).transpose() * col(out, j + 1);
-      small_cholesky_solve<F, 3>(blk(ws.L, j), v);
-      col(out, j) = v;
-    }
+  for (int j = M - 1; j >= 1; --j) {
+    Eigen::Matrix<double, F, 3> v = w.r[j];
+    if (j < M - 1) v.noalias() -= w.B[j + 1].transpose() * w.z[j + 1];
+    small_cholesky_solve<F, 3>(w.L[j], v);
+    w.z[j] = v;
   }
-
-};
+}
 
 template <int S>
-void solve_order(const MincoProblem& p, MincoSolver::Workspace& ws, PolynomialTrajectory& out) {
+void solve_order(const MincoProblem& p, OrderWorkspace<S>& ws, PolynomialTrajectory& out) {
   constexpr int F = S - 1;  // free derivatives per waypoint
   constexpr int N = 2 * S;
   const int M = static_cast<int>(p.durations.size());
-  ws.Q.resize(M);
   ws.x.resize(M);
-  for (auto* v : {&ws.A, &ws.B, &ws.L, &ws.W, &ws.r, &ws.y, &ws.z}) v->resize(M + 1);
+  ws.A.resize(M + 1);
+  ws.B.resize(M + 1);
+  ws.L.resize(M + 1);
+  ws.W.resize(M + 1);
+  ws.r.resize(M + 1);
+  ws.z.resize(M + 1);
 
   // Work in normalised time t / tau with tau the mean duration: by the time-scaling
   // law the optimum is the same curve, and the blocks no longer carry factors
@@ -190,39 +187,38 @@ void solve_order(const MincoProblem& p, MincoSolver::Workspace& ws, PolynomialTr
   double tau = 0.0;
   for (double T : p.durations) tau += T;
   tau /= M;
-  double tau_pow[S];  // tau^k
-  tau_pow[0] = 1.0;
-  for (int k = 1; k < S; ++k) tau_pow[k] = tau_pow[k - 1] * tau;
-  for (int i = 0; i < M; ++i) {
-    SegmentMatrix<S> Q;
-    segment_cost_matrix<S>(p.durations[i] / tau, Q);
-    ws.Q[i].template topLeftCorner<N, N>() = Q;
+  const double inv_tau = 1.0 / tau;
+  double tau_pow[S], inv_tau_pow[S], taylor[S];  // tau^k, tau^-k, 1 / (k! tau^k)
+  tau_pow[0] = inv_tau_pow[0] = taylor[0] = 1.0;
+  for (int k = 1; k < S; ++k) {
+    tau_pow[k] = tau_pow[k - 1] * tau;
+    inv_tau_pow[k] = inv_tau_pow[k - 1] * inv_tau;
+    taylor[k] = taylor[k - 1] * inv_tau / k;
   }
-  auto Q = [&](int seg) { return ws.Q[seg].template topLeftCorner<N, N>(); };
   // Known derivatives at the ends, in normalised time: d^k/ds^k = tau^k d^k/dt^k.
   for (int k = 1; k < S; ++k) {
     ws.z[0].row(k - 1) = p.head.row(k) * tau_pow[k];
     ws.z[M].row(k - 1) = p.tail.row(k) * tau_pow[k];
   }
 
-  // Equation of interior waypoint j (segments j-1 ending and j starting there):
+  // Equation of interior waypoint j (segment j-1 ends and segment j starts there):
   //   dJ/dz_j = 0  <=>  B_j z_{j-1} + A_j z_j + B_{j+1}^T z_{j+1} = r_j.
+  // Q of the two segments is computed once each, rolling along the path.
+  SegmentMatrix<S> Qa, Qb;
+  segment_cost_matrix<S>(p.durations[0] * inv_tau, Qa);
   for (int j = 1; j < M; ++j) {
-    const auto Qa = Q(j - 1), Qb = Q(j);
-    ws.A[j].template topLeftCorner<F, F>() = Qa.template block<F, F>(S + 1, S + 1) + Qb.template block<F, F>(1, 1);
-    ws.B[j].template topLeftCorner<F, F>() = Qa.template block<F, F>(S + 1, 1);
-    Rhs<S> r = -(Qa.template block<F, 1>(S + 1, 0) * p.points.row(j - 1) +
-                 (Qa.template block<F, 1>(S + 1, S) + Qb.template block<F, 1>(1, 0)) * p.points.row(j) +
-                 Qb.template block<F, 1>(1, S) * p.points.row(j + 1));
-    if (j == 1) r -= Qa.template block<F, F>(S + 1, 1) * ws.z[0].template topRows<F>();
-    if (j == M - 1) r -= Qb.template block<F, F>(1, S + 1) * ws.z[M].template topRows<F>();
-    ws.r[j].template topRows<F>() = r;
+    segment_cost_matrix<S>(p.durations[j] * inv_tau, Qb);
+    ws.A[j] = Qa.template block<F, F>(S + 1, S + 1) + Qb.template block<F, F>(1, 1);
+    ws.B[j] = Qa.template block<F, F>(S + 1, 1);
+    Eigen::Matrix<double, F, 3> r = -(Qa.template block<F, 1>(S + 1, 0) * p.points.row(j - 1) +
+                                      (Qa.template block<F, 1>(S + 1, S) + Qb.template block<F, 1>(1, 0)) * p.points.row(j) +
+                                      Qb.template block<F, 1>(1, S) * p.points.row(j + 1));
+    if (j == 1) r.noalias() -= ws.B[1] * ws.z[0];
+    if (j == M - 1) r.noalias() -= Qb.template block<F, F>(1, S + 1) * ws.z[M];
+    ws.r[j] = r;
+    Qa = Qb;
   }
-  if (M > 1) {
-    ReducedSystem<S> sys{ws, M};
-    sys.factor();
-    sys.solve(ws.r, ws.z);
-  }
+  if (M > 1) solve_reduced<S>(ws, M);
 
   // Coefficients c_i(j, :) = sum_r G(j, r) T^{k(r) - j} x_i(r, :).
   const auto& G = UnitHermite<S>::get().G;
@@ -230,16 +226,17 @@ void solve_order(const MincoProblem& p, MincoSolver::Workspace& ws, PolynomialTr
   c.resize(N * M, 3);
   out.mutable_durations() = p.durations;
   for (int i = 0; i < M; ++i) {
-    auto x = ws.x[i].template topRows<N>();
+    auto& x = ws.x[i];
     x.row(0) = p.points.row(i);
-    x.template middleRows<F>(1) = ws.z[i].template topRows<F>();
+    x.template middleRows<F>(1) = ws.z[i];
     x.row(S) = p.points.row(i + 1);
-    x.template middleRows<F>(S + 1) = ws.z[i + 1].template topRows<F>();
+    x.template middleRows<F>(S + 1) = ws.z[i + 1];
     const double Tn = p.durations[i] / tau, T = p.durations[i];
-    double tn[S], tp[N];  // tn[k] = Tn^k, tp[j] = T^j
-    tn[0] = tp[0] = 1.0;
+    double tn[S], inv_tp[N];  // tn[k] = Tn^k, inv_tp[j] = T^-j
+    const double inv_T = 1.0 / T;
+    tn[0] = inv_tp[0] = 1.0;
     for (int k = 1; k < S; ++k) tn[k] = tn[k - 1] * Tn;
-    for (int j = 1; j < N; ++j) tp[j] = tp[j - 1] * T;
+    for (int j = 1; j < N; ++j) inv_tp[j] = inv_tp[j - 1] * inv_T;
     Eigen::Matrix<double, N, 3> scaled;  // unit-interval Hermite data
     for (int r = 0; r < S; ++r) {
       scaled.row(r) = x.row(r) * tn[r];
@@ -247,23 +244,19 @@ void solve_order(const MincoProblem& p, MincoSolver::Workspace& ws, PolynomialTr
     }
     // Rows j < S of G are the Taylor terms q^{(j)}(0) / j!; only rows S..2S-1 mix the ends.
     auto ci = c.template middleRows<N>(N * i);
-    double factorial = 1.0;
-    for (int j = 0; j < S; ++j) {
-      if (j > 0) factorial *= j;
-      ci.row(j) = x.row(j) / factorial / tau_pow[j];
-    }
+    for (int j = 0; j < S; ++j) ci.row(j) = x.row(j) * taylor[j];
     ci.template bottomRows<S>().noalias() = G.template bottomRows<S>() * scaled;
-    for (int j = S; j < N; ++j) ci.row(j) /= tp[j];
+    for (int j = S; j < N; ++j) ci.row(j) *= inv_tp[j];
     // Keep the Hermite data in real time for cost_and_gradients().
     for (int k = 1; k < S; ++k) {
-      x.row(k) /= tau_pow[k];
-      x.row(S + k) /= tau_pow[k];
+      x.row(k) *= inv_tau_pow[k];
+      x.row(S + k) *= inv_tau_pow[k];
     }
   }
 }
 
 template <int S>
-double cost_order(const MincoProblem& p, const std::vector<Eigen::Matrix<double, 8, 3>>& xs,
+double cost_order(const MincoProblem& p, const std::vector<Eigen::Matrix<double, 2 * S, 3>>& xs,
                   MincoGradients* g) {
   constexpr int N = 2 * S;
   const int M = static_cast<int>(p.durations.size());
@@ -275,7 +268,7 @@ double cost_order(const MincoProblem& p, const std::vector<Eigen::Matrix<double,
   for (int i = 0; i < M; ++i) {
     SegmentMatrix<S> Q;
     segment_cost_matrix<S>(p.durations[i], Q);
-    const auto x = xs[i].template topRows<N>();
+    const auto& x = xs[i];
     const Eigen::Matrix<double, N, 3> Qx = Q * x;
     J += (x.transpose() * Qx).trace();
     if (g) {
@@ -298,18 +291,18 @@ std::string row_text(const Eigen::MatrixX3d& m, Eigen::Index r) {
 void MincoSolver::solve(const MincoProblem& p, PolynomialTrajectory& out) {
   out.set_order(p.order);
   if (p.order == 3) {
-    solve_order<3>(p, *ws_, out);
+    solve_order<3>(p, ws_->jerk, out);
   } else if (p.order == 4) {
-    solve_order<4>(p, *ws_, out);
+    solve_order<4>(p, ws_->snap, out);
   } else {
     throw Error("order: must be 3 (minimum jerk) or 4 (minimum snap), got " + std::to_string(p.order));
   }
 }
 
 double MincoSolver::cost_and_gradients(const MincoProblem& p, MincoGradients* gradients) const {
-  if (ws_->x.size() < p.durations.size()) throw Error("MincoSolver: cost_and_gradients needs a solve() first");
-  return p.order == 3 ? cost_order<3>(p, ws_->x, gradients)
-                      : cost_order<4>(p, ws_->x, gradients);
+  const std::size_t solved = p.order == 3 ? ws_->jerk.x.size() : ws_->snap.x.size();
+  if (solved < p.durations.size()) throw Error("MincoSolver: cost_and_gradients needs a solve() first");
+  return p.order == 3 ? cost_order<3>(p, ws_->jerk.x, gradients) : cost_order<4>(p, ws_->snap.x, gradients);
 }
 
 MincoProblem rest_to_rest(int order, const Eigen::MatrixX3d& points, std::vector<double> durations) {

@@ -1,5 +1,6 @@
 #include "miner/world/map.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -55,6 +56,67 @@ Map::Map(Box bounds, double resolution, std::vector<Box> obstacles, std::optiona
     require_finite(query_->robot_radius, "query.robot_radius");
     if (query_->robot_radius < 0.0) throw Error("query.robot_radius: must not be negative");
   }
+  build_index();
+}
+
+void Map::build_index() {
+  // About 32 buckets along the longest side: a few obstacles per bucket for the paper's
+  // maps; fine enough that a short RRT edge visits few buckets.
+  constexpr int kBucketsPerSide = 32;
+  index_.origin = bounds_.min;
+  index_.cell = bounds_.extent().maxCoeff() / kBucketsPerSide;
+  for (int k = 0; k < 3; ++k) {
+    index_.dims[k] = std::max(1, static_cast<int>(std::ceil(bounds_.extent()[k] / index_.cell)));
+  }
+  index_.buckets.assign(static_cast<std::size_t>(index_.dims.prod()), {});
+  const auto clamp_cell = [&](double v, int k) {
+    const double c = std::floor((v - index_.origin[k]) / index_.cell);
+    return static_cast<int>(std::min<double>(index_.dims[k] - 1, std::max(0.0, c)));
+  };
+  for (std::size_t i = 0; i < obstacles_.size(); ++i) {
+    const Box& b = obstacles_[i];
+    Eigen::Vector3i lo, hi;
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = clamp_cell(b.min[k], k);
+      hi[k] = clamp_cell(b.max[k], k);
+    }
+    for (int z = lo.z(); z <= hi.z(); ++z)
+      for (int y = lo.y(); y <= hi.y(); ++y)
+        for (int x = lo.x(); x <= hi.x(); ++x) {
+          index_.buckets[(static_cast<std::size_t>(z) * index_.dims.y() + y) * index_.dims.x() + x].push_back(
+              static_cast<std::uint32_t>(i));
+        }
+  }
+}
+
+template <typename Dist2>
+std::optional<std::size_t> Map::query_index(const Box& region, double r2, const Dist2& dist2) const {
+  // Obstacles outside the bounds still count: their buckets are the clamped border ones.
+  Eigen::Vector3i lo, hi;
+  for (int k = 0; k < 3; ++k) {
+    const auto cell = [&](double v) {
+      const double c = std::floor((v - index_.origin[k]) / index_.cell);
+      return static_cast<int>(std::min<double>(index_.dims[k] - 1, std::max(0.0, c)));
+    };
+    lo[k] = cell(region.min[k]);
+    hi[k] = cell(region.max[k]);
+  }
+  std::optional<std::size_t> best;
+  const auto consider = [&](std::size_t i) {
+    if ((!best || i < *best) && region.overlaps(obstacles_[i]) && dist2(obstacles_[i]) <= r2) best = i;
+  };
+  const long visits = static_cast<long>(hi.x() - lo.x() + 1) * (hi.y() - lo.y() + 1) * (hi.z() - lo.z() + 1);
+  if (visits > static_cast<long>(obstacles_.size())) {  // a long query: a plain scan is cheaper
+    for (std::size_t i = 0; i < obstacles_.size(); ++i) consider(i);
+    return best;
+  }
+  for (int z = lo.z(); z <= hi.z(); ++z)
+    for (int y = lo.y(); y <= hi.y(); ++y)
+      for (int x = lo.x(); x <= hi.x(); ++x)
+        for (const std::uint32_t i : index_.buckets[(static_cast<std::size_t>(z) * index_.dims.y() + y) * index_.dims.x() + x]) {
+          consider(i);
+        }
+  return best;
 }
 
 Map Map::from_json(const Json& doc, const std::string& origin) {
@@ -127,22 +189,14 @@ void Map::save(const std::string& path) const {
 }
 
 std::optional<std::size_t> Map::point_collision(const Eigen::Vector3d& p, double radius) const {
-  const double r2 = radius * radius;
-  for (std::size_t i = 0; i < obstacles_.size(); ++i) {
-    if (squared_distance(p, obstacles_[i]) <= r2) return i;
-  }
-  return std::nullopt;
+  const Box region{p.array() - radius, p.array() + radius};
+  return query_index(region, radius * radius, [&](const Box& b) { return squared_distance(p, b); });
 }
 
 std::optional<std::size_t> Map::segment_collision(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                                   double radius) const {
-  const double r2 = radius * radius;
   const Box sweep{a.cwiseMin(b).array() - radius, a.cwiseMax(b).array() + radius};
-  for (std::size_t i = 0; i < obstacles_.size(); ++i) {
-    if (!sweep.overlaps(obstacles_[i])) continue;  // broad phase: bounding boxes apart
-    if (squared_distance(a, b, obstacles_[i]) <= r2) return i;
-  }
-  return std::nullopt;
+  return query_index(sweep, radius * radius, [&](const Box& box) { return squared_distance(a, b, box); });
 }
 
 double Map::clearance(const Eigen::Vector3d& p) const {

@@ -12,6 +12,7 @@
 /// OctoMap binary trees (`.bt`) are accepted too (REQ-WORLD-003).
 
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -87,6 +88,22 @@ class Map {
   double resolution_;
   std::vector<Box> obstacles_;
   std::optional<Query> query_;
+
+  /// Broad phase: a uniform grid of buckets over the bounds, each listing the obstacles
+  /// that overlap it, so a query visits only nearby obstacles. Answers are identical to
+  /// a scan of all obstacles (the lowest colliding index is returned).
+  struct BucketGrid {
+    Eigen::Vector3d origin;
+    double cell = 1.0;
+    Eigen::Vector3i dims{1, 1, 1};
+    std::vector<std::vector<std::uint32_t>> buckets;
+  };
+  BucketGrid index_;
+  void build_index();
+  /// Lowest index of an obstacle whose squared distance (by `dist2`) to the query is
+  /// <= r2, among obstacles in buckets overlapping `region`.
+  template <typename Dist2>
+  std::optional<std::size_t> query_index(const Box& region, double r2, const Dist2& dist2) const;
 };
 
 }  // namespace miner::world

@@ -69,38 +69,30 @@ void Map::build_index() {
     index_.dims[k] = std::max(1, static_cast<int>(std::ceil(bounds_.extent()[k] / index_.cell)));
   }
   index_.buckets.assign(static_cast<std::size_t>(index_.dims.prod()), {});
-  const auto clamp_cell = [&](double v, int k) {
-    const double c = std::floor((v - index_.origin[k]) / index_.cell);
-    return static_cast<int>(std::min<double>(index_.dims[k] - 1, std::max(0.0, c)));
-  };
   for (std::size_t i = 0; i < obstacles_.size(); ++i) {
-    const Box& b = obstacles_[i];
     Eigen::Vector3i lo, hi;
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = clamp_cell(b.min[k], k);
-      hi[k] = clamp_cell(b.max[k], k);
-    }
+    index_.span(obstacles_[i], lo, hi);
     for (int z = lo.z(); z <= hi.z(); ++z)
       for (int y = lo.y(); y <= hi.y(); ++y)
-        for (int x = lo.x(); x <= hi.x(); ++x) {
-          index_.buckets[(static_cast<std::size_t>(z) * index_.dims.y() + y) * index_.dims.x() + x].push_back(
-              static_cast<std::uint32_t>(i));
-        }
+        for (int x = lo.x(); x <= hi.x(); ++x) index_.buckets[index_.at(x, y, z)].push_back(static_cast<std::uint32_t>(i));
+  }
+}
+
+void Map::BucketGrid::span(const Box& box, Eigen::Vector3i& lo, Eigen::Vector3i& hi) const {
+  for (int k = 0; k < 3; ++k) {
+    const auto coord = [&](double v) {
+      const double c = std::floor((v - origin[k]) / cell);
+      return static_cast<int>(std::min<double>(dims[k] - 1, std::max(0.0, c)));
+    };
+    lo[k] = coord(box.min[k]);
+    hi[k] = coord(box.max[k]);
   }
 }
 
 template <typename Dist2>
 std::optional<std::size_t> Map::query_index(const Box& region, double r2, const Dist2& dist2) const {
-  // Obstacles outside the bounds still count: their buckets are the clamped border ones.
   Eigen::Vector3i lo, hi;
-  for (int k = 0; k < 3; ++k) {
-    const auto cell = [&](double v) {
-      const double c = std::floor((v - index_.origin[k]) / index_.cell);
-      return static_cast<int>(std::min<double>(index_.dims[k] - 1, std::max(0.0, c)));
-    };
-    lo[k] = cell(region.min[k]);
-    hi[k] = cell(region.max[k]);
-  }
+  index_.span(region, lo, hi);
   std::optional<std::size_t> best;
   const auto consider = [&](std::size_t i) {
     if ((!best || i < *best) && region.overlaps(obstacles_[i]) && dist2(obstacles_[i]) <= r2) best = i;
@@ -113,9 +105,7 @@ std::optional<std::size_t> Map::query_index(const Box& region, double r2, const 
   for (int z = lo.z(); z <= hi.z(); ++z)
     for (int y = lo.y(); y <= hi.y(); ++y)
       for (int x = lo.x(); x <= hi.x(); ++x)
-        for (const std::uint32_t i : index_.buckets[(static_cast<std::size_t>(z) * index_.dims.y() + y) * index_.dims.x() + x]) {
-          consider(i);
-        }
+        for (const std::uint32_t i : index_.buckets[index_.at(x, y, z)]) consider(i);
   return best;
 }
 

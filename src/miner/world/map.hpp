@@ -97,6 +97,12 @@ class Map {
     double cell = 1.0;
     Eigen::Vector3i dims{1, 1, 1};
     std::vector<std::vector<std::uint32_t>> buckets;
+    /// Bucket coordinates covering `box` along each axis, clamped to the grid (obstacles
+    /// and queries outside the bounds land in the border buckets).
+    void span(const Box& box, Eigen::Vector3i& lo, Eigen::Vector3i& hi) const;
+    std::size_t at(int x, int y, int z) const {
+      return (static_cast<std::size_t>(z) * dims.y() + y) * dims.x() + x;
+    }
   };
   BucketGrid index_;
   void build_index();

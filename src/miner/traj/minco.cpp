@@ -3,7 +3,6 @@
 #include <cmath>
 #include <sstream>
 
-#include <Eigen/Cholesky>
 #include <Eigen/LU>
 
 #include "miner/core/error.hpp"
@@ -52,10 +51,6 @@ struct UnitHermite {
 
 template <int S>
 using SegmentMatrix = Eigen::Matrix<double, 2 * S, 2 * S>;
-template <int S>
-using Block = Eigen::Matrix<double, S - 1, S - 1>;
-template <int S>
-using Rhs = Eigen::Matrix<double, S - 1, 3>;
 
 /// Q(T)_{ab} = K_ab T^{1 - 2S + k(a) + k(b)}, k(r) = r mod S (derivative order of row r),
 /// i.e. Q = T^{1-2S} (d d^T) o K with d_r = T^{k(r)}.

@@ -1,5 +1,6 @@
 // `miner bench backend` (REQ-TRAJ-009).
 #include <ostream>
+#include <sstream>
 
 #include <CLI/CLI.hpp>
 
@@ -12,8 +13,7 @@ namespace miner::cli {
 namespace {
 struct BackendOptions {
   bench::BackendBenchOptions bench;
-  bool json = false;
-  std::string out;
+  OutputOptions output;
 };
 }  // namespace
 
@@ -30,17 +30,12 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   b->add_option("--budget", o->bench.budget_s, "seconds per (method, order, M)")->capture_default_str();
   b->add_option("--samples", o->bench.samples, "timed batches (median reported)")->capture_default_str();
   b->add_option("--seed", o->bench.seed, "seed of the waypoints")->capture_default_str();
-  b->add_flag("--json", o->json, "print the records as JSON");
-  b->add_option("--out", o->out, "also write the JSON records to this file");
+  add_output_options(b, o->output);
   b->callback([o, &out] {
     const auto records = bench::run_backend_bench(o->bench);
-    const Json doc = bench::to_json(records);
-    if (!o->out.empty()) write_file_atomic(o->out, dump_json(doc));
-    if (o->json) {
-      out << dump_json(doc);
-    } else {
-      bench::print_table(records, out);
-    }
+    std::ostringstream table;
+    bench::print_table(records, table);
+    emit(o->output, bench::to_json(records), table.str(), out);
   });
 }
 

@@ -9,6 +9,20 @@
 
 namespace miner::cli {
 
+void add_output_options(CLI::App* cmd, OutputOptions& o) {
+  cmd->add_flag("--json", o.json, "print the result as JSON");
+  cmd->add_option("--out", o.out, "also write the JSON result to this file");
+}
+
+void emit(const OutputOptions& o, const Json& doc, const std::string& human, std::ostream& out) {
+  if (!o.out.empty()) write_file_atomic(o.out, dump_json(doc));
+  if (o.json) {
+    out << dump_json(doc);
+  } else {
+    out << human;
+  }
+}
+
 int run_cli(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
   CLI::App app{"miner — MINER-RRT* quadrotor planning and flight stack", "miner"};
   app.require_subcommand(1);

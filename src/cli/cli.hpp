@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "miner/core/json_io.hpp"
+
 namespace CLI {
 class App;
 }
@@ -16,6 +18,16 @@ namespace miner::cli {
 /// Runs `miner <args...>` (args excludes the program name); returns the exit code
 /// (miner::ExitCode). Never throws: every error becomes "miner: error: ..." on `err`.
 int run_cli(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+
+/// Options shared by commands that produce a result: --json prints it as JSON instead
+/// of the human text, --out also writes the JSON to a file (atomically).
+struct OutputOptions {
+  bool json = false;
+  std::string out;
+};
+void add_output_options(CLI::App* cmd, OutputOptions& o);
+/// Writes `doc` to o.out if set, then prints `doc` (with --json) or `human`.
+void emit(const OutputOptions& o, const Json& doc, const std::string& human, std::ostream& out);
 
 /// Registers `miner map ...` and `miner astar` (map_commands.cpp). The callbacks
 /// write to `out`; errors propagate as miner::Error.

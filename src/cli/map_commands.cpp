@@ -30,21 +30,6 @@ Eigen::Vector3d to_vec3(const std::vector<double>& v, const std::string& field) 
   return p;
 }
 
-/// Options shared by commands that write a result: --json to stdout, --out to a file.
-struct OutputOptions {
-  bool json = false;
-  std::string out;
-};
-
-void emit(const OutputOptions& o, const Json& doc, const std::string& human, std::ostream& out) {
-  if (!o.out.empty()) write_file_atomic(o.out, dump_json(doc));
-  if (o.json) {
-    out << dump_json(doc);
-  } else {
-    out << human;
-  }
-}
-
 struct GenOptions {
   std::string preset = "sim";
   std::uint64_t seed = 1;
@@ -170,11 +155,6 @@ const CLI::Validator kFinite(
       return {};
     },
     "FINITE");
-
-void add_output_options(CLI::App* cmd, OutputOptions& o) {
-  cmd->add_flag("--json", o.json, "print the result as JSON");
-  cmd->add_option("--out", o.out, "also write the JSON result to this file");
-}
 
 }  // namespace
 

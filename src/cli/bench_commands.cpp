@@ -4,7 +4,11 @@
 
 #include <CLI/CLI.hpp>
 
+#include <fstream>
+#include <iostream>
+
 #include "bench/backend_bench.hpp"
+#include "bench/frontend_bench.hpp"
 #include "cli/cli.hpp"
 #include "miner/core/json_io.hpp"
 
@@ -15,6 +19,32 @@ struct BackendOptions {
   bench::BackendBenchOptions bench;
   OutputOptions output;
 };
+
+struct FrontendOptions {
+  QueryOptions query;
+  bench::FrontendBenchOptions bench;
+  std::vector<int> region_dims = {32, 32, 32};
+  std::string ompl_log;
+  bool quiet = false;
+  OutputOptions output;
+};
+
+void run_frontend(const FrontendOptions& o, std::ostream& out) {
+  const ResolvedQuery q = resolve_query(o.query);
+  bench::FrontendBenchOptions options = o.bench;
+  options.region_dims = Eigen::Vector3i(o.region_dims[0], o.region_dims[1], o.region_dims[2]);
+  // Progress goes to stderr so --json output stays clean.
+  const auto result = bench::run_frontend_bench(o.query.map, q.start, q.goal, q.radius, options,
+                                                o.quiet ? nullptr : &std::cerr);
+  if (!o.ompl_log.empty()) {
+    std::ostringstream log;
+    bench::write_ompl_log(result, log);
+    write_file_atomic(o.ompl_log, log.str());
+  }
+  std::ostringstream table;
+  bench::print_table(result, table);
+  emit(o.output, bench::to_json(result), table.str(), out);
+}
 }  // namespace
 
 void add_bench_commands(CLI::App& app, std::ostream& out) {
@@ -37,6 +67,38 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
     bench::print_table(records, table);
     emit(o->output, bench::to_json(records), table.str(), out);
   });
+
+  auto f = std::make_shared<FrontendOptions>();
+  CLI::App* fc = bench_cmd->add_subcommand(
+      "frontend", "Monte Carlo front-end campaign like the paper's Table I, with OMPL's planners beside ours");
+  add_query_options(fc, f->query);
+  fc->add_option("--planners", f->bench.planners,
+                 "planners (default: rrtstar,informed,guided,miner and every ompl:* planner)")
+      ->delimiter(',');
+  fc->add_option("--runs", f->bench.runs, "runs per planner")->check(CLI::PositiveNumber)->capture_default_str();
+  fc->add_option("--seed", f->bench.seed, "master seed (run k uses stream k)")->capture_default_str();
+  fc->add_option("--target-factor", f->bench.target_factor, "target cost = this x the A* reference cost")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  fc->add_option("--max-iterations", f->bench.max_iterations, "iteration budget per run")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  fc->add_option("--time-limit", f->bench.time_limit_s, "wall-clock cap per run in s")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  fc->add_option("--step", f->bench.planner_options.steer_step, "steering step eta in m (default 0.1 x diagonal)")
+      ->check(CLI::PositiveNumber);
+  fc->add_option("--goal-radius", f->bench.planner_options.goal_radius, "goal radius in m (default 2 x resolution)")
+      ->check(CLI::PositiveNumber);
+  fc->add_option("--region", f->bench.region_file, "miner's region file (default: the A*-dilated region)");
+  fc->add_option("--region-dims", f->region_dims, "A*-dilated region grid")->expected(3)->check(CLI::PositiveNumber);
+  fc->add_option("--throughput-iterations", f->bench.throughput_iterations,
+                 "iterations of the rrtstar vs ompl:RRTstar throughput check (0: skip)")
+      ->capture_default_str();
+  fc->add_option("--ompl-log", f->ompl_log, "also write OMPL's benchmark log format to this file");
+  fc->add_flag("--quiet", f->quiet, "no progress lines on stderr");
+  add_output_options(fc, f->output);
+  fc->callback([f, &out] { run_frontend(*f, out); });
 }
 
 }  // namespace miner::cli

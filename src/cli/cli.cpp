@@ -1,5 +1,6 @@
 #include "cli/cli.hpp"
 
+#include <cmath>
 #include <iostream>
 #include <new>
 
@@ -8,6 +9,52 @@
 #include "miner/core/error.hpp"
 
 namespace miner::cli {
+
+const CLI::Validator kFiniteNonNegative(
+    [](std::string& text) -> std::string {
+      double v = 0.0;
+      if (!CLI::detail::lexical_cast(text, v) || !std::isfinite(v) || v < 0.0) {
+        return "must be a finite number >= 0, got " + text;
+      }
+      return {};
+    },
+    "NONNEGATIVE");
+
+const CLI::Validator kFinite(
+    [](std::string& text) -> std::string {
+      double v = 0.0;
+      if (!CLI::detail::lexical_cast(text, v) || !std::isfinite(v)) {
+        return "must be a finite number, got " + text;
+      }
+      return {};
+    },
+    "FINITE");
+
+Json vec_json(const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); }
+
+void add_query_options(CLI::App* cmd, QueryOptions& q) {
+  cmd->add_option("--map", q.map, "map file (.json or .bt)")->required();
+  cmd->add_option("--start", q.start, "start x y z in m (default: the map's query)")->expected(3)->check(kFinite);
+  cmd->add_option("--goal", q.goal, "goal x y z in m (default: the map's query)")->expected(3)->check(kFinite);
+  cmd->add_option("--radius", q.radius, "robot radius in m (default: the map's query radius or 0)")
+      ->check(kFiniteNonNegative);
+}
+
+ResolvedQuery resolve_query(const QueryOptions& q) {
+  world::Map map = world::Map::load(q.map);
+  if ((q.start.empty() || q.goal.empty()) && !map.query()) {
+    throw Error(q.map + ": has no \"query\"; give --start x y z and --goal x y z");
+  }
+  const auto vec = [](const std::vector<double>& v, const char* field) {
+    Eigen::Vector3d p(v.at(0), v.at(1), v.at(2));
+    require_finite(p, field);
+    return p;
+  };
+  const Eigen::Vector3d start = q.start.empty() ? map.query()->start : vec(q.start, "--start");
+  const Eigen::Vector3d goal = q.goal.empty() ? map.query()->goal : vec(q.goal, "--goal");
+  const double radius = q.radius >= 0.0 ? q.radius : (map.query() ? map.query()->robot_radius : 0.0);
+  return {std::move(map), start, goal, radius};
+}
 
 void add_output_options(CLI::App* cmd, OutputOptions& o) {
   cmd->add_flag("--json", o.json, "print the result as JSON");
@@ -30,6 +77,7 @@ int run_cli(const std::vector<std::string>& args, std::ostream& out, std::ostrea
   add_map_commands(app, out);
   add_traj_commands(app, out);
   add_bench_commands(app, out);
+  add_plan_commands(app, out);
 
   // CLI11 parses in reverse order of the vector it is given.
   std::vector<std::string> reversed(args.rbegin(), args.rend());

@@ -7,10 +7,14 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "miner/core/json_io.hpp"
+#include "miner/world/map.hpp"
 
 namespace CLI {
 class App;
+class Validator;
 }
 
 namespace miner::cli {
@@ -29,6 +33,31 @@ void add_output_options(CLI::App* cmd, OutputOptions& o);
 /// Writes `doc` to o.out if set, then prints `doc` (with --json) or `human`.
 void emit(const OutputOptions& o, const Json& doc, const std::string& human, std::ostream& out);
 
+/// CLI11 validators: a finite number; a finite number >= 0.
+extern const CLI::Validator kFinite;
+extern const CLI::Validator kFiniteNonNegative;
+
+/// [x, y, z] as a JSON array.
+Json vec_json(const Eigen::Vector3d& v);
+
+/// --map, --start x y z, --goal x y z, --radius: a planning query, where start, goal and
+/// radius default to the map's stored "query" (REQ-CLI-004).
+struct QueryOptions {
+  std::string map;
+  std::vector<double> start, goal;
+  double radius = -1.0;
+};
+void add_query_options(CLI::App* cmd, QueryOptions& q);
+struct ResolvedQuery {
+  world::Map map;
+  Eigen::Vector3d start;
+  Eigen::Vector3d goal;
+  double radius = 0.0;
+};
+/// Loads the map and fills start/goal/radius; throws miner::Error if the map has no
+/// query and --start/--goal are missing.
+ResolvedQuery resolve_query(const QueryOptions& q);
+
 /// Registers `miner map ...` and `miner astar` (map_commands.cpp). The callbacks
 /// write to `out`; errors propagate as miner::Error.
 void add_map_commands(CLI::App& app, std::ostream& out);
@@ -36,5 +65,7 @@ void add_map_commands(CLI::App& app, std::ostream& out);
 void add_traj_commands(CLI::App& app, std::ostream& out);
 /// Registers `miner bench ...` (bench_commands.cpp).
 void add_bench_commands(CLI::App& app, std::ostream& out);
+/// Registers `miner plan` and `miner region ...` (plan_commands.cpp).
+void add_plan_commands(CLI::App& app, std::ostream& out);
 
 }  // namespace miner::cli

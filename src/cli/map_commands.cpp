@@ -22,14 +22,6 @@ namespace {
 
 using world::Map;
 
-Json vec_json(const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); }
-
-Eigen::Vector3d to_vec3(const std::vector<double>& v, const std::string& field) {
-  Eigen::Vector3d p(v.at(0), v.at(1), v.at(2));
-  require_finite(p, field);
-  return p;
-}
-
 struct GenOptions {
   std::string preset = "sim";
   std::uint64_t seed = 1;
@@ -97,26 +89,22 @@ void run_convert(const ConvertOptions& o, std::ostream& out) {
 }
 
 struct AstarOptions {
-  std::string map;
-  std::vector<double> start, goal;
-  double radius = -1.0;
+  QueryOptions query;
   OutputOptions output;
 };
 
 void run_astar(const AstarOptions& o, std::ostream& out) {
-  const Map map = Map::load(o.map);
-  if ((o.start.empty() || o.goal.empty()) && !map.query()) {
-    throw Error(o.map + ": has no \"query\"; give --start x y z and --goal x y z");
-  }
-  const Eigen::Vector3d start = o.start.empty() ? map.query()->start : to_vec3(o.start, "--start");
-  const Eigen::Vector3d goal = o.goal.empty() ? map.query()->goal : to_vec3(o.goal, "--goal");
-  const double radius = o.radius >= 0.0 ? o.radius : (map.query() ? map.query()->robot_radius : 0.0);
+  const ResolvedQuery q = resolve_query(o.query);
+  const Map& map = q.map;
+  const Eigen::Vector3d& start = q.start;
+  const Eigen::Vector3d& goal = q.goal;
+  const double radius = q.radius;
   const world::VoxelGrid grid(map, radius);
   const world::GridPath path = world::astar(map, grid, start, goal);
 
   Json points = Json::array();
   for (const auto& p : path.points) points.push_back(vec_json(p));
-  const Json doc = {{"map", o.map},
+  const Json doc = {{"map", o.query.map},
                     {"start", vec_json(start)},
                     {"goal", vec_json(goal)},
                     {"robot_radius", radius},
@@ -134,27 +122,6 @@ void run_astar(const AstarOptions& o, std::ostream& out) {
     << " cells expanded\n";
   emit(o.output, doc, h.str(), out);
 }
-
-/// A CLI11 validator: the value parses as a finite number >= 0.
-const CLI::Validator kFiniteNonNegative(
-    [](std::string& text) -> std::string {
-      double v = 0.0;
-      if (!CLI::detail::lexical_cast(text, v) || !std::isfinite(v) || v < 0.0) {
-        return "must be a finite number >= 0, got " + text;
-      }
-      return {};
-    },
-    "NONNEGATIVE");
-
-const CLI::Validator kFinite(
-    [](std::string& text) -> std::string {
-      double v = 0.0;
-      if (!CLI::detail::lexical_cast(text, v) || !std::isfinite(v)) {
-        return "must be a finite number, got " + text;
-      }
-      return {};
-    },
-    "FINITE");
 
 }  // namespace
 
@@ -188,11 +155,7 @@ void add_map_commands(CLI::App& app, std::ostream& out) {
 
   auto astar = std::make_shared<AstarOptions>();
   CLI::App* a = app.add_subcommand("astar", "shortest 26-connected grid path (A*) between two points");
-  a->add_option("--map", astar->map, "map file (.json or .bt)")->required();
-  a->add_option("--start", astar->start, "start x y z in m (default: the map's query)")->expected(3)->check(kFinite);
-  a->add_option("--goal", astar->goal, "goal x y z in m (default: the map's query)")->expected(3)->check(kFinite);
-  a->add_option("--radius", astar->radius, "robot radius in m (default: the map's query radius or 0)")
-      ->check(kFiniteNonNegative);
+  add_query_options(a, astar->query);
   add_output_options(a, astar->output);
   a->callback([astar, &out] { run_astar(*astar, out); });
 }

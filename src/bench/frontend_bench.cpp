@@ -1,0 +1,396 @@
+#include "bench/frontend_bench.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <ctime>
+#include <iomanip>
+#include <limits>
+#include <ostream>
+#include <sstream>
+#include <unistd.h>
+
+#include "bench/ompl_planners.hpp"
+#include "miner/core/error.hpp"
+#include "miner/plan/heuristic_region.hpp"
+#include "miner/plan/reference.hpp"
+#include "miner/world/map.hpp"
+
+namespace miner::bench {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+bool is_ompl(const std::string& name) { return name.rfind("ompl:", 0) == 0; }
+
+/// NaN marks an unknown value: a statistic over a list with one is unknown too.
+bool any_unknown(const std::vector<double>& v) {
+  return std::any_of(v.begin(), v.end(), [](double x) { return std::isnan(x); });
+}
+
+double median(std::vector<double> v) {
+  if (v.empty() || any_unknown(v)) return NAN;
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  // Lower median for even n keeps "+inf in the upper half" well defined.
+  const double m = n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+  return std::isfinite(m) ? m : NAN;
+}
+
+double mean(const std::vector<double>& v) {
+  if (v.empty() || any_unknown(v)) return NAN;
+  double s = 0.0;
+  for (double x : v) s += x;
+  return s / static_cast<double>(v.size());
+}
+
+nlohmann::json num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+}  // namespace
+
+std::vector<std::string> default_frontend_planners() {
+  std::vector<std::string> names;
+  for (plan::PlannerKind k : plan::all_planners()) names.push_back(plan::planner_name(k));
+  for (const auto& n : ompl_planner_names()) names.push_back(n);
+  return names;
+}
+
+PlannerSummary summarise(const std::string& planner, const std::vector<RunRecord>& runs) {
+  PlannerSummary s;
+  s.planner = planner;
+  std::vector<double> fi, fn, fc, ft, ti, tn, tt, ti_all, tn_all, tt_all, final_cost;
+  const double inf = std::numeric_limits<double>::infinity();
+  int solved = 0, reached = 0;
+  for (const RunRecord& r : runs) {
+    if (r.planner != planner) continue;
+    ++s.runs;
+    const plan::PlanResult& res = r.result;
+    if (res.solved) {
+      ++solved;
+      final_cost.push_back(res.cost);
+    }
+    const auto count = [](std::size_t c) {
+      return c == kUnknownCount ? std::numeric_limits<double>::quiet_NaN() : static_cast<double>(c);
+    };
+    if (res.first) {
+      fi.push_back(count(res.first->iteration));
+      fn.push_back(count(res.first->nodes));
+      fc.push_back(res.first->cost);
+      ft.push_back(res.first->time_ms);
+    }
+    if (res.target) {
+      ++reached;
+      ti.push_back(count(res.target->iteration));
+      tn.push_back(count(res.target->nodes));
+      tt.push_back(res.target->time_ms);
+    }
+    ti_all.push_back(res.target ? count(res.target->iteration) : inf);
+    tn_all.push_back(res.target ? count(res.target->nodes) : inf);
+    tt_all.push_back(res.target ? res.target->time_ms : inf);
+  }
+  if (s.runs == 0) return s;
+  s.success_rate = static_cast<double>(solved) / s.runs;
+  s.target_rate = static_cast<double>(reached) / s.runs;
+  s.first_iterations = median(fi);
+  s.first_nodes = median(fn);
+  s.first_cost = median(fc);
+  s.first_time_ms = median(ft);
+  s.first_iterations_mean = mean(fi);
+  s.first_nodes_mean = mean(fn);
+  s.first_cost_mean = mean(fc);
+  s.first_time_ms_mean = mean(ft);
+  // Fewer than half reached: the median is +inf, reported as null.
+  if (2 * reached >= s.runs) {
+    s.target_iterations = median(ti_all);
+    s.target_nodes = median(tn_all);
+    s.target_time_ms = median(tt_all);
+  }
+  s.target_iterations_mean = mean(ti);
+  s.target_nodes_mean = mean(tn);
+  s.target_time_ms_mean = mean(tt);
+  s.final_cost = median(final_cost);
+  return s;
+}
+
+FrontendBenchResult run_frontend_bench(const std::string& map_path, const Eigen::Vector3d& start,
+                                       const Eigen::Vector3d& goal, double robot_radius,
+                                       const FrontendBenchOptions& options, std::ostream* progress) {
+  if (options.runs < 1) throw Error("--runs: must be >= 1, got " + std::to_string(options.runs));
+  if (!(options.target_factor > 0.0)) throw Error("--target-factor: must be > 0");
+  const Clock::time_point campaign_start = Clock::now();
+  const world::Map map = world::Map::load(map_path);
+  const plan::PlanningProblem problem = plan::PlanningProblem::make(map, start, goal, robot_radius);
+  const plan::ReferencePath reference = plan::astar_reference(problem);
+
+  FrontendBenchResult out;
+  out.options = options;
+  if (out.options.planners.empty()) out.options.planners = default_frontend_planners();
+  out.map = map_path;
+  out.start = start;
+  out.goal = goal;
+  out.robot_radius = robot_radius;
+  out.reference_cost = reference.cost;
+  out.target_cost = options.target_factor * reference.cost;
+  out.lower_bound = plan::straight_line_bound(problem);
+
+  plan::PlannerOptions base = options.planner_options;
+  base.max_iterations = options.max_iterations;
+  base.target_cost = out.target_cost;
+  base.stop_at_first = false;
+  base.record_tree = false;
+  // Resolve the defaults once so OMPL gets the same eta and goal radius.
+  const world::Box& b = map.bounds();
+  if (!(base.steer_step > 0.0)) base.steer_step = 0.1 * (b.max - b.min).norm();
+  if (!(base.goal_radius > 0.0)) base.goal_radius = 2.0 * map.resolution();
+  out.steer_step = base.steer_step;
+  out.goal_radius = base.goal_radius;
+
+  const Clock::time_point region_start = Clock::now();
+  const plan::HeuristicRegion region =
+      options.region_file.empty()
+          ? plan::HeuristicRegion::from_path(b, options.region_dims, reference.points, options.region_dilation,
+                                             "astar-dilated")
+          : plan::HeuristicRegion::load(options.region_file);
+  out.region_ms = std::chrono::duration<double, std::milli>(Clock::now() - region_start).count();
+  region.require_matches(map, "bench frontend");
+  out.region_source = options.region_file.empty() ? region.source() : options.region_file;
+  out.region_cells = region.cells().size();
+
+  init_ompl(options.seed);
+  const auto ompl_options = [&](const std::string& name) {
+    OmplRunOptions o;
+    o.planner = name;
+    o.time_limit_s = options.time_limit_s;
+    if (name == "ompl:RRTstar" || name == "ompl:InformedRRTstar") o.max_iterations = options.max_iterations;
+    o.steer_step = base.steer_step;
+    o.goal_radius = base.goal_radius;
+    o.goal_bias = base.goal_bias;
+    o.rewire_factor = base.rewire_factor;
+    o.target_cost = out.target_cost;
+    return o;
+  };
+
+  for (const std::string& name : out.options.planners) {
+    const bool ompl = is_ompl(name);
+    if (ompl) {
+      const auto names = ompl_planner_names();
+      if (std::find(names.begin(), names.end(), name) == names.end()) {
+        throw Error("unknown planner \"" + name + "\" (OMPL planners: ompl:RRTstar, ompl:InformedRRTstar, "
+                    "ompl:BITstar, ompl:ABITstar, ompl:AITstar, ompl:RRTConnect)");
+      }
+    }
+    const plan::PlannerKind kind = ompl ? plan::PlannerKind::kRrtStar : plan::planner_from_name(name);
+    for (int run = 0; run < options.runs; ++run) {
+      RunRecord record;
+      record.planner = name;
+      record.run = run;
+      if (ompl) {
+        record.result = run_ompl(problem, ompl_options(name));
+      } else {
+        plan::PlannerOptions po = base;
+        po.planner = kind;
+        po.seed = options.seed;
+        po.stream = static_cast<std::uint64_t>(run);  // common random numbers across planners
+        record.result = plan::plan(problem, po, kind == plan::PlannerKind::kMiner ? &region : nullptr);
+      }
+      out.runs.push_back(std::move(record));
+    }
+    out.summaries.push_back(summarise(name, out.runs));
+    if (progress) {
+      const PlannerSummary& s = out.summaries.back();
+      *progress << "  " << std::left << std::setw(22) << name << std::right << " success " << std::setw(5)
+                << 100.0 * s.success_rate << " %, target " << std::setw(5) << 100.0 * s.target_rate
+                << " %, median time to target " << s.target_time_ms << " ms\n";
+    }
+  }
+
+  if (options.throughput_iterations > 0) {
+    std::vector<double> mine, theirs;
+    const bool with_ompl = ompl_available();
+    for (int run = 0; run < std::min(options.runs, 5); ++run) {
+      plan::PlannerOptions po = base;
+      po.planner = plan::PlannerKind::kRrtStar;
+      po.target_cost.reset();
+      po.max_iterations = options.throughput_iterations;
+      po.seed = options.seed;
+      po.stream = static_cast<std::uint64_t>(run);
+      const plan::PlanResult r = plan::plan(problem, po);
+      mine.push_back(static_cast<double>(r.iterations) / (r.time_ms / 1000.0));
+      if (with_ompl) {
+        OmplRunOptions oo = ompl_options("ompl:RRTstar");
+        oo.target_cost.reset();
+        oo.max_iterations = options.throughput_iterations;
+        const plan::PlanResult t = run_ompl(problem, oo);
+        theirs.push_back(static_cast<double>(t.iterations) / (t.time_ms / 1000.0));
+      }
+    }
+    out.rrtstar_iterations_per_s = median(mine);
+    out.ompl_rrtstar_iterations_per_s = median(theirs);
+  }
+  out.total_s = std::chrono::duration<double>(Clock::now() - campaign_start).count();
+  return out;
+}
+
+nlohmann::json to_json(const FrontendBenchResult& r) {
+  nlohmann::json planners = nlohmann::json::array();
+  for (const PlannerSummary& s : r.summaries) {
+    planners.push_back({{"planner", s.planner},
+                        {"runs", s.runs},
+                        {"success_rate", s.success_rate},
+                        {"target_rate", s.target_rate},
+                        {"first_iterations", num(s.first_iterations)},
+                        {"first_nodes", num(s.first_nodes)},
+                        {"first_cost", num(s.first_cost)},
+                        {"first_time_ms", num(s.first_time_ms)},
+                        {"first_iterations_mean", num(s.first_iterations_mean)},
+                        {"first_nodes_mean", num(s.first_nodes_mean)},
+                        {"first_cost_mean", num(s.first_cost_mean)},
+                        {"first_time_ms_mean", num(s.first_time_ms_mean)},
+                        {"target_iterations", num(s.target_iterations)},
+                        {"target_nodes", num(s.target_nodes)},
+                        {"target_time_ms", num(s.target_time_ms)},
+                        {"target_iterations_mean", num(s.target_iterations_mean)},
+                        {"target_nodes_mean", num(s.target_nodes_mean)},
+                        {"target_time_ms_mean", num(s.target_time_ms_mean)},
+                        {"final_cost", num(s.final_cost)}});
+  }
+  const auto v3 = [](const Eigen::Vector3d& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); };
+  return {{"map", r.map},
+          {"start", v3(r.start)},
+          {"goal", v3(r.goal)},
+          {"robot_radius", r.robot_radius},
+          {"runs", r.options.runs},
+          {"seed", r.options.seed},
+          {"reference_cost", r.reference_cost},
+          {"target_factor", r.options.target_factor},
+          {"target_cost", r.target_cost},
+          {"lower_bound", r.lower_bound},
+          {"steer_step", r.steer_step},
+          {"goal_radius", r.goal_radius},
+          {"max_iterations", r.options.max_iterations},
+          {"time_limit_s", r.options.time_limit_s},
+          {"region", {{"source", r.region_source}, {"cells", r.region_cells}, {"build_ms", r.region_ms}}},
+          {"throughput",
+           {{"iterations", r.options.throughput_iterations},
+            {"rrtstar_iterations_per_s", num(r.rrtstar_iterations_per_s)},
+            {"ompl_rrtstar_iterations_per_s", num(r.ompl_rrtstar_iterations_per_s)}}},
+          {"total_s", r.total_s},
+          {"planners", planners}};
+}
+
+void print_table(const FrontendBenchResult& r, std::ostream& out) {
+  out << "map " << r.map << ", " << r.options.runs << " runs per planner, seed " << r.options.seed << "\n"
+      << std::fixed << std::setprecision(2) << "A* reference cost " << r.reference_cost << " m, target "
+      << r.target_cost << " m (" << r.options.target_factor << " x), straight line " << r.lower_bound
+      << " m; eta " << r.steer_step << " m, goal radius " << r.goal_radius << " m\n"
+      << "miner region: " << r.region_source << " (" << r.region_cells << " cells, built in " << r.region_ms
+      << " ms, not counted)\n\n";
+  out << std::left << std::setw(22) << "planner" << std::right << std::setw(8) << "success" << std::setw(10)
+      << "init it" << std::setw(10) << "init nod" << std::setw(10) << "init cost" << std::setw(10) << "init ms"
+      << std::setw(8) << "target" << std::setw(10) << "opt it" << std::setw(10) << "opt nod" << std::setw(10)
+      << "opt ms" << "\n";
+  const auto cell = [&](double v, int prec) {
+    std::ostringstream s;
+    if (std::isfinite(v)) s << std::fixed << std::setprecision(prec) << v;
+    else s << "-";
+    return s.str();
+  };
+  for (const PlannerSummary& s : r.summaries) {
+    out << std::left << std::setw(22) << s.planner << std::right << std::setw(7) << cell(100 * s.success_rate, 0)
+        << "%" << std::setw(10) << cell(s.first_iterations, 0) << std::setw(10) << cell(s.first_nodes, 0)
+        << std::setw(10) << cell(s.first_cost, 1) << std::setw(10) << cell(s.first_time_ms, 2) << std::setw(7)
+        << cell(100 * s.target_rate, 0) << "%" << std::setw(10) << cell(s.target_iterations, 0) << std::setw(10)
+        << cell(s.target_nodes, 0) << std::setw(10) << cell(s.target_time_ms, 2) << "\n";
+  }
+  out << "(medians; opt = until cost <= target, '-' where fewer than half the runs got there)\n";
+  if (std::isfinite(r.rrtstar_iterations_per_s)) {
+    out << "throughput over " << r.options.throughput_iterations << " iterations: rrtstar "
+        << cell(r.rrtstar_iterations_per_s, 0) << " it/s, ompl:RRTstar " << cell(r.ompl_rrtstar_iterations_per_s, 0)
+        << " it/s\n";
+  }
+}
+
+void write_ompl_log(const FrontendBenchResult& r, std::ostream& out) {
+  char host[256] = "unknown";
+  gethostname(host, sizeof host - 1);
+  std::string experiment = r.map;
+  for (char& c : experiment) {
+    if (c == ' ' || c == '/' ) c = '_';
+  }
+  const std::time_t now = std::time(nullptr);
+  char date[64];
+  std::strftime(date, sizeof date, "%Y-%m-%d %H:%M:%S", std::gmtime(&now));
+  out << std::setprecision(17);
+  out << "MINER version 0.1.0\n"
+      << "Experiment frontend_" << experiment << "\n"
+      << "3 experiment properties\n"
+      << "target_cost REAL = " << r.target_cost << "\n"
+      << "reference_cost REAL = " << r.reference_cost << "\n"
+      << "goal_radius REAL = " << r.goal_radius << "\n"
+      << "Running on " << host << "\n"
+      << "Starting at " << date << "\n"
+      << "<<<|\n"
+      << "map " << r.map << "; start " << r.start.transpose() << "; goal " << r.goal.transpose()
+      << "; robot radius " << r.robot_radius << "; steering step " << r.steer_step << "; target factor "
+      << r.options.target_factor << "\n"
+      << "|>>>\n"
+      << r.options.seed << " is the random seed\n"
+      << r.options.time_limit_s << " seconds per run\n"
+      << "0 MB per run\n"
+      << r.options.runs << " runs per planner\n"
+      << r.total_s << " seconds spent to collect the data\n"
+      << "0 enum types\n"
+      << r.summaries.size() << " planners\n";
+  const auto opt = [](bool has, double v) {
+    std::ostringstream s;
+    s << std::setprecision(17);
+    if (has && std::isfinite(v)) s << v;
+    return s.str();
+  };
+  for (const PlannerSummary& s : r.summaries) {
+    out << s.planner << "\n"
+        << "0 common properties\n"
+        << "12 properties for each run\n"
+        << "time REAL\n"
+        << "solved BOOLEAN\n"
+        << "best cost REAL\n"
+        << "iterations INTEGER\n"
+        << "graph states INTEGER\n"
+        << "first solution time REAL\n"
+        << "first solution cost REAL\n"
+        << "first solution iterations INTEGER\n"
+        << "first solution nodes INTEGER\n"
+        << "target time REAL\n"
+        << "target iterations INTEGER\n"
+        << "target nodes INTEGER\n";
+    std::vector<const RunRecord*> mine;
+    for (const RunRecord& run : r.runs) {
+      if (run.planner == s.planner) mine.push_back(&run);
+    }
+    out << mine.size() << " runs\n";
+    for (const RunRecord* run : mine) {
+      const plan::PlanResult& p = run->result;
+      const bool f = p.first.has_value(), t = p.target.has_value();
+      out << opt(true, p.time_ms / 1000.0) << "; " << (p.solved ? 1 : 0) << "; " << opt(p.solved, p.cost) << "; "
+          << p.iterations << "; " << p.nodes + 1 << "; " << opt(f, f ? p.first->time_ms / 1000.0 : 0) << "; "
+          << opt(f, f ? p.first->cost : 0) << "; " << (f ? std::to_string(p.first->iteration) : "") << "; "
+          << (f ? std::to_string(p.first->nodes) : "") << "; " << opt(t, t ? p.target->time_ms / 1000.0 : 0)
+          << "; " << (t ? std::to_string(p.target->iteration) : "") << "; "
+          << (t ? std::to_string(p.target->nodes) : "") << "; \n";
+    }
+    out << "2 progress properties for each run\n"
+        << "time REAL\n"
+        << "best cost REAL\n"
+        << mine.size() << " runs\n";
+    for (const RunRecord* run : mine) {
+      for (const plan::StageRecord& imp : run->result.improvements) {
+        out << opt(true, imp.time_ms / 1000.0) << "," << opt(true, imp.cost) << ",;";
+      }
+      out << "\n";
+    }
+    out << ".\n";
+  }
+}
+
+}  // namespace miner::bench

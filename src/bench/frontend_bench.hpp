@@ -1,0 +1,104 @@
+#pragma once
+/// \file
+/// `miner bench frontend` (REQ-PLAN-010, REQ-PLAN-011): a Monte Carlo campaign like the
+/// paper's Table I on one map and query. Every planner (the project's four and OMPL's)
+/// runs `runs` times with the same collision checker, goal region, steering step and
+/// target cost; per planner the initial stage (iterations, nodes, cost, time to the
+/// first solution) and the optimal stage (iterations, nodes, time until the cost is
+/// <= target = target_factor x the A* reference cost) are summarised, and the runs can
+/// be written in OMPL's benchmark log format. Benchmarks read the clock; tests never
+/// assert on it.
+
+#include <cstdint>
+#include <iosfwd>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+
+#include "miner/plan/rrt_star.hpp"
+
+namespace miner::bench {
+
+struct FrontendBenchOptions {
+  std::vector<std::string> planners;  ///< empty: the project's four + every OMPL planner
+  int runs = 50;
+  std::uint64_t seed = 1;
+  double target_factor = 1.0;   ///< target cost = factor x A* reference cost
+  std::size_t max_iterations = 200000;  ///< the project's planners (and OMPL's RRT*s)
+  double time_limit_s = 10.0;   ///< per run, every planner (wall clock, benchmark only)
+  plan::PlannerOptions planner_options;  ///< steer step, goal radius, mu_1, mu_2, ...
+  Eigen::Vector3i region_dims{32, 32, 32};
+  int region_dilation = 1;
+  std::string region_file;      ///< miner: this region instead of the A*-dilated one
+  /// Throughput check: the project's RRT* and OMPL's RRTstar both run this many
+  /// iterations with no target, and iterations per second are compared. 0: skip.
+  std::size_t throughput_iterations = 20000;
+};
+
+/// One run of one planner.
+struct RunRecord {
+  std::string planner;
+  int run = 0;
+  plan::PlanResult result;
+};
+
+struct PlannerSummary {
+  std::string planner;
+  int runs = 0;
+  double success_rate = 0.0;  ///< fraction of runs with a solution
+  double target_rate = 0.0;   ///< fraction of runs that reached the target cost
+  // Initial stage: medians and means over the solved runs (NaN if none).
+  double first_iterations = NAN, first_nodes = NAN, first_cost = NAN, first_time_ms = NAN;
+  double first_iterations_mean = NAN, first_nodes_mean = NAN, first_cost_mean = NAN, first_time_ms_mean = NAN;
+  // Optimal stage: medians over all runs, a run that missed the target counting as
+  // +infinity, so NaN (null in JSON) when fewer than half the runs reached it; means
+  // over the runs that reached it.
+  double target_iterations = NAN, target_nodes = NAN, target_time_ms = NAN;
+  double target_iterations_mean = NAN, target_nodes_mean = NAN, target_time_ms_mean = NAN;
+  double final_cost = NAN;  ///< median final cost of solved runs
+};
+
+struct FrontendBenchResult {
+  std::string map;
+  Eigen::Vector3d start, goal;
+  double robot_radius = 0.0;
+  double reference_cost = 0.0;   ///< A* path length
+  double target_cost = 0.0;
+  double lower_bound = 0.0;      ///< straight-line distance
+  double steer_step = 0.0, goal_radius = 0.0;
+  std::string region_source;
+  std::size_t region_cells = 0;
+  double region_ms = 0.0;        ///< time to build the region (not in MINER's times)
+  std::vector<RunRecord> runs;
+  std::vector<PlannerSummary> summaries;
+  // Throughput (iterations per second over throughput_iterations, median of the runs).
+  double rrtstar_iterations_per_s = NAN;
+  double ompl_rrtstar_iterations_per_s = NAN;
+  double total_s = 0.0;
+  FrontendBenchOptions options;
+};
+
+/// The default planner list: rrtstar, informed, guided, miner, then OMPL's.
+std::vector<std::string> default_frontend_planners();
+
+/// Runs the campaign. `progress` (may be null) receives one line per planner.
+FrontendBenchResult run_frontend_bench(const std::string& map_path, const Eigen::Vector3d& start,
+                                       const Eigen::Vector3d& goal, double robot_radius,
+                                       const FrontendBenchOptions& options, std::ostream* progress);
+
+/// Summary of a planner's runs (exposed for tests).
+PlannerSummary summarise(const std::string& planner, const std::vector<RunRecord>& runs);
+
+/// One record per planner: planner, runs, success_rate, first_* and target_* (medians,
+/// null where undefined), *_mean, final_cost; plus the campaign's settings.
+nlohmann::json to_json(const FrontendBenchResult& result);
+/// A table like the paper's Table I.
+void print_table(const FrontendBenchResult& result, std::ostream& out);
+/// OMPL's benchmark log format (ompl::tools::Benchmark::saveResultsToStream), readable by
+/// `ompl_benchmark_statistics` and Planner Arena.
+void write_ompl_log(const FrontendBenchResult& result, std::ostream& out);
+
+}  // namespace miner::bench

@@ -1,0 +1,211 @@
+// `miner plan` and `miner region astar` (REQ-PLAN-*, REQ-CLI-004).
+#include <iomanip>
+#include <memory>
+#include <optional>
+#include <ostream>
+#include <sstream>
+
+#include <CLI/CLI.hpp>
+
+#include "cli/cli.hpp"
+#include "miner/core/error.hpp"
+#include "miner/plan/heuristic_region.hpp"
+#include "miner/plan/reference.hpp"
+#include "miner/plan/rrt_star.hpp"
+
+namespace miner::cli {
+
+namespace {
+
+struct RegionGridOptions {
+  std::vector<int> dims = {32, 32, 32};
+  int dilation = 1;
+};
+
+void add_region_grid_options(CLI::App* cmd, RegionGridOptions& r) {
+  cmd->add_option("--dims", r.dims, "heuristic grid size nx ny nz (the sGAN's grid)")
+      ->expected(3)
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--dilation", r.dilation, "cells added around each path cell (1: 3x3x3 cubes)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+}
+
+struct PlanCliOptions {
+  QueryOptions query;
+  std::string planner = "miner";
+  std::string region;
+  RegionGridOptions grid;
+  plan::PlannerOptions planner_options;
+  double target_factor = 0.0;
+  double target_cost = 0.0;
+  bool tree = false;
+  bool timing = false;
+  OutputOptions output;
+};
+
+Json stage_json(const std::optional<plan::StageRecord>& s, bool timing) {
+  if (!s) return nullptr;
+  Json j = {{"iteration", s->iteration}, {"nodes", s->nodes}, {"cost", s->cost}};
+  if (timing) j["time_ms"] = s->time_ms;
+  return j;
+}
+
+void run_plan(PlanCliOptions o, std::ostream& out) {
+  const ResolvedQuery q = resolve_query(o.query);
+  const plan::PlanningProblem problem = plan::PlanningProblem::make(q.map, q.start, q.goal, q.radius);
+  o.planner_options.planner = plan::planner_from_name(o.planner);
+
+  std::optional<plan::ReferencePath> reference;
+  const auto need_reference = [&] {
+    if (!reference) reference = plan::astar_reference(problem);
+    return *reference;
+  };
+  if (o.target_cost > 0.0) o.planner_options.target_cost = o.target_cost;
+  if (o.target_factor > 0.0) o.planner_options.target_cost = o.target_factor * need_reference().cost;
+
+  std::optional<plan::HeuristicRegion> region;
+  if (o.planner_options.planner == plan::PlannerKind::kMiner) {
+    if (!o.region.empty()) {
+      region = plan::HeuristicRegion::load(o.region);
+    } else {
+      const Eigen::Vector3i dims(o.grid.dims[0], o.grid.dims[1], o.grid.dims[2]);
+      region = plan::HeuristicRegion::from_path(q.map.bounds(), dims, need_reference().points,
+                                                o.grid.dilation, "astar-dilated");
+    }
+  }
+  const plan::PlanResult r = plan::plan(problem, o.planner_options, region ? &*region : nullptr);
+
+  Json path = Json::array();
+  for (const auto& p : r.path) path.push_back(vec_json(p));
+  Json doc = {{"planner", o.planner},
+              {"map", o.query.map},
+              {"start", vec_json(q.start)},
+              {"goal", vec_json(q.goal)},
+              {"robot_radius", q.radius},
+              {"seed", o.planner_options.seed},
+              {"max_iterations", o.planner_options.max_iterations},
+              {"steer_step", r.steer_step},
+              {"goal_radius", r.goal_radius},
+              {"target_cost", o.planner_options.target_cost ? Json(*o.planner_options.target_cost) : Json(nullptr)},
+              {"solved", r.solved},
+              {"reason", r.reason},
+              {"cost", r.solved ? Json(r.cost) : Json(nullptr)},
+              {"iterations", r.iterations},
+              {"nodes", r.nodes},
+              {"first", stage_json(r.first, o.timing)},
+              {"target", stage_json(r.target, o.timing)},
+              {"path", path}};
+  if (region) {
+    doc["region"] = {{"source", o.region.empty() ? region->source() : o.region},
+                     {"cells", region->cells().size()},
+                     {"volume", region->volume()}};
+  }
+  if (o.timing) doc["time_ms"] = r.time_ms;
+  if (o.tree) {
+    Json vertices = Json::array();
+    for (const auto& v : r.tree_vertices) vertices.push_back(vec_json(v));
+    doc["tree"] = {{"vertices", vertices}, {"parents", r.tree_parents}};
+  }
+
+  std::ostringstream h;
+  h << o.planner << " on " << o.query.map << ": " << format_point(q.start) << " -> " << format_point(q.goal)
+    << " (seed " << o.planner_options.seed << ")\n";
+  if (region) {
+    h << "heuristic region: " << (o.region.empty() ? region->source() + " (A* oracle; the sGAN is not wired yet)" : o.region)
+      << ", " << region->cells().size() << " cells\n";
+  }
+  if (r.first) {
+    h << "first solution: iteration " << r.first->iteration << ", " << r.first->nodes << " nodes, cost "
+      << std::fixed << std::setprecision(3) << r.first->cost << " m\n" << std::defaultfloat;
+  }
+  if (o.planner_options.target_cost) {
+    h << "target cost " << std::fixed << std::setprecision(3) << *o.planner_options.target_cost << " m: "
+      << std::defaultfloat;
+    if (r.target) h << "reached at iteration " << r.target->iteration << " (" << r.target->nodes << " nodes)\n";
+    else h << "not reached\n";
+  }
+  if (r.solved) {
+    h << "path: " << r.path.size() << " points, cost " << std::fixed << std::setprecision(3) << r.cost
+      << " m after " << std::defaultfloat << r.iterations << " iterations, " << r.nodes << " nodes\n";
+  }
+  emit(o.output, doc, h.str(), out);
+  if (!r.solved) throw NoSolution(r.reason);
+}
+
+struct RegionCliOptions {
+  QueryOptions query;
+  RegionGridOptions grid;
+  std::string out;
+};
+
+void run_region_astar(const RegionCliOptions& o, std::ostream& out) {
+  const ResolvedQuery q = resolve_query(o.query);
+  const plan::PlanningProblem problem = plan::PlanningProblem::make(q.map, q.start, q.goal, q.radius);
+  const plan::ReferencePath reference = plan::astar_reference(problem);
+  const Eigen::Vector3i dims(o.grid.dims[0], o.grid.dims[1], o.grid.dims[2]);
+  const auto region = plan::HeuristicRegion::from_path(q.map.bounds(), dims, reference.points, o.grid.dilation,
+                                                       "astar-dilated");
+  region.save(o.out);
+  out << "wrote " << o.out << ": " << region.cells().size() << " of " << dims.prod()
+      << " cells around the A* path (cost " << std::fixed << std::setprecision(3) << reference.cost << " m)\n";
+}
+
+}  // namespace
+
+void add_plan_commands(CLI::App& app, std::ostream& out) {
+  auto po = std::make_shared<PlanCliOptions>();
+  CLI::App* p = app.add_subcommand("plan", "find a path with an RRT* planner (rrtstar, informed, guided, miner)");
+  add_query_options(p, po->query);
+  p->add_option("--planner", po->planner, "rrtstar | informed | guided | miner")
+      ->check(CLI::IsMember({"rrtstar", "informed", "guided", "miner"}))
+      ->capture_default_str();
+  p->add_option("--seed", po->planner_options.seed, "random seed")->capture_default_str();
+  p->add_option("--region", po->region,
+                "heuristic region file (miner-region-v1) for --planner miner (default: the A*-dilated region)");
+  add_region_grid_options(p, po->grid);
+  p->add_option("--iterations", po->planner_options.max_iterations, "iteration budget (Alg. 1's N)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  p->add_flag("--first", po->planner_options.stop_at_first, "stop at the first solution (Alg. 1 Line 24)");
+  p->add_option("--target-cost", po->target_cost, "stop once the path cost is <= this (m)")
+      ->check(CLI::PositiveNumber);
+  p->add_option("--target-factor", po->target_factor,
+                "stop once the cost is <= this x the A* reference cost (e.g. 1.05)")
+      ->check(CLI::PositiveNumber);
+  p->add_option("--step", po->planner_options.steer_step, "steering step eta in m (default: 0.1 x map diagonal)")
+      ->check(CLI::PositiveNumber);
+  p->add_option("--goal-radius", po->planner_options.goal_radius, "goal region radius in m (default: 2 x resolution)")
+      ->check(CLI::PositiveNumber);
+  p->add_option("--goal-bias", po->planner_options.goal_bias, "probability of sampling the goal")
+      ->check(CLI::Range(0.0, 0.999999))
+      ->capture_default_str();
+  p->add_option("--mu1", po->planner_options.mu_1, "miner: P(sample region) after the first solution, < 1")
+      ->check(CLI::Range(0.0, 0.999999))
+      ->capture_default_str();
+  p->add_option("--mu2", po->planner_options.mu_2, "miner: P(sample region) before the first solution, < 1")
+      ->check(CLI::Range(0.0, 0.999999))
+      ->capture_default_str();
+  p->add_option("--rewire-factor", po->planner_options.rewire_factor, "rewiring radius factor (>= 1)")
+      ->check(CLI::Range(1.0, 100.0))
+      ->capture_default_str();
+  p->add_flag("--tree", po->tree, "include the final tree (vertices, parents) in the JSON");
+  p->add_flag("--timing", po->timing, "include wall-clock times (makes the output non-deterministic)");
+  add_output_options(p, po->output);
+  p->callback([po, &out] {
+    po->planner_options.record_tree = po->tree;
+    run_plan(*po, out);
+  });
+
+  CLI::App* region = app.add_subcommand("region", "heuristic regions for the miner planner");
+  region->require_subcommand(1);
+  auto ro = std::make_shared<RegionCliOptions>();
+  CLI::App* ra = region->add_subcommand("astar", "the A*-dilated ground-truth region (paper Sec. V-A.1)");
+  add_query_options(ra, ro->query);
+  add_region_grid_options(ra, ro->grid);
+  ra->add_option("--out", ro->out, "output region file (miner-region-v1 JSON)")->required();
+  ra->callback([ro, &out] { run_region_astar(*ro, out); });
+}
+
+}  // namespace miner::cli

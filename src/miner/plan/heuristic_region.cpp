@@ -1,0 +1,208 @@
+#include "miner/plan/heuristic_region.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "miner/core/error.hpp"
+#include "miner/core/rng.hpp"
+#include "miner/world/map.hpp"
+
+namespace miner::plan {
+
+namespace {
+
+Json vec_json(const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); }
+
+// Bounds are compared relative to the map's extent: files written with 17 significant
+// digits round-trip exactly, so anything above this is a different map, not rounding.
+constexpr double kBoundsRelativeTolerance = 1e-9;
+
+}  // namespace
+
+HeuristicRegion::HeuristicRegion(world::Box bounds, Eigen::Vector3i dims,
+                                 std::vector<double> probabilities, double threshold,
+                                 std::string source)
+    : bounds_(std::move(bounds)),
+      dims_(std::move(dims)),
+      probabilities_(std::move(probabilities)),
+      threshold_(threshold),
+      source_(std::move(source)) {
+  require_finite(bounds_.min, "region bounds.min");
+  require_finite(bounds_.max, "region bounds.max");
+  if (!(bounds_.max.array() > bounds_.min.array()).all()) {
+    throw Error("region bounds: max " + format_point(bounds_.max) + " must exceed min " +
+                format_point(bounds_.min) + " on every axis");
+  }
+  if ((dims_.array() < 1).any()) {
+    throw Error("region dims: every entry must be >= 1, got [" + std::to_string(dims_.x()) + ", " +
+                std::to_string(dims_.y()) + ", " + std::to_string(dims_.z()) + "]");
+  }
+  const std::size_t n = static_cast<std::size_t>(dims_.x()) * dims_.y() * dims_.z();
+  if (n > kMaxCells) {
+    throw Error("region dims: " + std::to_string(n) + " cells exceed the limit of " +
+                std::to_string(kMaxCells));
+  }
+  if (probabilities_.size() != n) {
+    throw Error("region probabilities: expected nx*ny*nz = " + std::to_string(n) + " values, got " +
+                std::to_string(probabilities_.size()));
+  }
+  if (!(threshold_ > 0.0 && threshold_ <= 1.0)) {
+    std::ostringstream s;
+    s << "region threshold: must be in (0, 1], got " << threshold_;
+    throw Error(s.str());
+  }
+  cell_size_ = (bounds_.max - bounds_.min).cwiseQuotient(dims_.cast<double>());
+  for (std::size_t i = 0; i < n; ++i) {
+    const double p = probabilities_[i];
+    if (!(p >= 0.0 && p <= 1.0)) {
+      std::ostringstream s;
+      s << "region probabilities[" << i << "]: must be a number in [0, 1], got " << p;
+      throw Error(s.str());
+    }
+    if (p >= threshold_) cells_.push_back(i);
+  }
+}
+
+HeuristicRegion HeuristicRegion::from_json(const Json& doc, const std::string& origin) {
+  const JsonField root(doc, "", origin);
+  if (!doc.is_object()) root.fail(std::string("expected a JSON object with \"format\": \"") + kRegionFormat + "\"");
+  const std::string format = root.at("format").string();
+  if (format != kRegionFormat) {
+    root.at("format").fail("unknown format tag \"" + format + "\", expected \"" + kRegionFormat + "\"");
+  }
+  const JsonField jb = root.at("bounds");
+  world::Box bounds{jb.at("min").vec3(), jb.at("max").vec3()};
+  const JsonField jd = root.at("dims");
+  if (jd.array_size() != 3) jd.fail("expected an array of 3 integers");
+  const Eigen::Vector3i dims(jd.at(std::size_t{0}).integer(), jd.at(1).integer(), jd.at(2).integer());
+  const JsonField jp = root.at("probabilities");
+  const std::size_t n = jp.array_size();
+  std::vector<double> probabilities(n);
+  for (std::size_t i = 0; i < n; ++i) probabilities[i] = jp.at(i).number();
+  const double threshold = root.has("threshold") ? root.at("threshold").number() : 0.5;
+  const std::string source = root.has("source") ? root.at("source").string() : "";
+  try {
+    return HeuristicRegion(bounds, dims, std::move(probabilities), threshold, source);
+  } catch (const Error& e) {
+    throw Error(origin + ": " + e.what());
+  }
+}
+
+HeuristicRegion HeuristicRegion::load(const std::string& path) {
+  return from_json(read_json_file(path), path);
+}
+
+Json HeuristicRegion::to_json() const {
+  Json p = Json::array();
+  for (double v : probabilities_) {
+    // Binary regions stay compact ("0"/"1" rather than "0.0"/"1.0").
+    if (v == 0.0 || v == 1.0) p.push_back(static_cast<int>(v));
+    else p.push_back(v);
+  }
+  return {{"format", kRegionFormat},
+          {"bounds", {{"min", vec_json(bounds_.min)}, {"max", vec_json(bounds_.max)}}},
+          {"dims", Json::array({dims_.x(), dims_.y(), dims_.z()})},
+          {"threshold", threshold_},
+          {"source", source_},
+          {"probabilities", p}};
+}
+
+void HeuristicRegion::save(const std::string& path) const {
+  write_file_atomic(path, to_json().dump() + "\n");
+}
+
+HeuristicRegion HeuristicRegion::from_path(const world::Box& bounds, const Eigen::Vector3i& dims,
+                                           const std::vector<Eigen::Vector3d>& path, int dilation,
+                                           std::string source) {
+  if (dilation < 0) throw Error("region dilation: must be >= 0, got " + std::to_string(dilation));
+  if (path.empty()) throw Error("region from path: the path has no points");
+  HeuristicRegion region(bounds, dims,
+                         std::vector<double>(static_cast<std::size_t>(std::max(dims.prod(), 0)), 0.0),
+                         1.0, std::move(source));
+  const Eigen::Vector3d cell = region.cell_size_;
+  auto cell_of = [&](const Eigen::Vector3d& p) {
+    Eigen::Vector3i c;
+    for (int a = 0; a < 3; ++a) {
+      const double f = std::floor((p[a] - bounds.min[a]) / cell[a]);
+      c[a] = static_cast<int>(std::clamp(f, 0.0, static_cast<double>(dims[a] - 1)));
+    }
+    return c;
+  };
+  std::vector<char> on_path(region.probabilities_.size(), 0);
+  // Walk each segment in steps of a quarter of the smallest cell side, so no cell the
+  // segment crosses by more than that is missed; the dilation covers the rest.
+  const double step = 0.25 * cell.minCoeff();
+  for (std::size_t s = 0; s < path.size(); ++s) {
+    require_finite(path[s], "region path point " + std::to_string(s));
+    const Eigen::Vector3d a = path[s];
+    const Eigen::Vector3d b = s + 1 < path.size() ? path[s + 1] : path[s];
+    const int steps = std::max(1, static_cast<int>(std::ceil((b - a).norm() / step)));
+    for (int t = 0; t <= steps; ++t) {
+      const Eigen::Vector3i c = cell_of(a + (b - a) * (static_cast<double>(t) / steps));
+      on_path[region.index(c.x(), c.y(), c.z())] = 1;
+    }
+  }
+  for (std::size_t i = 0; i < on_path.size(); ++i) {
+    if (!on_path[i]) continue;
+    const Eigen::Vector3i c = region.coords(i);
+    const Eigen::Vector3i lo = (c.array() - dilation).max(0);
+    const Eigen::Vector3i hi = (c.array() + dilation).min(dims.array() - 1);
+    for (int k = lo.z(); k <= hi.z(); ++k)
+      for (int j = lo.y(); j <= hi.y(); ++j)
+        for (int ii = lo.x(); ii <= hi.x(); ++ii) region.probabilities_[region.index(ii, j, k)] = 1.0;
+  }
+  region.cells_.clear();
+  for (std::size_t i = 0; i < region.probabilities_.size(); ++i) {
+    if (region.probabilities_[i] >= region.threshold_) region.cells_.push_back(i);
+  }
+  return region;
+}
+
+Eigen::Vector3i HeuristicRegion::coords(std::size_t index) const {
+  const auto nx = static_cast<std::size_t>(dims_.x());
+  const auto ny = static_cast<std::size_t>(dims_.y());
+  return Eigen::Vector3i(static_cast<int>(index % nx), static_cast<int>((index / nx) % ny),
+                         static_cast<int>(index / (nx * ny)));
+}
+
+world::Box HeuristicRegion::cell_box(std::size_t index) const {
+  const Eigen::Vector3d lo = bounds_.min + coords(index).cast<double>().cwiseProduct(cell_size_);
+  return {lo, lo + cell_size_};
+}
+
+bool HeuristicRegion::contains(const Eigen::Vector3d& p) const {
+  if (!bounds_.contains(p)) return false;
+  Eigen::Vector3i c;
+  for (int a = 0; a < 3; ++a) {
+    c[a] = std::min(static_cast<int>(std::floor((p[a] - bounds_.min[a]) / cell_size_[a])), dims_[a] - 1);
+  }
+  return probabilities_[index(c.x(), c.y(), c.z())] >= threshold_;
+}
+
+double HeuristicRegion::volume() const { return static_cast<double>(cells_.size()) * cell_size_.prod(); }
+
+Eigen::Vector3d HeuristicRegion::sample(Rng& rng) const {
+  if (cells_.empty()) throw Error("heuristic region: sample() on a region with no cell in H");
+  const world::Box box = cell_box(cells_[rng.uniform_index(cells_.size())]);
+  Eigen::Vector3d p;
+  for (int a = 0; a < 3; ++a) p[a] = rng.uniform(box.min[a], box.max[a]);
+  return p;
+}
+
+void HeuristicRegion::require_matches(const world::Map& map, const std::string& what) const {
+  const world::Box& mb = map.bounds();
+  const double tol = kBoundsRelativeTolerance * (mb.max - mb.min).maxCoeff();
+  if (((bounds_.min - mb.min).cwiseAbs().array() > tol).any() ||
+      ((bounds_.max - mb.max).cwiseAbs().array() > tol).any()) {
+    throw Error(what + ": region bounds " + format_point(bounds_.min) + " - " + format_point(bounds_.max) +
+                " do not match the map's bounds " + format_point(mb.min) + " - " + format_point(mb.max));
+  }
+  if (cells_.empty()) {
+    std::ostringstream s;
+    s << what << ": region has no cell with probability >= threshold " << threshold_;
+    throw Error(s.str());
+  }
+}
+
+}  // namespace miner::plan

@@ -1,0 +1,95 @@
+#pragma once
+/// \file
+/// The heuristic region H of Alg. 1 (paper Sec. IV-A): a grid of probabilities over the
+/// map's bounds, thresholded into a set of cells, and the Nonuniform(H) sampler that
+/// draws uniformly inside those cells (REQ-PLAN-004, REQ-PLAN-005).
+///
+/// File format `miner-region-v1` (JSON):
+///   {"format": "miner-region-v1",
+///    "bounds": {"min": [x,y,z], "max": [x,y,z]},   // must equal the map's bounds
+///    "dims": [nx, ny, nz],
+///    "threshold": 0.5,                               // cell in H iff probability >= threshold
+///    "probabilities": [p_0, ..., p_{nx ny nz - 1}],  // in [0,1], x fastest, then y, then z
+///    "source": "astar-dilated"}                      // optional, free text
+/// Cell (i, j, k) covers bounds.min + ([i, i+1] x [j, j+1] x [k, k+1]) * cell_size with
+/// cell_size = (bounds.max - bounds.min) / dims; its index is (k ny + j) nx + i.
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "miner/core/json_io.hpp"
+#include "miner/world/box.hpp"
+
+namespace miner {
+class Rng;
+namespace world {
+class Map;
+}
+}  // namespace miner
+
+namespace miner::plan {
+
+inline constexpr const char* kRegionFormat = "miner-region-v1";
+
+class HeuristicRegion {
+ public:
+  /// Validates dims (each >= 1, product <= kMaxCells), probabilities (count, finite,
+  /// in [0, 1]) and threshold (in (0, 1]); throws miner::Error naming the fault.
+  HeuristicRegion(world::Box bounds, Eigen::Vector3i dims, std::vector<double> probabilities,
+                  double threshold, std::string source = "");
+
+  static constexpr std::size_t kMaxCells = std::size_t{1} << 24;
+
+  static HeuristicRegion from_json(const Json& doc, const std::string& origin);
+  static HeuristicRegion load(const std::string& path);
+  Json to_json() const;
+  void save(const std::string& path) const;
+
+  /// The "ground truth" region of the paper's dataset (Sec. V-A.1): every cell a path
+  /// polyline passes through, dilated by `dilation` cells in each direction
+  /// (dilation 1 = the 3x3x3 cube around each path cell). Probabilities are 0 or 1.
+  static HeuristicRegion from_path(const world::Box& bounds, const Eigen::Vector3i& dims,
+                                   const std::vector<Eigen::Vector3d>& path, int dilation,
+                                   std::string source);
+
+  const world::Box& bounds() const { return bounds_; }
+  const Eigen::Vector3i& dims() const { return dims_; }
+  const Eigen::Vector3d& cell_size() const { return cell_size_; }
+  double threshold() const { return threshold_; }
+  const std::string& source() const { return source_; }
+  const std::vector<double>& probabilities() const { return probabilities_; }
+  /// Indices of the cells in H (probability >= threshold), ascending.
+  const std::vector<std::size_t>& cells() const { return cells_; }
+  bool empty() const { return cells_.empty(); }
+  std::size_t index(int i, int j, int k) const {
+    return (static_cast<std::size_t>(k) * dims_.y() + j) * dims_.x() + i;
+  }
+  Eigen::Vector3i coords(std::size_t index) const;
+  world::Box cell_box(std::size_t index) const;
+  /// Whether p lies in a cell of H (points outside the bounds are not).
+  bool contains(const Eigen::Vector3d& p) const;
+  /// Lebesgue measure of H: number of cells times the cell volume.
+  double volume() const;
+
+  /// Nonuniform(H): a cell of H uniformly, then a point uniformly inside it, which is
+  /// the uniform distribution on H since all cells have the same volume. Requires !empty().
+  Eigen::Vector3d sample(Rng& rng) const;
+
+  /// Throws miner::Error unless this region fits `map`: same bounds (to 1e-9 of the
+  /// extent) and at least one cell in H.
+  void require_matches(const world::Map& map, const std::string& what) const;
+
+ private:
+  world::Box bounds_;
+  Eigen::Vector3i dims_;
+  Eigen::Vector3d cell_size_;
+  std::vector<double> probabilities_;
+  double threshold_;
+  std::string source_;
+  std::vector<std::size_t> cells_;
+};
+
+}  // namespace miner::plan

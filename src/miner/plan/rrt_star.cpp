@@ -1,0 +1,369 @@
+#include "miner/plan/rrt_star.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "miner/core/error.hpp"
+#include "miner/core/rng.hpp"
+#include "miner/plan/heuristic_region.hpp"
+#include "miner/plan/informed_set.hpp"
+#include "miner/plan/kd_tree.hpp"
+#include "miner/world/map.hpp"
+#include "miner/world/voxel_grid.hpp"
+
+namespace miner::plan {
+
+namespace {
+
+constexpr double kDimension = 3.0;
+/// zeta_3: volume of the unit ball in R^3.
+constexpr double kUnitBallVolume = 4.0 / 3.0 * M_PI;
+/// A rewire must lower a cost by more than this (relative to the cost) to happen, so
+/// that rounding noise never flips parents back and forth.
+constexpr double kRewireRelativeMargin = 1e-12;
+/// Rejection tries for a sample of (informed set) x (map bounds) before falling back
+/// to a uniform sample of the map (which keeps completeness and never loops forever).
+constexpr int kMaxRejectionTries = 64;
+
+using Clock = std::chrono::steady_clock;
+
+double elapsed_ms(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+void require_probability(double p, const std::string& name, bool below_one) {
+  if (!(p >= 0.0 && (below_one ? p < 1.0 : p <= 1.0))) {
+    std::ostringstream s;
+    s << name << ": must be in [0, 1" << (below_one ? ")" : "]") << ", got " << p;
+    throw Error(s.str());
+  }
+}
+
+/// One RRT* run (Karaman & Frazzoli 2011, Alg. 6) with a pluggable sampler.
+class RrtStar {
+ public:
+  RrtStar(const PlanningProblem& problem, const PlannerOptions& options, const HeuristicRegion* region)
+      : problem_(problem), map_(*problem.map), options_(options), region_(region),
+        rng_(options.seed, options.stream) {
+    const world::Box& b = map_.bounds();
+    eta_ = options.steer_step > 0.0 ? options.steer_step : 0.1 * (b.max - b.min).norm();
+    goal_radius_ = options.goal_radius > 0.0 ? options.goal_radius : 2.0 * map_.resolution();
+    gamma_ = options.rewire_factor * std::pow(2.0 * (1.0 + 1.0 / kDimension), 1.0 / kDimension) *
+             std::pow(problem.free_volume / kUnitBallVolume, 1.0 / kDimension);
+  }
+
+  PlanResult run();
+
+ private:
+  Eigen::Vector3d sample();
+  Eigen::Vector3d sample_uniform() {
+    const world::Box& b = map_.bounds();
+    return {rng_.uniform(b.min.x(), b.max.x()), rng_.uniform(b.min.y(), b.max.y()),
+            rng_.uniform(b.min.z(), b.max.z())};
+  }
+  /// Uniform on set ∩ bounds by rejection, falling back to Uniform(Map).
+  Eigen::Vector3d sample_in(const ProlateHyperspheroid& set) {
+    const world::Box& b = map_.bounds();
+    const bool set_smaller = set.measure() < b.volume();
+    for (int t = 0; t < kMaxRejectionTries; ++t) {
+      const Eigen::Vector3d x = set_smaller ? set.sample(rng_) : sample_uniform();
+      if (set_smaller ? b.contains(x) : set.contains(x)) return x;
+    }
+    return sample_uniform();
+  }
+  Eigen::Vector3d sample_informed() {
+    return sample_in(ProlateHyperspheroid(problem_.start, problem_.goal, best_cost_));
+  }
+  Eigen::Vector3d sample_guided_local();
+
+  double rewire_radius() const {
+    const double n = static_cast<double>(positions_.size() + 1);
+    return std::min(eta_, gamma_ * std::pow(std::log(n) / n, 1.0 / kDimension));
+  }
+  bool free(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const {
+    return map_.segment_free(a, b, problem_.robot_radius);
+  }
+  void set_parent(std::size_t v, std::size_t parent, double cost);
+  void propagate_cost(std::size_t v);
+  void update_best(std::size_t iteration, Clock::time_point t0);
+  std::vector<Eigen::Vector3d> path_to(std::size_t v) const;
+
+  const PlanningProblem& problem_;
+  const world::Map& map_;
+  const PlannerOptions& options_;
+  const HeuristicRegion* region_;
+  Rng rng_;
+  double eta_ = 0.0, goal_radius_ = 0.0, gamma_ = 0.0;
+
+  KdTree tree_;
+  std::vector<Eigen::Vector3d> positions_;
+  std::vector<long> parent_;
+  std::vector<double> cost_;
+  std::vector<std::vector<std::uint32_t>> children_;
+  std::vector<std::size_t> goal_vertices_;
+
+  double best_cost_ = std::numeric_limits<double>::infinity();
+  long best_vertex_ = -1;
+  // Guided RRT* beacons: interior vertices of the current solution, with cost-to-come.
+  std::vector<std::pair<Eigen::Vector3d, double>> beacons_;
+
+  PlanResult result_;
+  // Scratch buffers reused every iteration.
+  std::vector<std::size_t> near_;
+  std::vector<std::pair<double, std::size_t>> candidates_;
+  std::vector<signed char> checked_;  // per candidate: -1 unknown, 0 blocked, 1 free
+};
+
+Eigen::Vector3d RrtStar::sample() {
+  if (options_.goal_bias > 0.0 && rng_.uniform01() < options_.goal_bias) return problem_.goal;
+  const bool solved = best_vertex_ >= 0;
+  switch (options_.planner) {
+    case PlannerKind::kRrtStar:
+      return sample_uniform();
+    case PlannerKind::kInformed:
+      return solved ? sample_informed() : sample_uniform();
+    case PlannerKind::kGuided:
+      if (!solved) return sample_uniform();
+      if (!beacons_.empty() && rng_.uniform01() < options_.guided_local_fraction) {
+        return sample_guided_local();
+      }
+      return sample_informed();
+    case PlannerKind::kMiner: {
+      const double mu = solved ? options_.mu_1 : options_.mu_2;
+      return rng_.uniform01() < mu ? region_->sample(rng_) : sample_uniform();
+    }
+  }
+  return sample_uniform();
+}
+
+Eigen::Vector3d RrtStar::sample_guided_local() {
+  const auto& [b, g] = beacons_[rng_.uniform_index(beacons_.size())];
+  const ProlateHyperspheroid to_start(problem_.start, b, g);
+  const ProlateHyperspheroid to_goal(b, problem_.goal, best_cost_ - g);
+  const double m1 = to_start.measure(), m2 = to_goal.measure();
+  if (!(m1 + m2 > 0.0)) return sample_informed();
+  return rng_.uniform01() * (m1 + m2) < m1 ? sample_in(to_start) : sample_in(to_goal);
+}
+
+void RrtStar::set_parent(std::size_t v, std::size_t parent, double cost) {
+  const long old = parent_[v];
+  if (old >= 0) {
+    auto& siblings = children_[static_cast<std::size_t>(old)];
+    siblings.erase(std::find(siblings.begin(), siblings.end(), static_cast<std::uint32_t>(v)));
+  }
+  parent_[v] = static_cast<long>(parent);
+  children_[parent].push_back(static_cast<std::uint32_t>(v));
+  cost_[v] = cost;
+}
+
+void RrtStar::propagate_cost(std::size_t v) {
+  std::vector<std::uint32_t> stack(children_[v].begin(), children_[v].end());
+  while (!stack.empty()) {
+    const std::uint32_t c = stack.back();
+    stack.pop_back();
+    const auto p = static_cast<std::size_t>(parent_[c]);
+    cost_[c] = cost_[p] + (positions_[c] - positions_[p]).norm();
+    stack.insert(stack.end(), children_[c].begin(), children_[c].end());
+  }
+}
+
+std::vector<Eigen::Vector3d> RrtStar::path_to(std::size_t v) const {
+  std::vector<Eigen::Vector3d> path;
+  for (long at = static_cast<long>(v); at >= 0; at = parent_[static_cast<std::size_t>(at)]) {
+    path.push_back(positions_[static_cast<std::size_t>(at)]);
+  }
+  std::reverse(path.begin(), path.end());
+  if ((path.back() - problem_.goal).norm() > 0.0) path.push_back(problem_.goal);
+  return path;
+}
+
+void RrtStar::update_best(std::size_t iteration, Clock::time_point t0) {
+  double best = std::numeric_limits<double>::infinity();
+  long vertex = -1;
+  for (std::size_t v : goal_vertices_) {
+    const double c = cost_[v] + (positions_[v] - problem_.goal).norm();
+    if (c < best) {
+      best = c;
+      vertex = static_cast<long>(v);
+    }
+  }
+  if (vertex < 0 || !(best < best_cost_)) return;
+  best_cost_ = best;
+  best_vertex_ = vertex;
+  const StageRecord record{iteration, positions_.size() - 1, best, elapsed_ms(t0)};
+  if (!result_.first) result_.first = record;
+  result_.improvements.push_back(record);
+  if (options_.target_cost && !result_.target && best <= *options_.target_cost) result_.target = record;
+  if (options_.planner == PlannerKind::kGuided) {
+    beacons_.clear();
+    const auto path = path_to(static_cast<std::size_t>(vertex));
+    double g = 0.0;
+    for (std::size_t i = 1; i + 1 < path.size(); ++i) {
+      g += (path[i] - path[i - 1]).norm();
+      beacons_.emplace_back(path[i], g);
+    }
+  }
+}
+
+PlanResult RrtStar::run() {
+  const Clock::time_point t0 = Clock::now();
+  result_.planner = options_.planner;
+  result_.steer_step = eta_;
+  result_.goal_radius = goal_radius_;
+
+  positions_.push_back(problem_.start);
+  parent_.push_back(-1);
+  cost_.push_back(0.0);
+  children_.emplace_back();
+  tree_.insert(problem_.start);
+  if ((problem_.start - problem_.goal).norm() <= goal_radius_ && free(problem_.start, problem_.goal)) {
+    goal_vertices_.push_back(0);
+  }
+  update_best(0, t0);
+
+  std::size_t iteration = 0;
+  while (iteration < options_.max_iterations) {
+    if (options_.stop_at_first && result_.first) break;
+    if (result_.target) break;
+    ++iteration;
+    const Eigen::Vector3d x_rand = sample();
+    const std::size_t nearest = tree_.nearest(x_rand);
+    const Eigen::Vector3d& x_nearest = positions_[nearest];
+    // Steer: move from x_nearest toward x_rand by at most eta.
+    const Eigen::Vector3d delta = x_rand - x_nearest;
+    const double dist = delta.norm();
+    if (dist == 0.0) continue;
+    const Eigen::Vector3d x_new = dist <= eta_ ? x_rand : Eigen::Vector3d(x_nearest + delta * (eta_ / dist));
+    if (!free(x_nearest, x_new)) continue;
+
+    // Extend: the parent minimising cost-to-come among X_near (x_nearest always qualifies).
+    tree_.within(x_new, rewire_radius(), near_);
+    candidates_.clear();
+    for (std::size_t v : near_) candidates_.emplace_back(cost_[v] + (positions_[v] - x_new).norm(), v);
+    std::sort(candidates_.begin(), candidates_.end());
+    checked_.assign(candidates_.size(), -1);
+    std::size_t parent = nearest;
+    double cost_new = cost_[nearest] + (x_new - x_nearest).norm();
+    for (std::size_t c = 0; c < candidates_.size(); ++c) {
+      if (candidates_[c].first >= cost_new) break;
+      const std::size_t v = candidates_[c].second;
+      checked_[c] = free(positions_[v], x_new) ? 1 : 0;
+      if (checked_[c]) {
+        parent = v;
+        cost_new = candidates_[c].first;
+        break;
+      }
+    }
+    const std::size_t v_new = positions_.size();
+    positions_.push_back(x_new);
+    parent_.push_back(-1);
+    cost_.push_back(0.0);
+    children_.emplace_back();
+    tree_.insert(x_new);
+    set_parent(v_new, parent, cost_new);
+
+    // Rewire: X_near vertices that x_new reaches more cheaply.
+    for (std::size_t c = 0; c < candidates_.size(); ++c) {
+      const std::size_t v = candidates_[c].second;
+      if (v == parent) continue;
+      const double via_new = cost_new + (positions_[v] - x_new).norm();
+      if (!(via_new < cost_[v] * (1.0 - kRewireRelativeMargin))) continue;
+      if (checked_[c] < 0) checked_[c] = free(x_new, positions_[v]) ? 1 : 0;
+      if (!checked_[c]) continue;
+      set_parent(v, v_new, via_new);
+      propagate_cost(v);
+    }
+    if ((x_new - problem_.goal).norm() <= goal_radius_ && free(x_new, problem_.goal)) {
+      goal_vertices_.push_back(v_new);
+    }
+    update_best(iteration, t0);
+  }
+
+  result_.iterations = iteration;
+  result_.nodes = positions_.size() - 1;
+  result_.time_ms = elapsed_ms(t0);
+  if (best_vertex_ >= 0) {
+    result_.solved = true;
+    result_.path = path_to(static_cast<std::size_t>(best_vertex_));
+    double length = 0.0;
+    for (std::size_t i = 1; i < result_.path.size(); ++i) length += (result_.path[i] - result_.path[i - 1]).norm();
+    result_.cost = length;
+  } else {
+    std::ostringstream s;
+    s << "no path to the goal region (radius " << goal_radius_ << " m) within " << iteration
+      << " iterations (" << result_.nodes << " vertices)";
+    result_.reason = s.str();
+  }
+  if (options_.record_tree) {
+    result_.tree_vertices = positions_;
+    result_.tree_parents = parent_;
+  }
+  return result_;
+}
+
+}  // namespace
+
+std::string planner_name(PlannerKind kind) {
+  switch (kind) {
+    case PlannerKind::kRrtStar: return "rrtstar";
+    case PlannerKind::kInformed: return "informed";
+    case PlannerKind::kGuided: return "guided";
+    case PlannerKind::kMiner: return "miner";
+  }
+  return "?";
+}
+
+PlannerKind planner_from_name(const std::string& name) {
+  for (PlannerKind k : all_planners()) {
+    if (planner_name(k) == name) return k;
+  }
+  throw Error("unknown planner \"" + name + "\"; expected one of rrtstar, informed, guided, miner");
+}
+
+std::vector<PlannerKind> all_planners() {
+  return {PlannerKind::kRrtStar, PlannerKind::kInformed, PlannerKind::kGuided, PlannerKind::kMiner};
+}
+
+PlanningProblem PlanningProblem::make(const world::Map& map, const Eigen::Vector3d& start,
+                                      const Eigen::Vector3d& goal, double robot_radius) {
+  require_finite(start, "start");
+  require_finite(goal, "goal");
+  require_finite(robot_radius, "robot_radius");
+  if (robot_radius < 0.0) throw Error("robot_radius: must be >= 0");
+  map.require_free(start, robot_radius, "start");
+  map.require_free(goal, robot_radius, "goal");
+  PlanningProblem p;
+  p.map = &map;
+  p.start = start;
+  p.goal = goal;
+  p.robot_radius = robot_radius;
+  const world::VoxelGrid grid(map, 0.0);
+  const double cell = grid.resolution() * grid.resolution() * grid.resolution();
+  p.free_volume = static_cast<double>(grid.cell_count() - grid.occupied_count()) * cell;
+  return p;
+}
+
+PlanResult plan(const PlanningProblem& problem, const PlannerOptions& options, const HeuristicRegion* region) {
+  if (problem.map == nullptr) throw Error("plan: the problem has no map");
+  require_probability(options.goal_bias, "goal_bias", true);
+  require_probability(options.mu_1, "mu_1", true);
+  require_probability(options.mu_2, "mu_2", true);
+  require_probability(options.guided_local_fraction, "guided_local_fraction", false);
+  require_finite(options.steer_step, "steer_step");
+  require_finite(options.goal_radius, "goal_radius");
+  if (!(options.rewire_factor >= 1.0 && std::isfinite(options.rewire_factor))) {
+    throw Error("rewire_factor: must be a finite number >= 1 (Lemma 2's radius condition)");
+  }
+  if (options.target_cost) require_finite(*options.target_cost, "target_cost");
+  if (options.planner == PlannerKind::kMiner) {
+    if (region == nullptr) throw Error("planner miner: needs a heuristic region");
+    region->require_matches(*problem.map, "planner miner");
+  }
+  RrtStar planner(problem, options, region);
+  return planner.run();
+}
+
+}  // namespace miner::plan

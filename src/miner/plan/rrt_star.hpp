@@ -1,0 +1,124 @@
+#pragma once
+/// \file
+/// The RRT* family of the paper's front end (Sec. IV-A, Alg. 1): one tree with
+/// Extend / Rewire (Karaman & Frazzoli 2011, Alg. 6) and four sampling policies
+/// (REQ-PLAN-001..005):
+///
+///  - `rrtstar`:  Uniform(Map) [Karaman 2011].
+///  - `informed`: Uniform(Map) until a solution of cost c_best exists, then uniform on the
+///                L2 informed set {x : |x - x_init| + |x - x_goal| <= c_best} intersected
+///                with the map [Gammell 2018].
+///  - `guided`:   as `informed`, but a fraction `guided_local_fraction` of the samples after
+///                the first solution is drawn from the local subsets of a beacon b on the
+///                current solution (GuILD, Scalise et al. 2023): {x : |x - x_init| +
+///                |x - b| <= g(b)} and {x : |x - b| + |x - x_goal| <= c_best - g(b)}, chosen
+///                in proportion to their volumes; beacons are the solution's interior vertices.
+///  - `miner`:    Alg. 1 Lines 5-17: Nonuniform(H) with probability mu_2 before the first
+///                solution and mu_1 after it, else Uniform(Map). mu_1, mu_2 < 1, which is what
+///                keeps Lemma 1 (probabilistic completeness) whatever H is.
+///
+/// Every policy first draws x_goal itself with probability `goal_bias` (as OMPL does).
+///
+/// Extend uses the rewiring radius of Alg. 1 Line 21, r_n = min(eta, gamma (log n / n)^(1/d)),
+/// d = 3, gamma = rewire_factor * (2 (1 + 1/d))^(1/d) (M(X_free) / zeta_d)^(1/d) (the paper's
+/// Lemma 2 condition with the (log n / n)^(1/d) factor the paper omits; Solovey et al. 2020
+/// show the constant must be larger than Karaman & Frazzoli's for RRT*, hence rewire_factor
+/// > 1, 1.1 by default as in OMPL). eta is the steering step.
+///
+/// The goal region is X_goal = {x : |x - x_goal| <= goal_radius}. A vertex in X_goal whose
+/// straight segment to x_goal is collision-free is a goal vertex; a solution is the tree
+/// path to a goal vertex followed by x_goal itself, so every returned path ends exactly at
+/// the goal and its cost is its Euclidean length.
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace miner::world {
+class Map;
+}
+
+namespace miner::plan {
+
+class HeuristicRegion;
+
+enum class PlannerKind { kRrtStar, kInformed, kGuided, kMiner };
+
+/// "rrtstar", "informed", "guided", "miner".
+std::string planner_name(PlannerKind kind);
+/// Inverse of planner_name; throws miner::Error listing the valid names.
+PlannerKind planner_from_name(const std::string& name);
+/// All four, in the order above.
+std::vector<PlannerKind> all_planners();
+
+/// Parameters of a planning run, with their defaults (REQ-PLAN-007).
+struct PlannerOptions {
+  PlannerKind planner = PlannerKind::kRrtStar;
+  std::uint64_t seed = 1;
+  std::uint64_t stream = 0;          ///< Rng stream (the trial number in a campaign)
+  std::size_t max_iterations = 20000;  ///< budget: Alg. 1's N
+  double steer_step = 0.0;   ///< eta (m); <= 0: 0.1 x the diagonal of the map's bounds
+  double goal_radius = 0.0;  ///< r of X_goal (m); <= 0: 2 x the map's resolution
+  double goal_bias = 0.05;   ///< probability of sampling x_goal itself
+  double rewire_factor = 1.1;
+  double mu_1 = 0.5;         ///< miner: P(sample H) after the first solution
+  double mu_2 = 0.9;         ///< miner: P(sample H) before the first solution
+  double guided_local_fraction = 0.5;  ///< guided: P(local subset) after the first solution
+  std::optional<double> target_cost;   ///< stop as soon as the cost is <= this
+  bool stop_at_first = false;          ///< stop at the first solution (Alg. 1 Line 24)
+  bool record_tree = false;            ///< keep the final tree in the result
+};
+
+/// A planning query after validation (REQ-PLAN-008): start and goal inside the bounds and
+/// at least robot_radius from every obstacle, with M(X_free) measured once.
+struct PlanningProblem {
+  const world::Map* map = nullptr;
+  Eigen::Vector3d start;
+  Eigen::Vector3d goal;
+  double robot_radius = 0.0;
+  double free_volume = 0.0;  ///< M(X_free): free cells of the conservative voxel grid
+
+  /// Throws miner::Error naming the fault (start/goal out of bounds or in collision).
+  static PlanningProblem make(const world::Map& map, const Eigen::Vector3d& start,
+                              const Eigen::Vector3d& goal, double robot_radius);
+};
+
+/// When a stage (first solution, target cost) was reached.
+struct StageRecord {
+  std::size_t iteration = 0;  ///< 1-based iteration that reached it
+  std::size_t nodes = 0;      ///< vertices added to the tree by then (x_init not counted)
+  double cost = 0.0;
+  double time_ms = 0.0;       ///< wall clock since plan() started (not deterministic)
+};
+
+struct PlanResult {
+  PlannerKind planner = PlannerKind::kRrtStar;
+  bool solved = false;
+  std::string reason;  ///< why not solved (empty if solved)
+  std::vector<Eigen::Vector3d> path;  ///< x_init, ..., x_goal
+  double cost = 0.0;                  ///< Euclidean length of path
+  std::size_t iterations = 0;
+  std::size_t nodes = 0;
+  std::optional<StageRecord> first;
+  std::optional<StageRecord> target;
+  std::vector<StageRecord> improvements;  ///< every time the best cost dropped
+  double time_ms = 0.0;
+  double steer_step = 0.0;   ///< the eta and r actually used (defaults resolved)
+  double goal_radius = 0.0;
+  /// The final tree when options.record_tree: vertex positions and parent indices (-1: root).
+  std::vector<Eigen::Vector3d> tree_vertices;
+  std::vector<long> tree_parents;
+};
+
+/// Runs the planner for at most options.max_iterations iterations. `region` is required
+/// for PlannerKind::kMiner (and must match the map, REQ-PLAN-008) and ignored otherwise.
+/// Throws miner::Error for invalid options; an unsolved query is a result with
+/// solved == false and a reason, never an exception or a hang.
+PlanResult plan(const PlanningProblem& problem, const PlannerOptions& options,
+                const HeuristicRegion* region = nullptr);
+
+}  // namespace miner::plan

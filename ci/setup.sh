@@ -21,7 +21,7 @@ PACKAGES=(
   nlohmann-json3-dev   # map / scenario / result JSON
   libcli11-dev         # the `miner` command line
   # benchmark peers
-  libompl-dev libboost-filesystem-dev libboost-system-dev libboost-serialization-dev
+  libompl-dev ompl-demos libboost-filesystem-dev libboost-system-dev libboost-serialization-dev
   # verification
   catch2               # unit tests (Catch2 v2)
   librapidcheck-dev    # property tests

@@ -211,3 +211,81 @@ TEST_CASE("traj solve answers the problem contract on stdout or in --out", "[REQ
   CHECK_THAT(e.err, Contains("bad-problem.json: points[0] and points[1] coincide"));
   CHECK(miner::read_json_file(out) == doc);  // the good answer is kept
 }
+
+TEST_CASE("plan prints a path and --json is the same bytes for the same seed", "[REQ-CLI-004][REQ-PLAN-007]") {
+  const std::string map = write("pillar-plan.json", kPillarMap);
+  const std::vector<std::string> args{"plan", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5",
+                                      "--planner", "rrtstar", "--iterations", "800", "--seed", "3"};
+  const Run human = miner_cli(args);
+  REQUIRE(human.code == 0);
+  CHECK_THAT(human.out, Contains("first solution: iteration") && Contains("path:"));
+  auto json_args = args;
+  json_args.push_back("--json");
+  const Run a = miner_cli(json_args);
+  const Run b = miner_cli(json_args);
+  REQUIRE(a.code == 0);
+  CHECK(a.out == b.out);
+  const auto doc = miner::parse_json(a.out, "stdout");
+  for (const char* key : {"planner", "solved", "cost", "path", "iterations", "nodes", "first", "target", "seed",
+                          "steer_step", "goal_radius"}) {
+    CHECK(doc.contains(key));
+  }
+  CHECK_FALSE(doc.contains("time_ms"));
+  CHECK(doc["solved"] == true);
+  CHECK(doc["path"].front() == miner::Json::array({1.0, 5.0, 5.0}));
+  CHECK(doc["path"].back() == miner::Json::array({9.0, 5.0, 5.0}));
+  json_args.push_back("--timing");
+  json_args.push_back("--tree");
+  const auto timed = miner::parse_json(miner_cli(json_args).out, "stdout");
+  CHECK(timed.contains("time_ms"));
+  CHECK(timed["tree"]["vertices"].size() == timed["nodes"].get<std::size_t>() + 1);
+}
+
+TEST_CASE("plan --planner miner uses the A*-dilated region by default or a region file", "[REQ-CLI-004][REQ-PLAN-005]") {
+  const std::string map = dir() + "/indoor-plan.json";
+  REQUIRE(miner_cli({"map", "gen", "--preset", "indoor", "--seed", "2", "--out", map}).code == 0);
+  const Run def = miner_cli({"plan", "--map", map, "--planner", "miner", "--iterations", "3000", "--target-factor",
+                             "1.02"});
+  REQUIRE(def.code == 0);
+  CHECK_THAT(def.out, Contains("astar-dilated (A* oracle") && Contains("target cost"));
+  const std::string region = dir() + "/region.json";
+  const Run reg = miner_cli({"region", "astar", "--map", map, "--dims", "16", "16", "8", "--out", region});
+  REQUIRE(reg.code == 0);
+  CHECK_THAT(reg.out, Contains("cells around the A* path"));
+  const Run with = miner_cli({"plan", "--map", map, "--planner", "miner", "--region", region, "--json"});
+  REQUIRE(with.code == 0);
+  const auto doc = miner::parse_json(with.out, "stdout");
+  CHECK(doc["region"]["source"] == region);
+  CHECK(doc["region"]["cells"].get<int>() > 0);
+}
+
+TEST_CASE("plan: bad input is named, an unreachable goal exits 3", "[REQ-CLI-004][REQ-PLAN-008]") {
+  const std::string map = write("pillar-bad.json", kPillarMap);
+  const Run inside = miner_cli({"plan", "--map", map, "--start", "5", "5", "5", "--goal", "9", "5", "5"});
+  CHECK(inside.code == 1);
+  CHECK_THAT(inside.err, Contains("start"));
+  const Run planner = miner_cli({"plan", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5",
+                                 "--planner", "bogus"});
+  CHECK(planner.code == 2);
+  const Run mu = miner_cli({"plan", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5", "--mu1", "1"});
+  CHECK(mu.code == 2);
+  const std::string region = write("bad-region.json", R"({"format": "miner-region-v1",
+    "bounds": {"min": [0,0,0], "max": [5,5,5]}, "dims": [1,1,1], "threshold": 0.5, "probabilities": [1]})");
+  const Run mismatch = miner_cli({"plan", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5",
+                                  "--planner", "miner", "--region", region});
+  CHECK(mismatch.code == 1);
+  CHECK_THAT(mismatch.err, Contains("do not match the map's bounds"));
+  // A closed wall: the goal is unreachable; the budget ends the run with exit 3.
+  const std::string closed = write("closed.json", R"({"format": "miner-map-v1",
+    "bounds": {"min": [0,0,0], "max": [10,10,3]}, "resolution": 0.5,
+    "obstacles": [{"type": "box", "min": [4,0,0], "max": [5,10,3]}]})");
+  const Run none = miner_cli({"plan", "--map", closed, "--start", "1", "1", "1", "--goal", "9", "1", "1",
+                              "--planner", "informed", "--iterations", "1000", "--json"});
+  CHECK(none.code == 3);
+  CHECK_THAT(none.err, Contains("no path to the goal region") && Contains("1000 iterations"));
+  CHECK(miner::parse_json(none.out, "stdout")["solved"] == false);
+  // miner's default region needs the A* path, which does not exist here either.
+  const Run miner_none = miner_cli({"plan", "--map", closed, "--start", "1", "1", "1", "--goal", "9", "1", "1",
+                                    "--planner", "miner"});
+  CHECK(miner_none.code == 3);
+}

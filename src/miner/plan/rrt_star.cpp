@@ -300,6 +300,7 @@ PlanResult RrtStar::run() {
   if (options_.record_tree) {
     result_.tree_vertices = positions_;
     result_.tree_parents = parent_;
+    result_.tree_costs = cost_;
   }
   return result_;
 }

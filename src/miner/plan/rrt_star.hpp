@@ -109,9 +109,11 @@ struct PlanResult {
   double time_ms = 0.0;
   double steer_step = 0.0;   ///< the eta and r actually used (defaults resolved)
   double goal_radius = 0.0;
-  /// The final tree when options.record_tree: vertex positions and parent indices (-1: root).
+  /// The final tree when options.record_tree: vertex positions, parent indices (-1: root)
+  /// and costs-to-come.
   std::vector<Eigen::Vector3d> tree_vertices;
   std::vector<long> tree_parents;
+  std::vector<double> tree_costs;  ///< cost-to-come of each vertex
 };
 
 /// Runs the planner for at most options.max_iterations iterations. `region` is required

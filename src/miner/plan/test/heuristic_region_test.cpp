@@ -1,0 +1,99 @@
+#include <catch2/catch.hpp>
+
+#include <fstream>
+
+#include "miner/core/error.hpp"
+#include "miner/core/rng.hpp"
+#include "miner/plan/heuristic_region.hpp"
+#include "plan_test_maps.hpp"
+
+using miner::plan::HeuristicRegion;
+using miner::world::Box;
+using Catch::Matchers::Contains;
+using V = Eigen::Vector3d;
+using I = Eigen::Vector3i;
+
+namespace {
+HeuristicRegion two_cells() {
+  // 4 x 2 x 1 cells over [0,8] x [0,2] x [0,1]; cells 1 and 6 in H.
+  std::vector<double> p(8, 0.1);
+  p[1] = 0.9;
+  p[6] = 0.5;
+  return HeuristicRegion(Box{{0, 0, 0}, {8, 2, 1}}, I(4, 2, 1), p, 0.5, "test");
+}
+}  // namespace
+
+TEST_CASE("A region's H is the cells at or above the threshold and its samples stay inside them", "[REQ-PLAN-004][REQ-PLAN-005]") {
+  const HeuristicRegion r = two_cells();
+  REQUIRE(r.cells() == std::vector<std::size_t>{1, 6});
+  CHECK(r.volume() == Approx(2 * 2.0));
+  CHECK(r.contains(V(2.5, 0.5, 0.5)));   // cell (1, 0, 0)
+  CHECK(r.contains(V(4.5, 1.5, 0.5)));   // cell (2, 1, 0) = index 6
+  CHECK_FALSE(r.contains(V(0.5, 0.5, 0.5)));
+  CHECK_FALSE(r.contains(V(9, 0.5, 0.5)));  // outside the bounds
+  miner::Rng rng(5);
+  int in_first = 0;
+  const int n = 20000;
+  for (int i = 0; i < n; ++i) {
+    const V x = r.sample(rng);
+    REQUIRE(r.contains(x));
+    in_first += x.x() < 4.0;
+  }
+  // Both cells have the same volume: each gets half the samples (6 sigma of 0.0035).
+  CHECK(std::abs(in_first / static_cast<double>(n) - 0.5) < 6 * 0.5 / std::sqrt(n));
+}
+
+TEST_CASE("A region round-trips through miner-region-v1 and bad files name the field", "[REQ-PLAN-005]") {
+  const HeuristicRegion r = two_cells();
+  const std::string path = miner::plan::test::temp_path("two.json");
+  r.save(path);
+  const HeuristicRegion back = HeuristicRegion::load(path);
+  CHECK(back.cells() == r.cells());
+  CHECK(back.probabilities() == r.probabilities());
+  CHECK(back.source() == "test");
+
+  miner::Json doc = r.to_json();
+  doc["format"] = "other";
+  CHECK_THROWS_WITH(HeuristicRegion::from_json(doc, "r.json"), Contains("unknown format tag"));
+  doc = r.to_json();
+  doc["probabilities"][3] = 1.5;
+  CHECK_THROWS_WITH(HeuristicRegion::from_json(doc, "r.json"), Contains("probabilities[3]") && Contains("[0, 1]"));
+  doc = r.to_json();
+  doc["probabilities"].erase(0);
+  CHECK_THROWS_WITH(HeuristicRegion::from_json(doc, "r.json"), Contains("expected nx*ny*nz = 8 values, got 7"));
+  doc = r.to_json();
+  doc["dims"] = {4, 0, 2};
+  CHECK_THROWS_WITH(HeuristicRegion::from_json(doc, "r.json"), Contains("dims"));
+  doc = r.to_json();
+  doc["threshold"] = 0.0;
+  CHECK_THROWS_WITH(HeuristicRegion::from_json(doc, "r.json"), Contains("threshold"));
+  doc = r.to_json();
+  doc["probabilities"][2] = "x";
+  CHECK_THROWS_WITH(HeuristicRegion::from_json(doc, "r.json"), Contains("probabilities[2]"));
+  CHECK_THROWS_WITH(HeuristicRegion(Box{{0, 0, 0}, {1, 1, 1}}, I(8192, 8192, 1), {}, 0.5),
+                    Contains("exceed the limit"));
+  CHECK_THROWS_WITH(HeuristicRegion(Box{{0, 0, 0}, {0, 1, 1}}, I(1, 1, 1), {1.0}, 0.5), Contains("must exceed"));
+}
+
+TEST_CASE("The A*-dilated region covers the path and its 3x3x3 neighbourhood", "[REQ-PLAN-005]") {
+  const Box bounds{{0, 0, 0}, {10, 10, 10}};
+  const std::vector<V> path{V(0.5, 0.5, 0.5), V(9.5, 0.5, 0.5)};  // along the x axis, first row of cells
+  const HeuristicRegion r0 = HeuristicRegion::from_path(bounds, I(10, 10, 10), path, 0, "p");
+  CHECK(r0.cells().size() == 10);
+  const HeuristicRegion r1 = HeuristicRegion::from_path(bounds, I(10, 10, 10), path, 1, "p");
+  CHECK(r1.cells().size() == 10 * 2 * 2);  // clipped at the map's corner: y, z in {0, 1}
+  for (double x = 0.1; x < 10; x += 0.37) CHECK(r1.contains(V(x, 0.5, 0.5)));
+  CHECK_FALSE(r1.contains(V(5, 2.5, 0.5)));
+  CHECK_THROWS_WITH(HeuristicRegion::from_path(bounds, I(10, 10, 10), path, -1, "p"), Contains("dilation"));
+  CHECK_THROWS_WITH(HeuristicRegion::from_path(bounds, I(10, 10, 10), {}, 1, "p"), Contains("no points"));
+}
+
+TEST_CASE("A region must match the map's bounds and hold at least one cell", "[REQ-PLAN-008]") {
+  const auto map = miner::plan::test::wall_with_door_map();  // bounds [0,10] x [0,10] x [0,3]
+  const HeuristicRegion wrong = two_cells();
+  CHECK_THROWS_WITH(wrong.require_matches(map, "planner miner"),
+                    Contains("do not match the map's bounds") && Contains("(10, 10, 3)"));
+  const HeuristicRegion empty(map.bounds(), I(2, 2, 2), std::vector<double>(8, 0.2), 0.5);
+  CHECK_THROWS_WITH(empty.require_matches(map, "planner miner"), Contains("no cell with probability >= threshold"));
+  CHECK_THROWS_AS(empty.sample(*std::make_unique<miner::Rng>(1)), miner::Error);
+}

@@ -1,0 +1,231 @@
+#include <catch2/catch.hpp>
+
+#include "miner/core/error.hpp"
+#include "miner/plan/heuristic_region.hpp"
+#include "miner/plan/reference.hpp"
+#include "miner/plan/rrt_star.hpp"
+#include "plan_test_maps.hpp"
+
+using miner::plan::HeuristicRegion;
+using miner::plan::PlannerKind;
+using miner::plan::PlannerOptions;
+using miner::plan::PlanningProblem;
+using miner::plan::PlanResult;
+using Catch::Matchers::Contains;
+using V = Eigen::Vector3d;
+using I = Eigen::Vector3i;
+
+namespace {
+
+// Costs are sums of a few hundred edge lengths of ~1 m: rounding stays far below this.
+constexpr double kCostTolerance = 1e-9;
+
+double path_length(const std::vector<V>& path) {
+  double length = 0.0;
+  for (std::size_t i = 1; i < path.size(); ++i) length += (path[i] - path[i - 1]).norm();
+  return length;
+}
+
+HeuristicRegion astar_region(const PlanningProblem& problem) {
+  const auto ref = miner::plan::astar_reference(problem);
+  return HeuristicRegion::from_path(problem.map->bounds(), I(10, 10, 3), ref.points, 1, "astar-dilated");
+}
+
+}  // namespace
+
+TEST_CASE("Every planner returns a collision-free path from start to goal whose cost is its length", "[REQ-PLAN-001][REQ-PLAN-004][REQ-PLAN-009]") {
+  const auto map = miner::plan::test::wall_with_door_map();
+  const auto problem = PlanningProblem::make(map, V(1, 1, 0.5), V(9, 1, 0.5), 0.1);
+  const HeuristicRegion region = astar_region(problem);
+  for (PlannerKind kind : miner::plan::all_planners()) {
+    INFO(miner::plan::planner_name(kind));
+    PlannerOptions o;
+    o.planner = kind;
+    o.max_iterations = 3000;
+    o.record_tree = true;
+    const PlanResult r = miner::plan::plan(problem, o, &region);
+    REQUIRE(r.solved);
+    CHECK(r.reason.empty());
+    CHECK(r.path.front() == problem.start);
+    CHECK(r.path.back() == problem.goal);
+    for (std::size_t i = 1; i < r.path.size(); ++i) CHECK(map.segment_free(r.path[i - 1], r.path[i], 0.1));
+    CHECK(r.cost == Approx(path_length(r.path)).margin(kCostTolerance));
+    CHECK(r.cost >= miner::plan::straight_line_bound(problem));
+    // The only way through is the door (y in [7.5, 9], z < 1.5 at x in [4, 5]).
+    bool through_door = false;
+    for (std::size_t i = 1; i < r.path.size(); ++i) {
+      const V& a = r.path[i - 1];
+      const V& b = r.path[i];
+      if ((a.x() - 4.5) * (b.x() - 4.5) <= 0) {
+        const double t = (4.5 - a.x()) / (b.x() - a.x());
+        const V x = a + t * (b - a);
+        through_door |= x.y() > 7.5 && x.y() < 9 && x.z() < 1.5;
+      }
+    }
+    CHECK(through_door);
+    // Tree invariants: edges collision-free, cost-to-come consistent.
+    REQUIRE(r.tree_vertices.size() == r.nodes + 1);
+    CHECK(r.tree_parents[0] == -1);
+    CHECK(r.tree_costs[0] == 0.0);
+    for (std::size_t v = 1; v < r.tree_vertices.size(); ++v) {
+      const auto p = static_cast<std::size_t>(r.tree_parents[v]);
+      REQUIRE(p < r.tree_vertices.size());
+      CHECK(map.segment_free(r.tree_vertices[p], r.tree_vertices[v], 0.1));
+      CHECK(r.tree_costs[v] == Approx(r.tree_costs[p] + (r.tree_vertices[v] - r.tree_vertices[p]).norm())
+                                   .margin(kCostTolerance));
+    }
+    // The best cost never increases and the first solution is the first improvement.
+    REQUIRE(r.first);
+    CHECK(r.improvements.front().iteration == r.first->iteration);
+    for (std::size_t i = 1; i < r.improvements.size(); ++i) {
+      CHECK(r.improvements[i].cost < r.improvements[i - 1].cost);
+      CHECK(r.improvements[i].iteration >= r.improvements[i - 1].iteration);
+    }
+    CHECK(r.improvements.back().cost == Approx(r.cost).margin(kCostTolerance));
+  }
+}
+
+TEST_CASE("Informed and guided RRT* sample like RRT* until the first solution", "[REQ-PLAN-002][REQ-PLAN-003]") {
+  // Both switch sampler only once c_best exists, so under common random numbers their
+  // first solution is RRT*'s to the bit; afterwards they converge faster.
+  const auto map = miner::plan::test::wall_with_door_map();
+  const auto problem = PlanningProblem::make(map, V(1, 1, 0.5), V(9, 1, 0.5), 0.1);
+  PlannerOptions o;
+  o.max_iterations = 4000;
+  o.seed = 11;
+  const PlanResult rrt = miner::plan::plan(problem, o);
+  o.planner = PlannerKind::kInformed;
+  const PlanResult informed = miner::plan::plan(problem, o);
+  o.planner = PlannerKind::kGuided;
+  const PlanResult guided = miner::plan::plan(problem, o);
+  REQUIRE(rrt.first);
+  for (const PlanResult* r : {&informed, &guided}) {
+    REQUIRE(r->first);
+    CHECK(r->first->iteration == rrt.first->iteration);
+    CHECK(r->first->cost == rrt.first->cost);
+    CHECK(r->first->nodes == rrt.first->nodes);
+    CHECK(r->cost < rrt.cost);  // focused sampling after the first solution pays off
+  }
+  CHECK(informed.cost != guided.cost);  // and the two focus differently
+}
+
+TEST_CASE("Planning is deterministic for a seed and stream and differs across streams", "[REQ-PLAN-007]") {
+  const auto map = miner::plan::test::wall_with_door_map();
+  const auto problem = PlanningProblem::make(map, V(1, 1, 0.5), V(9, 1, 0.5), 0.1);
+  const HeuristicRegion region = astar_region(problem);
+  for (PlannerKind kind : miner::plan::all_planners()) {
+    PlannerOptions o;
+    o.planner = kind;
+    o.max_iterations = 1500;
+    o.record_tree = true;
+    const PlanResult a = miner::plan::plan(problem, o, &region);
+    const PlanResult b = miner::plan::plan(problem, o, &region);
+    CHECK(a.path == b.path);
+    CHECK(a.tree_vertices == b.tree_vertices);
+    CHECK(a.tree_parents == b.tree_parents);
+    CHECK(a.nodes == b.nodes);
+    o.stream = 1;
+    const PlanResult c = miner::plan::plan(problem, o, &region);
+    CHECK(c.tree_vertices != a.tree_vertices);
+  }
+}
+
+TEST_CASE("Planning stops at the first solution or at the target cost when asked", "[REQ-PLAN-001][REQ-PLAN-009]") {
+  const auto map = miner::plan::test::wall_with_door_map();
+  const auto problem = PlanningProblem::make(map, V(1, 1, 0.5), V(9, 1, 0.5), 0.1);
+  PlannerOptions o;
+  o.max_iterations = 20000;
+  o.stop_at_first = true;
+  const PlanResult first = miner::plan::plan(problem, o);
+  REQUIRE(first.solved);
+  CHECK(first.iterations == first.first->iteration);
+  o.stop_at_first = false;
+  o.target_cost = 0.98 * first.cost;
+  const PlanResult target = miner::plan::plan(problem, o);
+  REQUIRE(target.target);
+  CHECK(target.iterations == target.target->iteration);
+  CHECK(target.cost <= *o.target_cost);
+  CHECK(target.target->cost == target.cost);
+  // A target below the straight line is never reached: the budget ends the run.
+  o.target_cost = 0.5 * miner::plan::straight_line_bound(problem);
+  o.max_iterations = 500;
+  const PlanResult never = miner::plan::plan(problem, o);
+  CHECK_FALSE(never.target);
+  CHECK(never.iterations == 500);
+}
+
+TEST_CASE("Start or goal out of bounds or in collision is refused before planning", "[REQ-PLAN-008]") {
+  const auto map = miner::plan::test::wall_with_door_map();
+  CHECK_THROWS_WITH(PlanningProblem::make(map, V(4.5, 2, 1), V(9, 1, 0.5), 0.1), Contains("start"));
+  CHECK_THROWS_WITH(PlanningProblem::make(map, V(1, 1, 0.5), V(11, 1, 0.5), 0.1), Contains("goal"));
+  CHECK_THROWS_WITH(PlanningProblem::make(map, V(3.95, 1, 0.5), V(9, 1, 0.5), 0.1), Contains("start"));
+  CHECK_THROWS_WITH(PlanningProblem::make(map, V(1, 1, 0.5), V(9, 1, 0.5), -1.0), Contains("robot_radius"));
+  CHECK_THROWS_WITH(PlanningProblem::make(map, V(1, NAN, 0.5), V(9, 1, 0.5), 0.1), Contains("start"));
+  // An empty free space: one obstacle fills the whole map.
+  const miner::world::Map full(miner::world::Box{{0, 0, 0}, {5, 5, 5}}, 0.5,
+                               {miner::world::Box{{0, 0, 0}, {5, 5, 5}}});
+  CHECK_THROWS_WITH(PlanningProblem::make(full, V(1, 1, 1), V(4, 4, 4), 0.0), Contains("start"));
+}
+
+TEST_CASE("An unreachable goal ends within the budget with a reason", "[REQ-PLAN-008]") {
+  const auto map = miner::plan::test::closed_wall_map();
+  const auto problem = PlanningProblem::make(map, V(1, 1, 0.5), V(9, 1, 0.5), 0.1);
+  const HeuristicRegion region(map.bounds(), I(10, 10, 3), std::vector<double>(300, 1.0), 0.5, "all");
+  for (PlannerKind kind : miner::plan::all_planners()) {
+    PlannerOptions o;
+    o.planner = kind;
+    o.max_iterations = 2000;
+    const PlanResult r = miner::plan::plan(problem, o, &region);
+    CHECK_FALSE(r.solved);
+    CHECK(r.iterations == 2000);
+    CHECK(r.path.empty());
+    CHECK_THAT(r.reason, Contains("no path to the goal region") && Contains("2000 iterations"));
+  }
+}
+
+TEST_CASE("Invalid planner options and a missing or mismatched region are refused", "[REQ-PLAN-007][REQ-PLAN-008]") {
+  const auto map = miner::plan::test::wall_with_door_map();
+  const auto problem = PlanningProblem::make(map, V(1, 1, 0.5), V(9, 1, 0.5), 0.1);
+  PlannerOptions o;
+  o.planner = PlannerKind::kMiner;
+  CHECK_THROWS_WITH(miner::plan::plan(problem, o), Contains("needs a heuristic region"));
+  const HeuristicRegion other(miner::world::Box{{0, 0, 0}, {10, 10, 4}}, I(2, 2, 2), std::vector<double>(8, 1.0), 0.5);
+  CHECK_THROWS_WITH(miner::plan::plan(problem, o, &other), Contains("do not match"));
+  const HeuristicRegion region = astar_region(problem);
+  o.mu_1 = 1.0;
+  CHECK_THROWS_WITH(miner::plan::plan(problem, o, &region), Contains("mu_1"));
+  o.mu_1 = 0.5;
+  o.mu_2 = -0.1;
+  CHECK_THROWS_WITH(miner::plan::plan(problem, o, &region), Contains("mu_2"));
+  o.mu_2 = 0.9;
+  o.goal_bias = 1.0;
+  CHECK_THROWS_WITH(miner::plan::plan(problem, o, &region), Contains("goal_bias"));
+  o.goal_bias = 0.05;
+  o.rewire_factor = 0.5;
+  CHECK_THROWS_WITH(miner::plan::plan(problem, o, &region), Contains("rewire_factor"));
+  o.rewire_factor = 1.1;
+  o.guided_local_fraction = 2;
+  CHECK_THROWS_WITH(miner::plan::plan(problem, o, &region), Contains("guided_local_fraction"));
+  o.guided_local_fraction = 0.5;
+  o.steer_step = NAN;
+  CHECK_THROWS_WITH(miner::plan::plan(problem, o, &region), Contains("steer_step"));
+  o.steer_step = 0;
+  o.target_cost = INFINITY;
+  CHECK_THROWS_WITH(miner::plan::plan(problem, o, &region), Contains("target_cost"));
+  CHECK_THROWS_WITH(miner::plan::planner_from_name("rrt"), Contains("rrtstar, informed, guided, miner"));
+  CHECK(miner::plan::planner_from_name("guided") == PlannerKind::kGuided);
+  PlanningProblem no_map;
+  CHECK_THROWS_WITH(miner::plan::plan(no_map, PlannerOptions{}), Contains("no map"));
+}
+
+TEST_CASE("A start inside the goal region is solved at once", "[REQ-PLAN-001]") {
+  const auto map = miner::plan::test::wall_with_door_map();
+  const auto problem = PlanningProblem::make(map, V(1, 1, 0.5), V(1.5, 1, 0.5), 0.1);
+  PlannerOptions o;
+  o.stop_at_first = true;
+  const PlanResult r = miner::plan::plan(problem, o);
+  REQUIRE(r.solved);
+  CHECK(r.iterations == 0);
+  CHECK(r.path == std::vector<V>{problem.start, problem.goal});
+  CHECK(r.cost == Approx(0.5));
+}

@@ -199,6 +199,8 @@ plan::PlanResult run_ompl(const plan::PlanningProblem& problem, const OmplRunOpt
   ob::PlannerTerminationCondition ptc([&] {
     poll_solutions();
     if (o.target_cost && best <= *o.target_cost) return true;
+    if (o.stop_at_first && best < std::numeric_limits<double>::infinity()) return true;
+    if (o.max_condition_checks && ptc_calls >= *o.max_condition_checks) return true;
     if (max_iterations && rrtstar && rrtstar->numIterations() >= *max_iterations) return true;
     // Reading the clock every call would dominate cheap iterations; every 64th is enough.
     return (++ptc_calls & 63u) == 0 && now_ms() > 1000.0 * limit_s;

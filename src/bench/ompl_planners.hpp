@@ -28,6 +28,10 @@ struct OmplRunOptions {
   double goal_bias = 0.05;
   double rewire_factor = 1.1;
   std::optional<double> target_cost;  ///< PathLengthOptimizationObjective cost threshold
+  /// A budget that is not wall-clock: stop after this many evaluations of the termination
+  /// condition (one per iteration of the planner's main loop). For tests.
+  std::optional<std::size_t> max_condition_checks;
+  bool stop_at_first = false;  ///< stop as soon as an exact solution exists
 };
 
 /// A stage counter OMPL does not report (e.g. RRTstar's vertex count mid-run).

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # ci/main.sh — the README's first command: set up, build (Release) and run the main
-# job. Today the main job generates a seeded cluttered map and plans on it with A*;
-# later capabilities turn it into `miner fly`. Results go to run/quickstart/.
+# job. Today the main job generates a seeded cluttered map, plans on it with A* and
+# with MINER-RRT* (A*-dilated heuristic region until the sGAN lands); later
+# capabilities turn it into `miner fly`. Results go to run/quickstart/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -14,3 +15,4 @@ set -x
 build/release/miner map gen --preset sim --seed 7 --out "$out/map.json"
 build/release/miner map info --map "$out/map.json"
 build/release/miner astar --map "$out/map.json" --out "$out/astar.json"
+build/release/miner plan --map "$out/map.json" --planner miner --target-factor 1.0 --out "$out/plan.json"

@@ -72,6 +72,28 @@ class MapMotionValidator : public ob::MotionValidator {
   double radius_;
 };
 
+/// The state space's default projection, registered here instead of OMPL's random linear
+/// projection (whose Eigen storage libompl frees in a way AddressSanitizer rejects). None
+/// of the benchmarked planners uses projections; OMPL only requires one to exist.
+class XyzProjection : public ob::ProjectionEvaluator {
+ public:
+  explicit XyzProjection(const ob::StateSpace* space) : ob::ProjectionEvaluator(space) {}
+  unsigned int getDimension() const override { return 3; }
+  void defaultCellSizes() override { cellSizes_.assign(3, 1.0); }
+  void project(const ob::State* state, Eigen::Ref<Eigen::VectorXd> projection) const override {
+    const auto* r = state->as<ob::RealVectorStateSpace::StateType>();
+    for (int a = 0; a < 3; ++a) projection[a] = r->values[a];
+  }
+};
+
+class MapStateSpace : public ob::RealVectorStateSpace {
+ public:
+  MapStateSpace() : ob::RealVectorStateSpace(3) {}
+  void registerProjections() override {
+    registerDefaultProjection(std::make_shared<XyzProjection>(this));
+  }
+};
+
 ob::PlannerPtr make_planner(const std::string& name, const ob::SpaceInformationPtr& si, const OmplRunOptions& o) {
   if (name == "ompl:RRTstar" || name == "ompl:InformedRRTstar") {
     std::shared_ptr<og::RRTstar> p;
@@ -124,7 +146,7 @@ void init_ompl(std::uint64_t seed) {
 
 plan::PlanResult run_ompl(const plan::PlanningProblem& problem, const OmplRunOptions& o) {
   const world::Map& map = *problem.map;
-  auto space = std::make_shared<ob::RealVectorStateSpace>(3);
+  auto space = std::make_shared<MapStateSpace>();
   ob::RealVectorBounds bounds(3);
   for (int a = 0; a < 3; ++a) {
     bounds.setLow(static_cast<unsigned>(a), map.bounds().min[a]);

@@ -23,8 +23,8 @@ TEST_CASE("min_successes reproduces the anchor sizing 0.99 vs 0.90 with N 291 an
   // The defining property: false-fail <= alpha at k, > alpha at k + 1.
   CHECK(binomial_cdf(k - 1, 291, 0.99) <= 1e-6);
   CHECK(binomial_cdf(k, 291, 0.99) > 1e-6);
-  // ... and the test has power against p = 0.90: it passes by chance with P < 1e-6.
-  CHECK(1.0 - binomial_cdf(k - 1, 291, 0.90) < 1e-6);
+  // ... and it has power against p = 0.90: such a planner passes with P ~ 9.7e-4.
+  CHECK(1.0 - binomial_cdf(k - 1, 291, 0.90) < 1e-3);
 }
 
 TEST_CASE("min_successes rejects meaningless arguments", "[REQ-HARNESS-005]") {

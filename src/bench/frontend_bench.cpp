@@ -12,6 +12,7 @@
 
 #include "bench/ompl_planners.hpp"
 #include "miner/core/error.hpp"
+#include "miner/core/json_io.hpp"
 #include "miner/plan/heuristic_region.hpp"
 #include "miner/plan/reference.hpp"
 #include "miner/world/map.hpp"
@@ -255,10 +256,9 @@ nlohmann::json to_json(const FrontendBenchResult& r) {
                         {"target_time_ms_mean", num(s.target_time_ms_mean)},
                         {"final_cost", num(s.final_cost)}});
   }
-  const auto v3 = [](const Eigen::Vector3d& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); };
   return {{"map", r.map},
-          {"start", v3(r.start)},
-          {"goal", v3(r.goal)},
+          {"start", vec3_json(r.start)},
+          {"goal", vec3_json(r.goal)},
           {"robot_radius", r.robot_radius},
           {"runs", r.options.runs},
           {"seed", r.options.seed},

@@ -30,8 +30,6 @@ const CLI::Validator kFinite(
     },
     "FINITE");
 
-Json vec_json(const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); }
-
 void add_query_options(CLI::App* cmd, QueryOptions& q) {
   cmd->add_option("--map", q.map, "map file (.json or .bt)")->required();
   cmd->add_option("--start", q.start, "start x y z in m (default: the map's query)")->expected(3)->check(kFinite);

@@ -37,9 +37,6 @@ void emit(const OutputOptions& o, const Json& doc, const std::string& human, std
 extern const CLI::Validator kFinite;
 extern const CLI::Validator kFiniteNonNegative;
 
-/// [x, y, z] as a JSON array.
-Json vec_json(const Eigen::Vector3d& v);
-
 /// --map, --start x y z, --goal x y z, --radius: a planning query, where start, goal and
 /// radius default to the map's stored "query" (REQ-CLI-004).
 struct QueryOptions {

@@ -50,7 +50,7 @@ void run_info(const InfoOptions& o, std::ostream& out) {
   const world::VoxelGrid grid(map, radius);
   const double occupied = static_cast<double>(grid.occupied_count()) / static_cast<double>(grid.cell_count());
   Json doc = {{"map", o.map},
-              {"bounds", {{"min", vec_json(map.bounds().min)}, {"max", vec_json(map.bounds().max)}}},
+              {"bounds", {{"min", vec3_json(map.bounds().min)}, {"max", vec3_json(map.bounds().max)}}},
               {"resolution", map.resolution()},
               {"obstacles", map.obstacles().size()},
               {"grid", {{"dims", {grid.dims().x(), grid.dims().y(), grid.dims().z()}},
@@ -59,8 +59,8 @@ void run_info(const InfoOptions& o, std::ostream& out) {
                         {"occupied_cells", grid.occupied_count()},
                         {"occupied_fraction", occupied}}}};
   if (map.query()) {
-    doc["query"] = {{"start", vec_json(map.query()->start)},
-                    {"goal", vec_json(map.query()->goal)},
+    doc["query"] = {{"start", vec3_json(map.query()->start)},
+                    {"goal", vec3_json(map.query()->goal)},
                     {"robot_radius", map.query()->robot_radius}};
   }
   std::ostringstream h;
@@ -103,10 +103,10 @@ void run_astar(const AstarOptions& o, std::ostream& out) {
   const world::GridPath path = world::astar(map, grid, start, goal);
 
   Json points = Json::array();
-  for (const auto& p : path.points) points.push_back(vec_json(p));
+  for (const auto& p : path.points) points.push_back(vec3_json(p));
   const Json doc = {{"map", o.query.map},
-                    {"start", vec_json(start)},
-                    {"goal", vec_json(goal)},
+                    {"start", vec3_json(start)},
+                    {"goal", vec3_json(goal)},
                     {"robot_radius", radius},
                     {"resolution", grid.resolution()},
                     {"cost", path.cost},

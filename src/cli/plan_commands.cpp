@@ -78,11 +78,11 @@ void run_plan(PlanCliOptions o, std::ostream& out) {
   const plan::PlanResult r = plan::plan(problem, o.planner_options, region ? &*region : nullptr);
 
   Json path = Json::array();
-  for (const auto& p : r.path) path.push_back(vec_json(p));
+  for (const auto& p : r.path) path.push_back(vec3_json(p));
   Json doc = {{"planner", o.planner},
               {"map", o.query.map},
-              {"start", vec_json(q.start)},
-              {"goal", vec_json(q.goal)},
+              {"start", vec3_json(q.start)},
+              {"goal", vec3_json(q.goal)},
               {"robot_radius", q.radius},
               {"seed", o.planner_options.seed},
               {"max_iterations", o.planner_options.max_iterations},
@@ -105,7 +105,7 @@ void run_plan(PlanCliOptions o, std::ostream& out) {
   if (o.timing) doc["time_ms"] = r.time_ms;
   if (o.tree) {
     Json vertices = Json::array();
-    for (const auto& v : r.tree_vertices) vertices.push_back(vec_json(v));
+    for (const auto& v : r.tree_vertices) vertices.push_back(vec3_json(v));
     doc["tree"] = {{"vertices", vertices}, {"parents", r.tree_parents}};
   }
 

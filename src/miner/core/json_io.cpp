@@ -96,6 +96,8 @@ Eigen::Vector3d JsonField::vec3() const {
   return {at(std::size_t{0}).number(), at(std::size_t{1}).number(), at(std::size_t{2}).number()};
 }
 
+Json vec3_json(const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); }
+
 void write_file_atomic(const std::string& path, const std::string& content) {
   namespace fs = std::filesystem;
   const fs::path target(path);

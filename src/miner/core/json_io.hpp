@@ -50,6 +50,9 @@ class JsonField {
   std::string origin_;
 };
 
+/// [x, y, z] as a JSON array: what JsonField::vec3 reads back.
+Json vec3_json(const Eigen::Vector3d& v);
+
 /// Writes `content` to `path` via a temporary file in the same folder and a rename,
 /// so readers see either the old file or the complete new one, never a mix.
 void write_file_atomic(const std::string& path, const std::string& content);

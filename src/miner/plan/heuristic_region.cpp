@@ -12,7 +12,6 @@ namespace miner::plan {
 
 namespace {
 
-Json vec_json(const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); }
 
 // Bounds are compared relative to the map's extent: files written with 17 significant
 // digits round-trip exactly, so anything above this is a different map, not rounding.
@@ -101,7 +100,7 @@ Json HeuristicRegion::to_json() const {
     else p.push_back(v);
   }
   return {{"format", kRegionFormat},
-          {"bounds", {{"min", vec_json(bounds_.min)}, {"max", vec_json(bounds_.max)}}},
+          {"bounds", {{"min", vec3_json(bounds_.min)}, {"max", vec3_json(bounds_.max)}}},
           {"dims", Json::array({dims_.x(), dims_.y(), dims_.z()})},
           {"threshold", threshold_},
           {"source", source_},

@@ -26,7 +26,6 @@ void validate_box(const Box& b, const std::string& what) {
   }
 }
 
-Json vec_json(const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); }
 
 std::string obstacle_name(std::size_t i, const Box& b) {
   return "obstacle " + std::to_string(i) + " [" + format_point(b.min) + " - " +
@@ -156,15 +155,15 @@ Map Map::load(const std::string& path) {
 Json Map::to_json() const {
   Json obstacles = Json::array();
   for (const Box& b : obstacles_) {
-    obstacles.push_back({{"type", "box"}, {"min", vec_json(b.min)}, {"max", vec_json(b.max)}});
+    obstacles.push_back({{"type", "box"}, {"min", vec3_json(b.min)}, {"max", vec3_json(b.max)}});
   }
   Json doc = {{"format", kMapFormat},
-              {"bounds", {{"min", vec_json(bounds_.min)}, {"max", vec_json(bounds_.max)}}},
+              {"bounds", {{"min", vec3_json(bounds_.min)}, {"max", vec3_json(bounds_.max)}}},
               {"resolution", resolution_},
               {"obstacles", obstacles}};
   if (query_) {
-    doc["query"] = {{"start", vec_json(query_->start)},
-                    {"goal", vec_json(query_->goal)},
+    doc["query"] = {{"start", vec3_json(query_->start)},
+                    {"goal", vec3_json(query_->goal)},
                     {"robot_radius", query_->robot_radius}};
   }
   return doc;

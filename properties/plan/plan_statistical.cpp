@@ -188,11 +188,11 @@ TEST_CASE("Shared contract: every planner solves the fixture queries", "[REQ-PLA
       const HeuristicRegion region = HeuristicRegion::from_path(map.bounds(), I(32, 32, 16), ref.points, 1, "astar");
       for (int trial = 0; trial < n; ++trial) {
         PlanResult r;
-        if (planner.rfind("ompl:", 0) == 0) {
+        if (miner::bench::is_ompl_planner(planner)) {
           miner::bench::OmplRunOptions o;
           o.planner = planner;
-          o.steer_step = 0.1 * (map.bounds().max - map.bounds().min).norm();
-          o.goal_radius = 2 * map.resolution();
+          o.steer_step = miner::plan::resolved_steer_step(PlannerOptions{}, map);
+          o.goal_radius = miner::plan::resolved_goal_radius(PlannerOptions{}, map);
           o.max_condition_checks = 20000;
           o.time_limit_s = 1e9;  // the condition-check budget decides
           o.stop_at_first = true;

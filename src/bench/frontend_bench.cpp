@@ -23,8 +23,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-bool is_ompl(const std::string& name) { return name.rfind("ompl:", 0) == 0; }
-
 /// NaN marks an unknown value: a statistic over a list with one is unknown too.
 bool any_unknown(const std::vector<double>& v) {
   return std::any_of(v.begin(), v.end(), [](double x) { return std::isnan(x); });
@@ -114,20 +112,20 @@ PlannerSummary summarise(const std::string& planner, const std::vector<RunRecord
   return s;
 }
 
-FrontendBenchResult run_frontend_bench(const std::string& map_path, const Eigen::Vector3d& start,
-                                       const Eigen::Vector3d& goal, double robot_radius,
-                                       const FrontendBenchOptions& options, std::ostream* progress) {
+FrontendBenchResult run_frontend_bench(const world::Map& map, const std::string& map_name,
+                                       const Eigen::Vector3d& start, const Eigen::Vector3d& goal,
+                                       double robot_radius, const FrontendBenchOptions& options,
+                                       std::ostream* progress) {
   if (options.runs < 1) throw Error("--runs: must be >= 1, got " + std::to_string(options.runs));
   if (!(options.target_factor > 0.0)) throw Error("--target-factor: must be > 0");
   const Clock::time_point campaign_start = Clock::now();
-  const world::Map map = world::Map::load(map_path);
   const plan::PlanningProblem problem = plan::PlanningProblem::make(map, start, goal, robot_radius);
   const plan::ReferencePath reference = plan::astar_reference(problem);
 
   FrontendBenchResult out;
   out.options = options;
   if (out.options.planners.empty()) out.options.planners = default_frontend_planners();
-  out.map = map_path;
+  out.map = map_name;
   out.start = start;
   out.goal = goal;
   out.robot_radius = robot_radius;
@@ -141,16 +139,15 @@ FrontendBenchResult run_frontend_bench(const std::string& map_path, const Eigen:
   base.stop_at_first = false;
   base.record_tree = false;
   // Resolve the defaults once so OMPL gets the same eta and goal radius.
-  const world::Box& b = map.bounds();
-  if (!(base.steer_step > 0.0)) base.steer_step = 0.1 * (b.max - b.min).norm();
-  if (!(base.goal_radius > 0.0)) base.goal_radius = 2.0 * map.resolution();
+  base.steer_step = plan::resolved_steer_step(base, map);
+  base.goal_radius = plan::resolved_goal_radius(base, map);
   out.steer_step = base.steer_step;
   out.goal_radius = base.goal_radius;
 
   const Clock::time_point region_start = Clock::now();
   const plan::HeuristicRegion region =
       options.region_file.empty()
-          ? plan::HeuristicRegion::from_path(b, options.region_dims, reference.points, options.region_dilation,
+          ? plan::HeuristicRegion::from_path(map.bounds(), options.region_dims, reference.points, options.region_dilation,
                                              "astar-dilated")
           : plan::HeuristicRegion::load(options.region_file);
   out.region_ms = std::chrono::duration<double, std::milli>(Clock::now() - region_start).count();
@@ -173,7 +170,7 @@ FrontendBenchResult run_frontend_bench(const std::string& map_path, const Eigen:
   };
 
   for (const std::string& name : out.options.planners) {
-    const bool ompl = is_ompl(name);
+    const bool ompl = is_ompl_planner(name);
     if (ompl) {
       const auto names = ompl_planner_names();
       if (std::find(names.begin(), names.end(), name) == names.end()) {

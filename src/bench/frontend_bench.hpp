@@ -20,6 +20,10 @@
 
 #include "miner/plan/rrt_star.hpp"
 
+namespace miner::world {
+class Map;
+}
+
 namespace miner::bench {
 
 struct FrontendBenchOptions {
@@ -84,10 +88,12 @@ struct FrontendBenchResult {
 /// The default planner list: rrtstar, informed, guided, miner, then OMPL's.
 std::vector<std::string> default_frontend_planners();
 
-/// Runs the campaign. `progress` (may be null) receives one line per planner.
-FrontendBenchResult run_frontend_bench(const std::string& map_path, const Eigen::Vector3d& start,
-                                       const Eigen::Vector3d& goal, double robot_radius,
-                                       const FrontendBenchOptions& options, std::ostream* progress);
+/// Runs the campaign on `map` (`map_name` labels the outputs). `progress` (may be null)
+/// receives one line per planner.
+FrontendBenchResult run_frontend_bench(const world::Map& map, const std::string& map_name,
+                                       const Eigen::Vector3d& start, const Eigen::Vector3d& goal,
+                                       double robot_radius, const FrontendBenchOptions& options,
+                                       std::ostream* progress);
 
 /// Summary of a planner's runs (exposed for tests).
 PlannerSummary summarise(const std::string& planner, const std::vector<RunRecord>& runs);

@@ -244,9 +244,7 @@ plan::PlanResult run_ompl(const plan::PlanningProblem& problem, const OmplRunOpt
         map.segment_free(result.path.back(), problem.goal, radius)) {
       result.path.push_back(problem.goal);
     }
-    double length = 0.0;
-    for (std::size_t i = 1; i < result.path.size(); ++i) length += (result.path[i] - result.path[i - 1]).norm();
-    result.cost = length;
+    result.cost = plan::path_length(result.path);
     result.solved = true;
     // Planners that stop at the target: the final counters are the target's.
     if (result.target && result.target->nodes == kUnknownCount && result.improvements.back().cost == result.target->cost) {

@@ -18,6 +18,8 @@ namespace miner::bench {
 /// "ompl:AITstar", "ompl:RRTConnect" (empty when built without OMPL).
 std::vector<std::string> ompl_planner_names();
 bool ompl_available();
+/// Whether `name` is in the OMPL namespace of planner names ("ompl:...").
+inline bool is_ompl_planner(const std::string& name) { return name.rfind("ompl:", 0) == 0; }
 
 struct OmplRunOptions {
   std::string planner;         ///< one of ompl_planner_names()

@@ -34,7 +34,7 @@ void run_frontend(const FrontendOptions& o, std::ostream& out) {
   bench::FrontendBenchOptions options = o.bench;
   options.region_dims = Eigen::Vector3i(o.region_dims[0], o.region_dims[1], o.region_dims[2]);
   // Progress goes to stderr so --json output stays clean.
-  const auto result = bench::run_frontend_bench(o.query.map, q.start, q.goal, q.radius, options,
+  const auto result = bench::run_frontend_bench(q.map, o.query.map, q.start, q.goal, q.radius, options,
                                                 o.quiet ? nullptr : &std::cerr);
   if (!o.ompl_log.empty()) {
     std::ostringstream log;

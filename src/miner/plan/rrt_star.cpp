@@ -48,9 +48,8 @@ class RrtStar {
   RrtStar(const PlanningProblem& problem, const PlannerOptions& options, const HeuristicRegion* region)
       : problem_(problem), map_(*problem.map), options_(options), region_(region),
         rng_(options.seed, options.stream) {
-    const world::Box& b = map_.bounds();
-    eta_ = options.steer_step > 0.0 ? options.steer_step : 0.1 * (b.max - b.min).norm();
-    goal_radius_ = options.goal_radius > 0.0 ? options.goal_radius : 2.0 * map_.resolution();
+    eta_ = resolved_steer_step(options, map_);
+    goal_radius_ = resolved_goal_radius(options, map_);
     gamma_ = options.rewire_factor * std::pow(2.0 * (1.0 + 1.0 / kDimension), 1.0 / kDimension) *
              std::pow(problem.free_volume / kUnitBallVolume, 1.0 / kDimension);
   }
@@ -288,9 +287,7 @@ PlanResult RrtStar::run() {
   if (best_vertex_ >= 0) {
     result_.solved = true;
     result_.path = path_to(static_cast<std::size_t>(best_vertex_));
-    double length = 0.0;
-    for (std::size_t i = 1; i < result_.path.size(); ++i) length += (result_.path[i] - result_.path[i - 1]).norm();
-    result_.cost = length;
+    result_.cost = path_length(result_.path);
   } else {
     std::ostringstream s;
     s << "no path to the goal region (radius " << goal_radius_ << " m) within " << iteration
@@ -306,6 +303,21 @@ PlanResult RrtStar::run() {
 }
 
 }  // namespace
+
+double resolved_steer_step(const PlannerOptions& options, const world::Map& map) {
+  const world::Box& b = map.bounds();
+  return options.steer_step > 0.0 ? options.steer_step : 0.1 * (b.max - b.min).norm();
+}
+
+double resolved_goal_radius(const PlannerOptions& options, const world::Map& map) {
+  return options.goal_radius > 0.0 ? options.goal_radius : 2.0 * map.resolution();
+}
+
+double path_length(const std::vector<Eigen::Vector3d>& path) {
+  double length = 0.0;
+  for (std::size_t i = 1; i < path.size(); ++i) length += (path[i] - path[i - 1]).norm();
+  return length;
+}
 
 std::string planner_name(PlannerKind kind) {
   switch (kind) {

@@ -73,6 +73,14 @@ struct PlannerOptions {
   bool record_tree = false;            ///< keep the final tree in the result
 };
 
+/// eta actually used: options.steer_step, or 0.1 x the diagonal of the map's bounds.
+double resolved_steer_step(const PlannerOptions& options, const world::Map& map);
+/// r of X_goal actually used: options.goal_radius, or 2 x the map's resolution.
+double resolved_goal_radius(const PlannerOptions& options, const world::Map& map);
+
+/// Euclidean length of a polyline (the cost of every path the front end reports).
+double path_length(const std::vector<Eigen::Vector3d>& path);
+
 /// A planning query after validation (REQ-PLAN-008): start and goal inside the bounds and
 /// at least robot_radius from every obstacle, with M(X_free) measured once.
 struct PlanningProblem {

@@ -58,8 +58,12 @@ std::vector<std::string> default_frontend_planners() {
 PlannerSummary summarise(const std::string& planner, const std::vector<RunRecord>& runs) {
   PlannerSummary s;
   s.planner = planner;
-  std::vector<double> fi, fn, fc, ft, ti, tn, tt, ti_all, tn_all, tt_all, final_cost;
+  // Per run; a run that missed a stage holds +inf there (NaN: a counter OMPL does not report).
+  std::vector<double> fi, fn, fc, ft, ti, tn, tt, final_cost;
   const double inf = std::numeric_limits<double>::infinity();
+  const auto count = [](std::size_t c) {
+    return c == kUnknownCount ? std::numeric_limits<double>::quiet_NaN() : static_cast<double>(c);
+  };
   int solved = 0, reached = 0;
   for (const RunRecord& r : runs) {
     if (r.planner != planner) continue;
@@ -69,24 +73,16 @@ PlannerSummary summarise(const std::string& planner, const std::vector<RunRecord
       ++solved;
       final_cost.push_back(res.cost);
     }
-    const auto count = [](std::size_t c) {
-      return c == kUnknownCount ? std::numeric_limits<double>::quiet_NaN() : static_cast<double>(c);
-    };
     if (res.first) {
       fi.push_back(count(res.first->iteration));
       fn.push_back(count(res.first->nodes));
       fc.push_back(res.first->cost);
       ft.push_back(res.first->time_ms);
     }
-    if (res.target) {
-      ++reached;
-      ti.push_back(count(res.target->iteration));
-      tn.push_back(count(res.target->nodes));
-      tt.push_back(res.target->time_ms);
-    }
-    ti_all.push_back(res.target ? count(res.target->iteration) : inf);
-    tn_all.push_back(res.target ? count(res.target->nodes) : inf);
-    tt_all.push_back(res.target ? res.target->time_ms : inf);
+    reached += res.target.has_value();
+    ti.push_back(res.target ? count(res.target->iteration) : inf);
+    tn.push_back(res.target ? count(res.target->nodes) : inf);
+    tt.push_back(res.target ? res.target->time_ms : inf);
   }
   if (s.runs == 0) return s;
   s.success_rate = static_cast<double>(solved) / s.runs;
@@ -99,15 +95,18 @@ PlannerSummary summarise(const std::string& planner, const std::vector<RunRecord
   s.first_nodes_mean = mean(fn);
   s.first_cost_mean = mean(fc);
   s.first_time_ms_mean = mean(ft);
-  // Fewer than half reached: the median is +inf, reported as null.
-  if (2 * reached >= s.runs) {
-    s.target_iterations = median(ti_all);
-    s.target_nodes = median(tn_all);
-    s.target_time_ms = median(tt_all);
-  }
-  s.target_iterations_mean = mean(ti);
-  s.target_nodes_mean = mean(tn);
-  s.target_time_ms_mean = mean(tt);
+  // A median that lands on a missed run (fewer than half reached) is infinite: median()
+  // reports it as unknown (null).
+  s.target_iterations = median(ti);
+  s.target_nodes = median(tn);
+  s.target_time_ms = median(tt);
+  const auto reached_only = [](std::vector<double> v) {
+    v.erase(std::remove(v.begin(), v.end(), std::numeric_limits<double>::infinity()), v.end());
+    return v;
+  };
+  s.target_iterations_mean = mean(reached_only(ti));
+  s.target_nodes_mean = mean(reached_only(tn));
+  s.target_time_ms_mean = mean(reached_only(tt));
   s.final_cost = median(final_cost);
   return s;
 }

@@ -114,6 +114,7 @@ class RrtStar {
   std::vector<std::size_t> near_;
   std::vector<std::pair<double, std::size_t>> candidates_;
   std::vector<signed char> checked_;  // per candidate: -1 unknown, 0 blocked, 1 free
+  std::vector<std::uint32_t> propagate_stack_;
 };
 
 Eigen::Vector3d RrtStar::sample() {
@@ -159,7 +160,8 @@ void RrtStar::set_parent(std::size_t v, std::size_t parent, double cost) {
 }
 
 void RrtStar::propagate_cost(std::size_t v) {
-  std::vector<std::uint32_t> stack(children_[v].begin(), children_[v].end());
+  auto& stack = propagate_stack_;
+  stack.assign(children_[v].begin(), children_[v].end());
   while (!stack.empty()) {
     const std::uint32_t c = stack.back();
     stack.pop_back();

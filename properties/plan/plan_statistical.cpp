@@ -10,6 +10,7 @@
 #include "miner/plan/reference.hpp"
 #include "miner/plan/rrt_star.hpp"
 #include "miner/testing/binomial.hpp"
+#include "miner/testing/door_maps.hpp"
 #include "miner/world/map.hpp"
 
 using miner::plan::HeuristicRegion;
@@ -19,22 +20,18 @@ using miner::plan::PlanningProblem;
 using miner::plan::PlanResult;
 using miner::testing::kFalseFailRate;
 using miner::testing::min_successes;
-using miner::world::Box;
 using V = Eigen::Vector3d;
 using I = Eigen::Vector3i;
 
 namespace {
 
-/// 10 x 10 x 3 m; a wall x in [4, 5] with one door y in [7.5, 9], z in [0, 1.5].
-miner::world::Map door_map() {
-  return miner::world::Map(Box{{0, 0, 0}, {10, 10, 3}}, 0.5,
-                           {Box{{4, 0, 0}, {5, 7.5, 3}}, Box{{4, 9, 0}, {5, 10, 3}}, Box{{4, 7.5, 1.5}, {5, 9, 3}}});
-}
+using miner::testing::wall_with_door_map;
 const V kStart(1, 1, 0.5), kGoal(9, 1, 0.5);
 
-/// The optimum of door_map() for a point robot from kStart to kGoal. A path must cross the
-/// planes x = 4 and x = 5 inside the door; projecting it onto z = 0.5 (where both ends
-/// lie, inside the door's z range) shortens no segment, so its length is at least
+/// The optimum of wall_with_door_map() (door y in [7.5, 9], z in [0, 1.5]) for a point
+/// robot from kStart to kGoal. A path must cross the planes x = 4 and x = 5 inside the
+/// door; projecting it onto z = 0.5 (where both ends lie, inside the door's z range)
+/// shortens no segment, so its length is at least
 /// min over y1, y2 in [7.5, 9] of |(3, y1 - 1)| + |(1, y2 - y1)| + |(4, y2 - 1)|, which
 /// increases in y1 and y2 there: the bound is attained at y1 = y2 = 7.5 (the door's
 /// corner edge), so it is the optimum c* itself.
@@ -48,7 +45,7 @@ double median(std::vector<double> v) {
 }  // namespace
 
 TEST_CASE("Lemma 1: miner with a region that holds no path still solves within K iterations", "[REQ-PLAN-012]") {
-  const auto map = door_map();
+  const auto map = wall_with_door_map();
   const auto problem = PlanningProblem::make(map, kStart, kGoal, 0.0);
   // Adversarial H: the start's side of the wall away from the door, x in [0, 4), y in
   // [0, 5): it holds no path to the goal, yet mu_2 = 0.9 sends 90 % of samples there.
@@ -88,7 +85,7 @@ TEST_CASE("Lemma 1: miner with a region that holds no path still solves within K
 }
 
 TEST_CASE("Under common random numbers, solved after K1 iterations implies solved after K2", "[REQ-PLAN-013]") {
-  const auto map = door_map();
+  const auto map = wall_with_door_map();
   const auto problem = PlanningProblem::make(map, kStart, kGoal, 0.0);
   const auto ref = miner::plan::astar_reference(problem);
   const HeuristicRegion region = HeuristicRegion::from_path(map.bounds(), I(10, 10, 3), ref.points, 1, "astar");
@@ -122,7 +119,7 @@ TEST_CASE("Under common random numbers, solved after K1 iterations implies solve
 }
 
 TEST_CASE("Lemma 2: the median cost falls toward the optimum and never below it", "[REQ-PLAN-014]") {
-  const auto map = door_map();
+  const auto map = wall_with_door_map();
   const auto problem = PlanningProblem::make(map, kStart, kGoal, 0.0);
   const auto ref = miner::plan::astar_reference(problem);
   const HeuristicRegion region = HeuristicRegion::from_path(map.bounds(), I(10, 10, 3), ref.points, 1, "astar");

@@ -89,7 +89,7 @@ TEST_CASE("The A*-dilated region covers the path and its 3x3x3 neighbourhood", "
 }
 
 TEST_CASE("A region must match the map's bounds and hold at least one cell", "[REQ-PLAN-008]") {
-  const auto map = miner::plan::test::wall_with_door_map();  // bounds [0,10] x [0,10] x [0,3]
+  const auto map = miner::testing::wall_with_door_map();  // bounds [0,10] x [0,10] x [0,3]
   const HeuristicRegion wrong = two_cells();
   CHECK_THROWS_WITH(wrong.require_matches(map, "planner miner"),
                     Contains("do not match the map's bounds") && Contains("(10, 10, 3)"));

@@ -34,7 +34,7 @@ HeuristicRegion astar_region(const PlanningProblem& problem) {
 }  // namespace
 
 TEST_CASE("Every planner returns a collision-free path from start to goal whose cost is its length", "[REQ-PLAN-001][REQ-PLAN-004][REQ-PLAN-009]") {
-  const auto map = miner::plan::test::wall_with_door_map();
+  const auto map = miner::testing::wall_with_door_map();
   const auto problem = PlanningProblem::make(map, V(1, 1, 0.5), V(9, 1, 0.5), 0.1);
   const HeuristicRegion region = astar_region(problem);
   for (PlannerKind kind : miner::plan::all_planners()) {
@@ -88,7 +88,7 @@ TEST_CASE("Every planner returns a collision-free path from start to goal whose 
 TEST_CASE("Informed and guided RRT* sample like RRT* until the first solution", "[REQ-PLAN-002][REQ-PLAN-003]") {
   // Both switch sampler only once c_best exists, so under common random numbers their
   // first solution is RRT*'s to the bit; afterwards they converge faster.
-  const auto map = miner::plan::test::wall_with_door_map();
+  const auto map = miner::testing::wall_with_door_map();
   const auto problem = PlanningProblem::make(map, V(1, 1, 0.5), V(9, 1, 0.5), 0.1);
   PlannerOptions o;
   o.max_iterations = 4000;
@@ -110,7 +110,7 @@ TEST_CASE("Informed and guided RRT* sample like RRT* until the first solution", 
 }
 
 TEST_CASE("Planning is deterministic for a seed and stream and differs across streams", "[REQ-PLAN-007]") {
-  const auto map = miner::plan::test::wall_with_door_map();
+  const auto map = miner::testing::wall_with_door_map();
   const auto problem = PlanningProblem::make(map, V(1, 1, 0.5), V(9, 1, 0.5), 0.1);
   const HeuristicRegion region = astar_region(problem);
   for (PlannerKind kind : miner::plan::all_planners()) {
@@ -131,7 +131,7 @@ TEST_CASE("Planning is deterministic for a seed and stream and differs across st
 }
 
 TEST_CASE("Planning stops at the first solution or at the target cost when asked", "[REQ-PLAN-001][REQ-PLAN-009]") {
-  const auto map = miner::plan::test::wall_with_door_map();
+  const auto map = miner::testing::wall_with_door_map();
   const auto problem = PlanningProblem::make(map, V(1, 1, 0.5), V(9, 1, 0.5), 0.1);
   PlannerOptions o;
   o.max_iterations = 20000;
@@ -155,7 +155,7 @@ TEST_CASE("Planning stops at the first solution or at the target cost when asked
 }
 
 TEST_CASE("Start or goal out of bounds or in collision is refused before planning", "[REQ-PLAN-008]") {
-  const auto map = miner::plan::test::wall_with_door_map();
+  const auto map = miner::testing::wall_with_door_map();
   CHECK_THROWS_WITH(PlanningProblem::make(map, V(4.5, 2, 1), V(9, 1, 0.5), 0.1), Contains("start"));
   CHECK_THROWS_WITH(PlanningProblem::make(map, V(1, 1, 0.5), V(11, 1, 0.5), 0.1), Contains("goal"));
   CHECK_THROWS_WITH(PlanningProblem::make(map, V(3.95, 1, 0.5), V(9, 1, 0.5), 0.1), Contains("start"));
@@ -168,7 +168,7 @@ TEST_CASE("Start or goal out of bounds or in collision is refused before plannin
 }
 
 TEST_CASE("An unreachable goal ends within the budget with a reason", "[REQ-PLAN-008]") {
-  const auto map = miner::plan::test::closed_wall_map();
+  const auto map = miner::testing::closed_wall_map();
   const auto problem = PlanningProblem::make(map, V(1, 1, 0.5), V(9, 1, 0.5), 0.1);
   const HeuristicRegion region(map.bounds(), I(10, 10, 3), std::vector<double>(300, 1.0), 0.5, "all");
   for (PlannerKind kind : miner::plan::all_planners()) {
@@ -184,7 +184,7 @@ TEST_CASE("An unreachable goal ends within the budget with a reason", "[REQ-PLAN
 }
 
 TEST_CASE("Invalid planner options and a missing or mismatched region are refused", "[REQ-PLAN-007][REQ-PLAN-008]") {
-  const auto map = miner::plan::test::wall_with_door_map();
+  const auto map = miner::testing::wall_with_door_map();
   const auto problem = PlanningProblem::make(map, V(1, 1, 0.5), V(9, 1, 0.5), 0.1);
   PlannerOptions o;
   o.planner = PlannerKind::kMiner;
@@ -219,7 +219,7 @@ TEST_CASE("Invalid planner options and a missing or mismatched region are refuse
 }
 
 TEST_CASE("A start inside the goal region is solved at once", "[REQ-PLAN-001]") {
-  const auto map = miner::plan::test::wall_with_door_map();
+  const auto map = miner::testing::wall_with_door_map();
   const auto problem = PlanningProblem::make(map, V(1, 1, 0.5), V(1.5, 1, 0.5), 0.1);
   PlannerOptions o;
   o.stop_at_first = true;

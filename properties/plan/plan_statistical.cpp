@@ -88,7 +88,7 @@ TEST_CASE("Under common random numbers, solved after K1 iterations implies solve
   const auto map = wall_with_door_map();
   const auto problem = PlanningProblem::make(map, kStart, kGoal, 0.0);
   const auto ref = miner::plan::astar_reference(problem);
-  const HeuristicRegion region = HeuristicRegion::from_path(map.bounds(), I(10, 10, 3), ref.points, 1, "astar");
+  const HeuristicRegion region = miner::plan::astar_dilated_region(problem, ref, I(10, 10, 3), 1);
   const std::size_t K1 = 150, K2 = 600;
   int solved_k1 = 0, solved_k2 = 0;
   for (PlannerKind kind : miner::plan::all_planners()) {
@@ -122,7 +122,7 @@ TEST_CASE("Lemma 2: the median cost falls toward the optimum and never below it"
   const auto map = wall_with_door_map();
   const auto problem = PlanningProblem::make(map, kStart, kGoal, 0.0);
   const auto ref = miner::plan::astar_reference(problem);
-  const HeuristicRegion region = HeuristicRegion::from_path(map.bounds(), I(10, 10, 3), ref.points, 1, "astar");
+  const HeuristicRegion region = miner::plan::astar_dilated_region(problem, ref, I(10, 10, 3), 1);
   const double c_star = door_optimum();
   REQUIRE(ref.cost > c_star);
   const std::vector<std::size_t> budgets{250, 1000, 4000};
@@ -182,7 +182,7 @@ TEST_CASE("Shared contract: every planner solves the fixture queries", "[REQ-PLA
       const auto& q = *map.query();
       const auto problem = PlanningProblem::make(map, q.start, q.goal, q.robot_radius);
       const auto ref = miner::plan::astar_reference(problem);
-      const HeuristicRegion region = HeuristicRegion::from_path(map.bounds(), I(32, 32, 16), ref.points, 1, "astar");
+      const HeuristicRegion region = miner::plan::astar_dilated_region(problem, ref, I(32, 32, 16), 1);
       for (int trial = 0; trial < n; ++trial) {
         PlanResult r;
         if (miner::bench::is_ompl_planner(planner)) {

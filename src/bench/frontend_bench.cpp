@@ -146,8 +146,7 @@ FrontendBenchResult run_frontend_bench(const world::Map& map, const std::string&
   const Clock::time_point region_start = Clock::now();
   const plan::HeuristicRegion region =
       options.region_file.empty()
-          ? plan::HeuristicRegion::from_path(map.bounds(), options.region_dims, reference.points, options.region_dilation,
-                                             "astar-dilated")
+          ? plan::astar_dilated_region(problem, reference, options.region_dims, options.region_dilation)
           : plan::HeuristicRegion::load(options.region_file);
   out.region_ms = std::chrono::duration<double, std::milli>(Clock::now() - region_start).count();
   region.require_matches(map, "bench frontend");

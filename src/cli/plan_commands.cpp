@@ -71,8 +71,7 @@ void run_plan(PlanCliOptions o, std::ostream& out) {
       region = plan::HeuristicRegion::load(o.region);
     } else {
       const Eigen::Vector3i dims(o.grid.dims[0], o.grid.dims[1], o.grid.dims[2]);
-      region = plan::HeuristicRegion::from_path(q.map.bounds(), dims, need_reference().points,
-                                                o.grid.dilation, "astar-dilated");
+      region = plan::astar_dilated_region(problem, need_reference(), dims, o.grid.dilation);
     }
   }
   const plan::PlanResult r = plan::plan(problem, o.planner_options, region ? &*region : nullptr);
@@ -145,8 +144,7 @@ void run_region_astar(const RegionCliOptions& o, std::ostream& out) {
   const plan::PlanningProblem problem = plan::PlanningProblem::make(q.map, q.start, q.goal, q.radius);
   const plan::ReferencePath reference = plan::astar_reference(problem);
   const Eigen::Vector3i dims(o.grid.dims[0], o.grid.dims[1], o.grid.dims[2]);
-  const auto region = plan::HeuristicRegion::from_path(q.map.bounds(), dims, reference.points, o.grid.dilation,
-                                                       "astar-dilated");
+  const auto region = plan::astar_dilated_region(problem, reference, dims, o.grid.dilation);
   region.save(o.out);
   out << "wrote " << o.out << ": " << region.cells().size() << " of " << dims.prod()
       << " cells around the A* path (cost " << std::fixed << std::setprecision(3) << reference.cost << " m)\n";

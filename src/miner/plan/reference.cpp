@@ -12,6 +12,11 @@ ReferencePath astar_reference(const PlanningProblem& problem) {
   return {path.points, path.cost};
 }
 
+HeuristicRegion astar_dilated_region(const PlanningProblem& problem, const ReferencePath& reference,
+                                     const Eigen::Vector3i& dims, int dilation) {
+  return HeuristicRegion::from_path(problem.map->bounds(), dims, reference.points, dilation, "astar-dilated");
+}
+
 double straight_line_bound(const PlanningProblem& problem) { return (problem.goal - problem.start).norm(); }
 
 }  // namespace miner::plan

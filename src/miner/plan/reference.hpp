@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 
+#include "miner/plan/heuristic_region.hpp"
 #include "miner/plan/rrt_star.hpp"
 
 namespace miner::plan {
@@ -22,6 +23,11 @@ struct ReferencePath {
 /// map's resolution, inflated by the robot radius. Every segment of the result is
 /// collision-free in the continuous map. Throws miner::NoSolution if the grid has no path.
 ReferencePath astar_reference(const PlanningProblem& problem);
+
+/// The A*-dilated ground-truth region (source "astar-dilated") over the problem's map:
+/// HeuristicRegion::from_path of the reference path on a dims grid.
+HeuristicRegion astar_dilated_region(const PlanningProblem& problem, const ReferencePath& reference,
+                                     const Eigen::Vector3i& dims, int dilation);
 
 /// |x_goal - x_init|: a lower bound on the cost of every path of the problem.
 double straight_line_bound(const PlanningProblem& problem);

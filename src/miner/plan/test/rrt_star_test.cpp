@@ -27,8 +27,7 @@ double path_length(const std::vector<V>& path) {
 }
 
 HeuristicRegion astar_region(const PlanningProblem& problem) {
-  const auto ref = miner::plan::astar_reference(problem);
-  return HeuristicRegion::from_path(problem.map->bounds(), I(10, 10, 3), ref.points, 1, "astar-dilated");
+  return miner::plan::astar_dilated_region(problem, miner::plan::astar_reference(problem), I(10, 10, 3), 1);
 }
 
 }  // namespace

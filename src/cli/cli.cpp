@@ -76,6 +76,7 @@ int run_cli(const std::vector<std::string>& args, std::ostream& out, std::ostrea
   add_traj_commands(app, out);
   add_bench_commands(app, out);
   add_plan_commands(app, out);
+  add_fly_commands(app, out);
 
   // CLI11 parses in reverse order of the vector it is given.
   std::vector<std::string> reversed(args.rbegin(), args.rend());

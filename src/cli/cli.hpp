@@ -64,5 +64,7 @@ void add_traj_commands(CLI::App& app, std::ostream& out);
 void add_bench_commands(CLI::App& app, std::ostream& out);
 /// Registers `miner plan` and `miner region ...` (plan_commands.cpp).
 void add_plan_commands(CLI::App& app, std::ostream& out);
+/// Registers `miner fly` and `miner bench sim` (fly_commands.cpp); after the bench commands.
+void add_fly_commands(CLI::App& app, std::ostream& out);
 
 }  // namespace miner::cli

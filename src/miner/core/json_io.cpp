@@ -124,6 +124,51 @@ void write_file_atomic(const std::string& path, const std::string& content) {
   }
 }
 
+void write_folder_atomic(const std::string& path, const std::vector<std::pair<std::string, std::string>>& files) {
+  namespace fs = std::filesystem;
+  const fs::path target = fs::path(path).lexically_normal();
+  if (target.empty() || target.filename().empty()) throw Error(path + ": not a folder name");
+  const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  std::error_code ec;
+  fs::create_directories(parent, ec);
+  if (ec || !fs::is_directory(parent)) throw Error(path + ": cannot create parent folder " + parent.string());
+  if (fs::exists(target, ec) && !fs::is_directory(target, ec))
+    throw Error(path + ": exists and is not a folder; refusing to replace it");
+  const std::string pid = std::to_string(::getpid());
+  const fs::path partial = parent / ("." + target.filename().string() + ".partial." + pid);
+  const fs::path old = parent / ("." + target.filename().string() + ".old." + pid);
+  fs::remove_all(partial, ec);
+  if (!fs::create_directory(partial, ec)) throw Error(path + ": cannot create " + partial.string());
+  try {
+    for (const auto& [name, content] : files) {
+      std::ofstream out(partial / name, std::ios::binary | std::ios::trunc);
+      out << content;
+      out.flush();
+      if (!out) throw Error(path + ": writing " + name + " failed");
+    }
+  } catch (...) {
+    fs::remove_all(partial, ec);
+    throw;
+  }
+  // Swap: the old folder stays whole until the new one is complete and in place.
+  const bool had_old = fs::exists(target, ec);
+  if (had_old) {
+    fs::rename(target, old, ec);
+    if (ec) {
+      fs::remove_all(partial, ec);
+      throw Error(path + ": cannot move the previous run folder aside");
+    }
+  }
+  fs::rename(partial, target, ec);
+  if (ec) {
+    std::error_code ignored;
+    if (had_old) fs::rename(old, target, ignored);
+    fs::remove_all(partial, ignored);
+    throw Error(path + ": cannot move the new run folder in place: " + ec.message());
+  }
+  if (had_old) fs::remove_all(old, ec);
+}
+
 std::string dump_json(const Json& j) { return j.dump(2) + "\n"; }
 
 }  // namespace miner

@@ -5,6 +5,8 @@
 /// REQ-CORE-004).
 
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
@@ -56,6 +58,12 @@ Json vec3_json(const Eigen::Vector3d& v);
 /// Writes `content` to `path` via a temporary file in the same folder and a rename,
 /// so readers see either the old file or the complete new one, never a mix.
 void write_file_atomic(const std::string& path, const std::string& content);
+
+/// Writes `files` (name, content) into the folder `path` as a whole: they are written to
+/// a hidden sibling folder first, which then replaces `path` (the previous folder is moved
+/// aside and removed only once the new one is in place), so a good run folder is never
+/// half-overwritten. Creates missing parent folders.
+void write_folder_atomic(const std::string& path, const std::vector<std::pair<std::string, std::string>>& files);
 
 /// JSON text as the project writes it: 2-space indent, trailing newline.
 std::string dump_json(const Json& j);

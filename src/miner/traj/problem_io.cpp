@@ -55,4 +55,29 @@ Json answer_to_json(const PolynomialTrajectory& t) {
           {"coefficients", coefficients}};
 }
 
+PolynomialTrajectory trajectory_from_answer_json(const Json& doc, const std::string& origin) {
+  const JsonField root(doc, "", origin);
+  const JsonField order_field = root.at("order");
+  const int order = order_field.integer();
+  if (order != 3 && order != 4) order_field.fail("must be 3 (jerk) or 4 (snap)");
+  const JsonField durations_field = root.at("durations");
+  const JsonField coefficients_field = root.at("coefficients");
+  const std::size_t m = durations_field.array_size();
+  if (m == 0) durations_field.fail("needs at least one segment");
+  if (coefficients_field.array_size() != m)
+    coefficients_field.fail("has " + std::to_string(coefficients_field.array_size()) +
+                            " segments but durations has " + std::to_string(m));
+  std::vector<double> durations(m);
+  Eigen::MatrixX3d c(2 * order * static_cast<Eigen::Index>(m), 3);
+  for (std::size_t i = 0; i < m; ++i) {
+    durations[i] = durations_field.at(i).positive_number();
+    const JsonField seg = coefficients_field.at(i);
+    if (seg.array_size() != static_cast<std::size_t>(2 * order))
+      seg.fail("needs 2s = " + std::to_string(2 * order) + " rows of [x, y, z]");
+    for (int r = 0; r < 2 * order; ++r)
+      c.row(2 * order * static_cast<Eigen::Index>(i) + r) = seg.at(static_cast<std::size_t>(r)).vec3().transpose();
+  }
+  return PolynomialTrajectory(order, std::move(durations), std::move(c));
+}
+
 }  // namespace miner::traj

@@ -21,4 +21,8 @@ MincoProblem problem_from_json(const Json& doc, const std::string& origin);
 
 Json answer_to_json(const PolynomialTrajectory& trajectory);
 
+/// Reads an answer back (what answer_to_json wrote): order 3 or 4, positive finite
+/// durations, M segments of 2s finite rows each. Errors name the field.
+PolynomialTrajectory trajectory_from_answer_json(const Json& doc, const std::string& origin);
+
 }  // namespace miner::traj

@@ -1,0 +1,109 @@
+// `miner fly` (REQ-FLIGHT-009) and `miner bench sim` (REQ-FLIGHT-010).
+#include <iomanip>
+#include <memory>
+#include <ostream>
+#include <sstream>
+
+#include <CLI/CLI.hpp>
+
+#include "bench/sim_bench.hpp"
+#include "cli/cli.hpp"
+#include "miner/core/error.hpp"
+#include "miner/flight/closed_loop.hpp"
+#include "miner/traj/problem_io.hpp"
+
+namespace miner::cli {
+
+namespace {
+
+struct ScenarioOptions {
+  std::string scenario;  ///< empty: the embedded default
+  long long seed = -1;   ///< < 0: the scenario's
+};
+
+void add_scenario_options(CLI::App* cmd, ScenarioOptions& o) {
+  cmd->add_option("--scenario", o.scenario, "miner-scenario-v1 file (default: the embedded indoor-1 scenario)");
+  cmd->add_option("--seed", o.seed, "override the scenario's seed")->check(CLI::NonNegativeNumber);
+}
+
+flight::Scenario resolve_scenario(const ScenarioOptions& o) {
+  flight::Scenario s = o.scenario.empty() ? flight::default_scenario() : flight::load_scenario(o.scenario);
+  if (o.seed >= 0) s.seed = static_cast<std::uint64_t>(o.seed);
+  return s;
+}
+
+struct FlyCliOptions {
+  ScenarioOptions scenario;
+  std::string out;
+  bool ground_truth = false;
+  bool json = false;
+};
+
+void run_fly(const FlyCliOptions& o, std::ostream& out) {
+  const flight::Scenario s = resolve_scenario(o.scenario);
+  const flight::ReferencePlan reference = flight::build_reference(s);
+  flight::FlyOptions options;
+  options.use_ground_truth = o.ground_truth;
+  const flight::FlightResult r = flight::fly(s, reference, options);
+
+  const std::string dir = o.out.empty() ? "runs/" + s.name + "-seed" + std::to_string(s.seed) : o.out;
+  Json summary = r.summary;
+  summary["run_folder"] = dir;
+  Json path = Json::array();
+  for (Eigen::Index i = 0; i < reference.path.rows(); ++i) path.push_back(vec3_json(reference.path.row(i).transpose()));
+  write_folder_atomic(dir, {{"summary.json", dump_json(r.summary)},
+                            {"trajectory.json", dump_json(traj::answer_to_json(reference.trajectory))},
+                            {"path.json", dump_json(Json{{"source", reference.source}, {"points", path}})},
+                            {"flight_log.csv", flight::flight_log_csv(r)}});
+  if (o.json) {
+    out << dump_json(summary);
+  } else {
+    out << "flew " << s.name << " (seed " << s.seed << ", controller on the "
+        << (o.ground_truth ? "GROUND TRUTH (diagnostic)" : "EKF estimate") << "): reference from "
+        << reference.source << ", " << reference.trajectory.segments() << " segments, " << std::fixed
+        << std::setprecision(2) << reference.trajectory.total_duration() << " s\n"
+        << flight::tracking_table(s.name, r) << std::setprecision(3) << "max position error " << r.max_position_error
+        << " m, estimate RMSE " << r.estimation_rmse << " m, collisions " << r.collisions << ", goal "
+        << (r.goal_reached ? "reached" : "NOT reached") << " (" << r.final_position_error << " m off)\n"
+        << "wrote " << dir << "/{summary.json,trajectory.json,path.json,flight_log.csv}\n";
+  }
+  if (!r.goal_reached)
+    throw NoSolution("the flight did not reach the goal (final error " + std::to_string(r.final_position_error) +
+                     " m, speed " + std::to_string(r.final_speed) + " m/s, collisions " +
+                     std::to_string(r.collisions) + ")");
+}
+
+struct SimBenchCliOptions {
+  ScenarioOptions scenario;
+  bench::SimBenchOptions bench;
+  OutputOptions output;
+};
+
+}  // namespace
+
+void add_fly_commands(CLI::App& app, std::ostream& out) {
+  auto o = std::make_shared<FlyCliOptions>();
+  CLI::App* fly = app.add_subcommand("fly", "fly a scenario in closed loop: reference -> SE(3) PID -> N3 -> CVODE -> EKF");
+  add_scenario_options(fly, o->scenario);
+  fly->add_option("--out", o->out, "run folder (default runs/<scenario>-seed<seed>)");
+  fly->add_flag("--ground-truth", o->ground_truth, "diagnostic: the controller reads the true state, not the EKF");
+  fly->add_flag("--json", o->json, "print the summary as JSON");
+  fly->callback([o, &out] { run_fly(*o, out); });
+
+  CLI::App* bench_cmd = app.get_subcommand("bench");
+  auto b = std::make_shared<SimBenchCliOptions>();
+  CLI::App* sim = bench_cmd->add_subcommand("sim", "real-time factor of the full flight loop on one core");
+  add_scenario_options(sim, b->scenario);
+  sim->add_option("--runs", b->bench.runs, "flights to time")->capture_default_str()->check(CLI::PositiveNumber);
+  sim->add_option("--rtol", b->bench.relative_tolerance, "CVODE relative tolerance")->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  add_output_options(sim, b->output);
+  sim->callback([b, &out] {
+    const auto r = bench::run_sim_bench(resolve_scenario(b->scenario), b->bench);
+    std::ostringstream table;
+    bench::print_table(r, table);
+    emit(b->output, bench::to_json(r), table.str(), out);
+  });
+}
+
+}  // namespace miner::cli

@@ -1,0 +1,261 @@
+#include "miner/flight/closed_loop.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <deque>
+#include <sstream>
+
+#include <Eigen/Cholesky>
+
+#include "miner/core/error.hpp"
+#include "miner/core/rng.hpp"
+#include "miner/flight/controller.hpp"
+#include "miner/flight/ekf.hpp"
+#include "miner/flight/flatness.hpp"
+#include "miner/flight/n3.hpp"
+#include "miner/flight/sensors.hpp"
+
+namespace miner::flight {
+
+const std::vector<std::string>& flight_log_columns() {
+  static const std::vector<std::string> columns = [] {
+    std::vector<std::string> c{"t"};
+    auto add3 = [&](const std::string& prefix, const char* a, const char* b, const char* d) {
+      c.push_back(prefix + a);
+      c.push_back(prefix + b);
+      c.push_back(prefix + d);
+    };
+    add3("ref_", "x", "y", "z");
+    add3("ref_", "vx", "vy", "vz");
+    add3("true_", "x", "y", "z");
+    add3("true_", "vx", "vy", "vz");
+    add3("true_", "roll", "pitch", "yaw");
+    add3("est_", "x", "y", "z");
+    add3("est_", "vx", "vy", "vz");
+    add3("est_", "roll", "pitch", "yaw");
+    add3("est_ba_", "x", "y", "z");
+    add3("est_bg_", "x", "y", "z");
+    add3("true_ba_", "x", "y", "z");
+    add3("true_bg_", "x", "y", "z");
+    for (const char* n : {"cmd_roll", "cmd_pitch", "cmd_thrust_pct", "cmd_yaw"}) c.emplace_back(n);
+    for (const char* n : {"rotor_0", "rotor_1", "rotor_2", "rotor_3"}) c.emplace_back(n);
+    c.emplace_back("failsafe");
+    c.emplace_back("collision");
+    return c;
+  }();
+  return columns;
+}
+
+namespace {
+
+void append(std::vector<double>& row, const Eigen::Vector3d& v) { row.insert(row.end(), {v.x(), v.y(), v.z()}); }
+void append_euler(std::vector<double>& row, const Eigen::Quaterniond& q) {
+  const Euler e = euler_zyx(q.toRotationMatrix());
+  row.insert(row.end(), {e.roll, e.pitch, e.yaw});
+}
+
+Json vec_json(const Eigen::Vector3d& v) { return vec3_json(v); }
+
+}  // namespace
+
+FlightResult fly(const Scenario& s, const ReferencePlan& reference, const FlyOptions& options) {
+  FlightResult out;
+  const double dt = 1.0 / s.n3.rate_hz;
+  const int control_every = static_cast<int>(std::lround(s.n3.rate_hz / s.controller.rate_hz));
+  const int pose_every = static_cast<int>(std::lround(s.n3.rate_hz / s.pose.rate_hz));
+  const int delay_ticks = static_cast<int>(std::lround(s.pose.delay_s / dt));
+  const double control_dt = control_every * dt;
+  const auto& trajectory = reference.trajectory;
+  const double t_traj = trajectory.total_duration();
+  const long total_ticks = static_cast<long>(std::ceil((t_traj + s.hover_after_s) / dt));
+
+  Rng imu_rng(s.seed, 1), pose_rng(s.seed, 2), init_rng(s.seed, 3);
+  QuadState truth = hover_state(s.vehicle, s.start, 0.0);
+  ImuModel imu(s.imu, dt, imu_rng);
+  NavState estimate0;
+  estimate0.p = truth.p + normal3(init_rng, s.ekf.initial_position_sigma);
+  estimate0.v = truth.v + normal3(init_rng, s.ekf.initial_velocity_sigma);
+  estimate0.q = (truth.q * quat_exp(normal3(init_rng, s.ekf.initial_attitude_sigma))).normalized();
+  Ekf ekf(s.ekf, dt, delay_ticks, estimate0, initial_covariance(s.ekf));
+  n3::FlightController fc(s.vehicle, s.n3);
+  fc.obtain_control(0.0);
+  Se3Controller controller(s.vehicle, s.controller);
+  Integrator integrator(s.vehicle, options.integrator);
+  const Mixer mixer(s.vehicle);
+
+  std::deque<std::pair<long, PoseMeasurement>> in_transit;
+  std::deque<std::pair<long, NavState>> truth_history;  // for NEES at the horizon
+  Eigen::Vector3d sum_p2 = Eigen::Vector3d::Zero(), sum_v2 = Eigen::Vector3d::Zero();
+  double sum_est2 = 0.0;
+  long tracked = 0, estimated = 0;
+  bool was_colliding = false;
+  n3::Command last_command;
+
+  for (long k = 0; k < total_ticks; ++k) {
+    const double t = static_cast<double>(k) * dt;
+    const Eigen::Vector3d accel = acceleration(s.vehicle, mixer, truth);
+    NavState truth_nav{truth.p, truth.v, truth.q, imu.accel_bias(), imu.gyro_bias()};
+    if (options.record_consistency) {
+      truth_history.emplace_back(k, truth_nav);
+      while (truth_history.size() > static_cast<std::size_t>(delay_ticks + 2)) truth_history.pop_front();
+    }
+    ekf.push_imu(k, imu.sample(truth.q, truth.omega, accel));
+    if (k % pose_every == 0) {
+      PoseMeasurement m = measure_pose(s.pose, t, truth.p, truth.q, pose_rng);
+      out.outliers_injected += m.outlier ? 1 : 0;
+      in_transit.emplace_back(k + delay_ticks, m);
+    }
+    while (!in_transit.empty() && in_transit.front().first <= k) {
+      const FuseResult r = ekf.push_pose(in_transit.front().second);
+      if (in_transit.front().second.outlier && !r.accepted && !r.stale) ++out.outliers_rejected;
+      in_transit.pop_front();
+    }
+
+    if (k % control_every == 0) {
+      const NavState est = ekf.current();
+      const NavState& flown_on = options.use_ground_truth ? truth_nav : est;
+      Reference ref;
+      ref.p = trajectory.evaluate(t);
+      ref.v = trajectory.evaluate(t, 1);
+      ref.a = trajectory.evaluate(t, 2);
+      const ControlOutput control = controller.update(ref, flown_on, control_dt);
+      const bool silent = s.command_dropout && t >= s.command_dropout->first && t < s.command_dropout->second;
+      if (!silent) {
+        if (!fc.has_authority()) fc.obtain_control(t);
+        fc.submit(control.command, t);
+        last_command = control.command;
+      }
+      if (t <= t_traj) {
+        const Eigen::Vector3d ep = truth.p - ref.p, ev = truth.v - ref.v;
+        sum_p2 += ep.cwiseAbs2();
+        sum_v2 += ev.cwiseAbs2();
+        out.max_position_error = std::max(out.max_position_error, ep.norm());
+        ++tracked;
+      }
+      sum_est2 += (est.p - truth.p).squaredNorm();
+      ++estimated;
+      const bool colliding = !s.map->is_free(truth.p, s.vehicle.radius);
+      if (colliding && !was_colliding) ++out.collisions;
+      if (colliding) out.collision_time_s += control_dt;
+      was_colliding = colliding;
+      if (options.record_consistency && !truth_history.empty()) {
+        for (const auto& [tick, nav] : truth_history) {
+          if (tick != ekf.horizon_tick()) continue;
+          const Vector15 e = state_error(ekf.horizon_state(), nav);
+          out.nees.push_back(e.dot(ekf.covariance().ldlt().solve(e)));
+        }
+      }
+      if (options.record_log) {
+        std::vector<double> row;
+        row.reserve(flight_log_columns().size());
+        row.push_back(t);
+        append(row, ref.p);
+        append(row, ref.v);
+        append(row, truth.p);
+        append(row, truth.v);
+        append_euler(row, truth.q);
+        append(row, est.p);
+        append(row, est.v);
+        append_euler(row, est.q);
+        append(row, est.b_a);
+        append(row, est.b_g);
+        append(row, truth_nav.b_a);
+        append(row, truth_nav.b_g);
+        row.insert(row.end(), {last_command.x, last_command.y, last_command.z, last_command.yaw});
+        row.insert(row.end(), {truth.rotor[0], truth.rotor[1], truth.rotor[2], truth.rotor[3]});
+        row.push_back(fc.in_failsafe() ? 1.0 : 0.0);
+        row.push_back(colliding ? 1.0 : 0.0);
+        out.log.push_back(std::move(row));
+      }
+    }
+    const Eigen::Vector4d rotor_command = fc.step(t, truth);
+    integrator.advance(truth, t, t + dt, rotor_command);
+  }
+
+  out.ticks = total_ticks;
+  out.flight_time = static_cast<double>(total_ticks) * dt;
+  if (tracked > 0) {
+    out.position_mse = sum_p2 / static_cast<double>(tracked);
+    out.velocity_mse = sum_v2 / static_cast<double>(tracked);
+    out.position_rmse = std::sqrt(out.position_mse.sum());
+  }
+  if (estimated > 0) out.estimation_rmse = std::sqrt(sum_est2 / static_cast<double>(estimated));
+  out.final_position_error = (truth.p - s.goal).norm();
+  out.final_speed = truth.v.norm();
+  // At rest means below the speed the position loop holds against sensor noise.
+  constexpr double kRestSpeed = 0.2;
+  out.goal_reached = out.final_position_error <= s.goal_tolerance && out.final_speed <= kRestSpeed &&
+                     out.collisions == 0;
+  out.fused = ekf.fused();
+  out.rejected = ekf.rejected();
+  out.stale = ekf.stale();
+  out.nis = ekf.nis_history();
+  out.n3_timeouts = fc.timeouts();
+  out.n3_rejected_commands = fc.rejected();
+  out.rhs_evaluations = integrator.rhs_evaluations();
+
+  double length = 0.0;
+  for (Eigen::Index i = 1; i < reference.path.rows(); ++i) length += (reference.path.row(i) - reference.path.row(i - 1)).norm();
+  out.summary = Json{
+      {"format", kSummaryFormat},
+      {"scenario", s.name},
+      {"seed", s.seed},
+      {"vehicle", s.vehicle.name},
+      {"controller_reads", options.use_ground_truth ? "ground-truth" : "ekf"},
+      {"reference", {{"source", reference.source},
+                     {"order", trajectory.order()},
+                     {"segments", trajectory.segments()},
+                     {"duration_s", t_traj},
+                     {"path_length_m", length},
+                     {"max_speed", reference.max_speed},
+                     {"max_acceleration", reference.max_acceleration},
+                     {"time_scale", reference.time_scale}}},
+      {"flight_time_s", out.flight_time},
+      {"goal_reached", out.goal_reached},
+      {"final_position_error", out.final_position_error},
+      {"final_speed", out.final_speed},
+      {"collisions", out.collisions},
+      {"collision_time_s", out.collision_time_s},
+      {"position_mse", vec_json(out.position_mse)},
+      {"velocity_mse", vec_json(out.velocity_mse)},
+      {"max_position_error", out.max_position_error},
+      {"position_rmse", out.position_rmse},
+      {"estimation", {{"position_rmse", out.estimation_rmse},
+                      {"pose_fused", out.fused},
+                      {"pose_rejected", out.rejected},
+                      {"pose_stale", out.stale},
+                      {"outliers_injected", out.outliers_injected},
+                      {"outliers_rejected", out.outliers_rejected}}},
+      {"n3", {{"timeouts", out.n3_timeouts}, {"rejected_commands", out.n3_rejected_commands}}}};
+  return out;
+}
+
+std::string flight_log_csv(const FlightResult& r) {
+  std::string text;
+  const auto& columns = flight_log_columns();
+  for (std::size_t i = 0; i < columns.size(); ++i) text += (i ? "," : "") + columns[i];
+  text += "\n";
+  char buf[32];
+  for (const auto& row : r.log) {
+    for (std::size_t i = 0; i < row.size(); ++i) {
+      std::snprintf(buf, sizeof buf, "%.9g", row[i] == 0.0 ? 0.0 : row[i]);  // no "-0"
+      if (i) text += ',';
+      text += buf;
+    }
+    text += "\n";
+  }
+  return text;
+}
+
+std::string tracking_table(const std::string& env, const FlightResult& r) {
+  std::ostringstream os;
+  char buf[160];
+  os << "Env.         Pos. Err. x  Pos. Err. y  Pos. Err. z  Vel. Err. x  Vel. Err. y  Vel. Err. z\n";
+  std::snprintf(buf, sizeof buf, "%-12s %11.4f  %11.4f  %11.4f  %11.4f  %11.4f  %11.4f\n", env.c_str(),
+                r.position_mse.x(), r.position_mse.y(), r.position_mse.z(), r.velocity_mse.x(),
+                r.velocity_mse.y(), r.velocity_mse.z());
+  os << buf;
+  return os.str();
+}
+
+}  // namespace miner::flight

@@ -1,0 +1,263 @@
+#include "miner/flight/scenario.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+#include "miner/core/error.hpp"
+#include "miner/flight/flatness.hpp"
+#include "miner/plan/reference.hpp"
+#include "miner/plan/rrt_star.hpp"
+#include "miner/traj/collision_repair.hpp"
+#include "miner/traj/problem_io.hpp"
+
+namespace miner::flight {
+
+namespace {
+
+std::string resolve(const std::string& base_dir, const std::string& path) {
+  const std::filesystem::path p(path);
+  if (p.is_absolute() || base_dir.empty()) return path;
+  return (std::filesystem::path(base_dir) / p).lexically_normal().string();
+}
+
+/// A rate that must be an integer fraction of the N3 loop rate; returns the ratio.
+int ticks_per(const JsonField& where, double loop_rate, double rate, const char* what) {
+  const double ratio = loop_rate / rate;
+  const double rounded = std::round(ratio);
+  if (rounded < 1.0 || std::abs(ratio - rounded) > 1e-9 * ratio)
+    where.fail(std::string(what) + " " + std::to_string(rate) + " Hz must divide the N3 loop rate " +
+               std::to_string(loop_rate) + " Hz (all sensors and loops run on its ticks)");
+  return static_cast<int>(rounded);
+}
+
+}  // namespace
+
+Scenario scenario_from_json(const Json& doc, const std::string& origin, const std::string& base_dir) {
+  const JsonField root(doc, "", origin);
+  if (!doc.is_object()) root.fail(std::string("expected a JSON object with \"format\": \"") + kScenarioFormat + "\"");
+  const std::string format = root.at("format").string();
+  if (format != kScenarioFormat)
+    root.at("format").fail("unknown format tag \"" + format + "\", expected \"" + kScenarioFormat + "\"");
+  Scenario s;
+  s.origin = origin;
+  if (root.has("name")) s.name = root.at("name").string();
+
+  const JsonField map_field = root.at("map");
+  if (map_field.value().is_string()) {
+    s.map = std::make_shared<const world::Map>(world::Map::load(resolve(base_dir, map_field.string())));
+  } else {
+    s.map = std::make_shared<const world::Map>(world::Map::from_json(map_field.value(), origin + ": map"));
+  }
+  if (root.has("vehicle")) {
+    const JsonField v = root.at("vehicle");
+    s.vehicle = v.value().is_string() ? load_vehicle(resolve(base_dir, v.string()))
+                                      : vehicle_from_json(v.value(), origin + ": vehicle");
+  }
+
+  const auto& query = s.map->query();
+  if (root.has("start")) s.start = root.at("start").vec3();
+  else if (query) s.start = query->start;
+  else root.fail("no \"start\" and the map stores no query");
+  if (root.has("goal")) s.goal = root.at("goal").vec3();
+  else if (query) s.goal = query->goal;
+  else root.fail("no \"goal\" and the map stores no query");
+  s.map->require_free(s.start, s.vehicle.radius, origin + ": start");
+  s.map->require_free(s.goal, s.vehicle.radius, origin + ": goal");
+
+  if (root.has("waypoints")) {
+    const JsonField w = root.at("waypoints");
+    Eigen::MatrixX3d m(static_cast<Eigen::Index>(w.array_size()), 3);
+    for (std::size_t i = 0; i < w.array_size(); ++i) {
+      m.row(static_cast<Eigen::Index>(i)) = w.at(i).vec3().transpose();
+      s.map->require_free(m.row(static_cast<Eigen::Index>(i)).transpose(), s.vehicle.radius,
+                         origin + ": waypoints[" + std::to_string(i) + "]");
+    }
+    s.waypoints = m;
+  }
+  if (root.has("trajectory")) {
+    const JsonField t = root.at("trajectory");
+    if (t.has("file")) {
+      const std::string path = resolve(base_dir, t.at("file").string());
+      s.trajectory_file = traj::trajectory_from_answer_json(read_json_file(path), path);
+    }
+    if (t.has("order")) {
+      s.order = t.at("order").integer();
+      if (s.order != 3 && s.order != 4) t.at("order").fail("must be 3 (jerk) or 4 (snap)");
+    }
+    if (t.has("v_max")) s.limits.v_max = t.at("v_max").positive_number();
+    if (t.has("a_max")) s.limits.a_max = t.at("a_max").positive_number();
+  }
+  if (root.has("seed")) {
+    const JsonField f = root.at("seed");
+    if (!f.value().is_number_unsigned()) f.fail("must be a non-negative integer");
+    s.seed = f.value().get<std::uint64_t>();
+  }
+  if (root.has("hover_after_s")) s.hover_after_s = root.at("hover_after_s").positive_number();
+  if (root.has("goal_tolerance_m")) s.goal_tolerance = root.at("goal_tolerance_m").positive_number();
+  if (root.has("imu")) s.imu = imu_params_from_json(root.at("imu"));
+  if (root.has("pose")) s.pose = pose_params_from_json(root.at("pose"));
+  if (root.has("n3")) s.n3 = n3::config_from_json(root.at("n3"));
+  if (root.has("controller")) s.controller = controller_params_from_json(root.at("controller"));
+  if (root.has("ekf")) {
+    const JsonField e = root.at("ekf");
+    if (e.has("gate_probability")) {
+      s.ekf.gate_probability = e.at("gate_probability").positive_number();
+      if (s.ekf.gate_probability >= 1.0) e.at("gate_probability").fail("must be below 1");
+    }
+    if (e.has("initial_position_sigma")) s.ekf.initial_position_sigma = e.at("initial_position_sigma").positive_number();
+    if (e.has("initial_velocity_sigma")) s.ekf.initial_velocity_sigma = e.at("initial_velocity_sigma").positive_number();
+    if (e.has("initial_attitude_sigma")) s.ekf.initial_attitude_sigma = e.at("initial_attitude_sigma").positive_number();
+  }
+  s.ekf.imu = s.imu;
+  s.ekf.pose = s.pose;
+  if (s.controller.max_tilt_deg > s.n3.max_tilt_deg)
+    root.fail("controller.max_tilt_deg exceeds the N3's max_tilt_deg");
+  ticks_per(root.has("controller") ? root.at("controller") : root, s.n3.rate_hz, s.controller.rate_hz, "controller rate");
+  ticks_per(root.has("pose") ? root.at("pose") : root, s.n3.rate_hz, s.pose.rate_hz, "pose rate");
+  if (root.has("command_dropout_s")) {
+    const JsonField d = root.at("command_dropout_s");
+    if (d.array_size() != 2) d.fail("expected [t0, t1]");
+    const double t0 = d.at(0).number(), t1 = d.at(1).number();
+    if (!(t0 >= 0.0 && t1 > t0)) d.fail("needs 0 <= t0 < t1");
+    s.command_dropout = std::make_pair(t0, t1);
+  }
+  // The limits themselves must be flyable: a horizontal a_max needs atan(a_max / g) of tilt.
+  const double tilt_needed = std::atan(s.limits.a_max / kGravity);
+  if (tilt_needed > kEnvelopeMargin * deg2rad(s.controller.max_tilt_deg))
+    root.fail("trajectory.a_max " + std::to_string(s.limits.a_max) + " m/s^2 needs " +
+              std::to_string(tilt_needed * 180.0 / kPi) + " deg of tilt, more than " +
+              std::to_string(kEnvelopeMargin * s.controller.max_tilt_deg) + " deg (" +
+              std::to_string(kEnvelopeMargin) + " of the tilt limit)");
+  return s;
+}
+
+Scenario load_scenario(const std::string& path) {
+  return scenario_from_json(read_json_file(path), path, std::filesystem::path(path).parent_path().string());
+}
+
+std::pair<double, double> trajectory_extremes(const traj::PolynomialTrajectory& t, double step) {
+  double v = 0.0, a = 0.0;
+  for (int i = 0; i < t.segments(); ++i) {
+    const double T = t.durations()[static_cast<std::size_t>(i)];
+    const int n = std::max(1, static_cast<int>(std::ceil(T / step)));
+    for (int k = 0; k <= n; ++k) {
+      const double tau = T * k / n;
+      v = std::max(v, t.evaluate_segment(i, tau, 1).norm());
+      a = std::max(a, t.evaluate_segment(i, tau, 2).norm());
+    }
+  }
+  return {v, a};
+}
+
+namespace {
+
+/// Sampling step for the limit checks: 1 ms resolves every polynomial of these orders
+/// on segments of tenths of seconds and more.
+constexpr double kLimitSampleStep = 1e-3;
+/// A trajectory may exceed v_max / a_max by this relative amount (sampling, rounding).
+constexpr double kLimitSlack = 1e-6;
+/// Start/end states must match to this (m, m/s, m/s^2).
+constexpr double kEndpointTolerance = 1e-6;
+
+void scale_time(traj::PolynomialTrajectory& t, double k) {
+  auto& c = t.mutable_coefficients();
+  const int n = 2 * t.order();
+  for (int i = 0; i < t.segments(); ++i)
+    for (int j = 0; j < n; ++j) c.row(n * i + j) /= std::pow(k, j);
+  for (double& d : t.mutable_durations()) d *= k;
+}
+
+void check_envelope(const Scenario& s, const traj::PolynomialTrajectory& t) {
+  const double max_tilt = kEnvelopeMargin * deg2rad(s.controller.max_tilt_deg);
+  const double max_thrust = kEnvelopeMargin * s.vehicle.max_thrust();
+  for (int i = 0; i < t.segments(); ++i) {
+    const double T = t.durations()[static_cast<std::size_t>(i)];
+    const int n = std::max(1, static_cast<int>(std::ceil(T / kLimitSampleStep)));
+    for (int k = 0; k <= n; ++k) {
+      const Eigen::Vector3d f = t.evaluate_segment(i, T * k / n, 2) + Eigen::Vector3d(0, 0, kGravity);
+      const double tilt = std::atan2(f.head<2>().norm(), f.z());
+      if (tilt > max_tilt || s.vehicle.mass * f.norm() > max_thrust)
+        throw Error(s.origin + ": the reference trajectory needs " + std::to_string(tilt * 180.0 / kPi) +
+                    " deg of tilt and " + std::to_string(s.vehicle.mass * f.norm()) + " N of thrust in segment " +
+                    std::to_string(i) + "; the vehicle allows " + std::to_string(max_tilt * 180.0 / kPi) +
+                    " deg and " + std::to_string(max_thrust) + " N (" + std::to_string(kEnvelopeMargin) +
+                    " of its limits)");
+    }
+  }
+}
+
+}  // namespace
+
+ReferencePlan build_reference(const Scenario& s) {
+  ReferencePlan r;
+  const double radius = s.vehicle.radius;
+  if (s.trajectory_file) {
+    r.trajectory = *s.trajectory_file;
+    r.source = "file";
+    const int m = r.trajectory.segments();
+    r.path.resize(m + 1, 3);
+    for (int i = 0; i < m; ++i) r.path.row(i) = r.trajectory.evaluate_segment(i, 0.0).transpose();
+    r.path.row(m) = r.trajectory.evaluate(r.trajectory.total_duration()).transpose();
+    const auto [v, a] = trajectory_extremes(r.trajectory, kLimitSampleStep);
+    if (v > s.limits.v_max * (1 + kLimitSlack) || a > s.limits.a_max * (1 + kLimitSlack))
+      throw Error(s.origin + ": trajectory file: maximum speed " + std::to_string(v) + " m/s and acceleration " +
+                  std::to_string(a) + " m/s^2 exceed the limits v_max " + std::to_string(s.limits.v_max) +
+                  ", a_max " + std::to_string(s.limits.a_max));
+    const auto colliding = traj::colliding_segments(r.trajectory, *s.map, radius, 0.0);
+    if (!colliding.empty())
+      throw Error(s.origin + ": trajectory file: segment " + std::to_string(colliding.front()) +
+                  " collides with the map (vehicle radius " + std::to_string(radius) + " m)");
+  } else {
+    Eigen::MatrixX3d path;
+    if (s.waypoints) {
+      r.source = "waypoints";
+      path.resize(s.waypoints->rows() + 2, 3);
+      path.row(0) = s.start.transpose();
+      path.middleRows(1, s.waypoints->rows()) = *s.waypoints;
+      path.row(path.rows() - 1) = s.goal.transpose();
+    } else {
+      r.source = "planner";
+      const auto problem = plan::PlanningProblem::make(*s.map, s.start, s.goal, radius);
+      const auto reference = plan::astar_reference(problem);
+      const auto region = plan::astar_dilated_region(problem, reference, Eigen::Vector3i(32, 32, 32), 1);
+      plan::PlannerOptions options;
+      options.seed = s.seed;
+      options.max_iterations = 5000;
+      const auto result = plan::plan(problem, options, &region);
+      if (!result.solved) throw NoSolution(s.origin + ": MINER RRT* found no path: " + result.reason);
+      path.resize(static_cast<Eigen::Index>(result.path.size()), 3);
+      for (std::size_t i = 0; i < result.path.size(); ++i) path.row(static_cast<Eigen::Index>(i)) = result.path[i].transpose();
+      r.planner_iterations = result.iterations;
+    }
+    traj::RepairOptions options;
+    options.order = s.order;
+    options.limits = s.limits;
+    options.robot_radius = radius;
+    auto repaired = traj::repair_collisions(*s.map, path, options);
+    r.trajectory = std::move(repaired.trajectory);
+    r.path = std::move(repaired.waypoints);
+    const auto [v, a] = trajectory_extremes(r.trajectory, kLimitSampleStep);
+    const double k = std::max({1.0, v / s.limits.v_max, std::sqrt(a / s.limits.a_max)});
+    if (k > 1.0 + kLimitSlack) {
+      r.time_scale = k * (1.0 + kLimitSlack);
+      scale_time(r.trajectory, r.time_scale);
+    }
+  }
+  const double T = r.trajectory.total_duration();
+  if ((r.trajectory.evaluate(0.0) - s.start).norm() > kEndpointTolerance ||
+      (r.trajectory.evaluate(T) - s.goal).norm() > kEndpointTolerance)
+    throw Error(s.origin + ": the reference trajectory must start at start " + format_point(s.start) +
+                " and end at goal " + format_point(s.goal) + "; it runs from " +
+                format_point(r.trajectory.evaluate(0.0)) + " to " + format_point(r.trajectory.evaluate(T)));
+  for (int k = 1; k <= 2; ++k)
+    if (r.trajectory.evaluate(0.0, k).norm() > kEndpointTolerance || r.trajectory.evaluate(T, k).norm() > kEndpointTolerance)
+      throw Error(s.origin + ": the reference trajectory must start and end at rest (the vehicle starts hovering)");
+  check_envelope(s, r.trajectory);
+  const auto [v, a] = trajectory_extremes(r.trajectory, kLimitSampleStep);
+  r.max_speed = v;
+  r.max_acceleration = a;
+  return r;
+}
+
+}  // namespace miner::flight

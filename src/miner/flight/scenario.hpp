@@ -1,0 +1,102 @@
+#pragma once
+/// \file
+/// A flight scenario (`miner-scenario-v1`, REQ-FLIGHT-007): the map, the vehicle, the
+/// query, where the reference trajectory comes from, the sensors, the N3, the controller
+/// and the seed — everything a flight depends on, so a scenario and a seed fix the bytes
+/// of the flight log.
+///
+///   {"format": "miner-scenario-v1", "name": "...",
+///    "map": "path relative to this file" | {inline miner-map-v1},
+///    "vehicle": "path" | {inline miner-vehicle-v1}        (optional: the N3-class default),
+///    "start": [x,y,z], "goal": [x,y,z]                     (optional: the map's query),
+///    "waypoints": [[x,y,z], ...]                           (optional interior waypoints;
+///                                                           absent: plan with MINER RRT*),
+///    "trajectory": {"order": 4, "v_max": 0.8, "a_max": 0.5} | {"file": "answer.json"},
+///    "seed": 1, "hover_after_s": 3, "goal_tolerance_m": 0.3,
+///    "imu": {...}, "pose": {...}, "n3": {...}, "controller": {...}, "ekf": {...},
+///    "command_dropout_s": [t0, t1]                         (optional: the companion
+///                                                           computer stays silent then)}
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+
+#include <Eigen/Core>
+
+#include "miner/core/json_io.hpp"
+#include "miner/flight/controller.hpp"
+#include "miner/flight/ekf.hpp"
+#include "miner/flight/n3.hpp"
+#include "miner/flight/sensors.hpp"
+#include "miner/flight/vehicle.hpp"
+#include "miner/traj/polynomial_trajectory.hpp"
+#include "miner/traj/trapezoidal_allocation.hpp"
+#include "miner/world/map.hpp"
+
+namespace miner::flight {
+
+inline constexpr const char* kScenarioFormat = "miner-scenario-v1";
+
+struct Scenario {
+  std::string name = "scenario";
+  std::string origin;                       ///< where it was read from (messages)
+  std::shared_ptr<const world::Map> map;  ///< never null after loading
+  VehicleParams vehicle;
+  Eigen::Vector3d start = Eigen::Vector3d::Zero();
+  Eigen::Vector3d goal = Eigen::Vector3d::Zero();
+  std::optional<Eigen::MatrixX3d> waypoints;  ///< interior waypoints, one per row
+  int order = 4;                            ///< s: 3 jerk, 4 snap
+  traj::Limits limits{0.8, 0.5};
+  std::optional<traj::PolynomialTrajectory> trajectory_file;
+  std::uint64_t seed = 1;
+  double hover_after_s = 3.0;
+  double goal_tolerance = 0.3;              ///< m
+  ImuParams imu;
+  PoseParams pose;
+  n3::Config n3;
+  ControllerParams controller;
+  EkfParams ekf;                            ///< imu and pose are copied from the above
+  std::optional<std::pair<double, double>> command_dropout;
+};
+
+/// Parses and validates a scenario; relative paths resolve against `base_dir`. Checks
+/// before any flight: every parameter, rates that divide the N3's loop rate, start and
+/// goal inside the map and clear of obstacles by the vehicle radius, limits within what
+/// the vehicle can fly (kEnvelopeMargin of its tilt and thrust).
+Scenario scenario_from_json(const Json& doc, const std::string& origin, const std::string& base_dir);
+Scenario load_scenario(const std::string& path);
+
+/// The embedded default scenario (fixtures/scenarios/default.json with its map and
+/// vehicle inlined at build time), so `miner fly` runs with no argument anywhere.
+Scenario default_scenario();
+/// Its text, as shipped.
+const char* default_scenario_text();
+
+/// The share of the vehicle's tilt limit and thrust that a reference trajectory may use;
+/// the rest is left to the feedback loop.
+inline constexpr double kEnvelopeMargin = 0.8;
+
+/// The reference the vehicle flies and where it came from.
+struct ReferencePlan {
+  traj::PolynomialTrajectory trajectory;
+  Eigen::MatrixX3d path;        ///< the waypoints MINCO went through (after repair)
+  std::string source;           ///< "waypoints", "planner" or "file"
+  double time_scale = 1.0;      ///< durations were stretched by this to meet the limits
+  double max_speed = 0.0, max_acceleration = 0.0;  ///< of the final trajectory
+  std::size_t planner_iterations = 0;
+};
+
+/// Builds the reference: the file as is, or MINCO through start-waypoints-goal (or a
+/// MINER RRT* path when there are no waypoints) with collision repair, uniformly
+/// time-stretched if it exceeds v_max / a_max (rest to rest, so the curve is unchanged).
+/// Throws miner::Error if the result starts or ends away from start / goal or needs more
+/// tilt or thrust than the vehicle's envelope allows.
+ReferencePlan build_reference(const Scenario& s);
+
+/// Maximum speed and acceleration of a trajectory, sampled every `step` seconds and at
+/// every segment end.
+std::pair<double, double> trajectory_extremes(const traj::PolynomialTrajectory& t, double step);
+
+}  // namespace miner::flight

@@ -1,0 +1,113 @@
+#include "miner/flight/sensors.hpp"
+
+#include <cmath>
+
+#include "miner/core/error.hpp"
+#include "miner/flight/vehicle.hpp"
+
+namespace miner::flight {
+
+Eigen::Vector3d normal3(Rng& rng, double sigma) {
+  const double x = rng.normal(), y = rng.normal(), z = rng.normal();
+  return sigma * Eigen::Vector3d(x, y, z);
+}
+
+Eigen::Quaterniond quat_exp(const Eigen::Vector3d& theta) {
+  const double angle = theta.norm();
+  if (angle < 1e-12) return Eigen::Quaterniond(1.0, 0.5 * theta.x(), 0.5 * theta.y(), 0.5 * theta.z()).normalized();
+  return Eigen::Quaterniond(Eigen::AngleAxisd(angle, theta / angle));
+}
+
+Eigen::Vector3d quat_log(const Eigen::Quaterniond& q_in) {
+  Eigen::Quaterniond q = q_in.normalized();
+  if (q.w() < 0.0) q.coeffs() = -q.coeffs();  // the short way round
+  const double s = q.vec().norm();
+  if (s < 1e-12) return 2.0 * q.vec();
+  return 2.0 * std::atan2(s, q.w()) * q.vec() / s;
+}
+
+ImuModel::ImuModel(const ImuParams& params, double dt, Rng& rng) : params_(params), dt_(dt), rng_(&rng) {
+  b_a_ = normal3(rng, params.accel_bias_initial);
+  b_g_ = normal3(rng, params.gyro_bias_initial);
+}
+
+ImuSample ImuModel::sample(const Eigen::Quaterniond& q, const Eigen::Vector3d& omega,
+                           const Eigen::Vector3d& acceleration) {
+  ImuSample s;
+  const Eigen::Vector3d specific_force = q.conjugate() * (acceleration + Eigen::Vector3d(0.0, 0.0, kGravity));
+  s.accel = specific_force + b_a_ + normal3(*rng_, params_.accel_noise_density / std::sqrt(dt_));
+  s.gyro = omega + b_g_ + normal3(*rng_, params_.gyro_noise_density / std::sqrt(dt_));
+  b_a_ += normal3(*rng_, params_.accel_bias_random_walk * std::sqrt(dt_));
+  b_g_ += normal3(*rng_, params_.gyro_bias_random_walk * std::sqrt(dt_));
+  return s;
+}
+
+PoseMeasurement measure_pose(const PoseParams& params, double stamp, const Eigen::Vector3d& p,
+                             const Eigen::Quaterniond& q, Rng& rng) {
+  PoseMeasurement m;
+  m.stamp = stamp;
+  m.p = p + normal3(rng, params.position_sigma);
+  m.q = (q * quat_exp(normal3(rng, params.attitude_sigma))).normalized();
+  if (rng.uniform01() < params.outlier_probability) {
+    m.outlier = true;
+    Eigen::Vector3d dir = normal3(rng, 1.0);
+    dir /= std::max(dir.norm(), 1e-12);
+    m.p += params.outlier_magnitude * dir;
+  }
+  return m;
+}
+
+namespace {
+double optional_non_negative(const JsonField& f, const char* key, double fallback) {
+  if (!f.has(key)) return fallback;
+  const JsonField v = f.at(key);
+  const double x = v.number();
+  if (x < 0.0) v.fail("must be >= 0, got " + v.value().dump());
+  return x;
+}
+}  // namespace
+
+ImuParams imu_params_from_json(const JsonField& f) {
+  ImuParams p;
+  p.accel_noise_density = optional_non_negative(f, "accel_noise_density", p.accel_noise_density);
+  p.gyro_noise_density = optional_non_negative(f, "gyro_noise_density", p.gyro_noise_density);
+  p.accel_bias_random_walk = optional_non_negative(f, "accel_bias_random_walk", p.accel_bias_random_walk);
+  p.gyro_bias_random_walk = optional_non_negative(f, "gyro_bias_random_walk", p.gyro_bias_random_walk);
+  p.accel_bias_initial = optional_non_negative(f, "accel_bias_initial", p.accel_bias_initial);
+  p.gyro_bias_initial = optional_non_negative(f, "gyro_bias_initial", p.gyro_bias_initial);
+  return p;
+}
+
+PoseParams pose_params_from_json(const JsonField& f) {
+  PoseParams p;
+  if (f.has("rate_hz")) p.rate_hz = f.at("rate_hz").positive_number();
+  p.delay_s = optional_non_negative(f, "delay_s", p.delay_s);
+  p.position_sigma = optional_non_negative(f, "position_sigma", p.position_sigma);
+  p.attitude_sigma = optional_non_negative(f, "attitude_sigma", p.attitude_sigma);
+  p.outlier_probability = optional_non_negative(f, "outlier_probability", p.outlier_probability);
+  p.outlier_magnitude = optional_non_negative(f, "outlier_magnitude", p.outlier_magnitude);
+  if (p.outlier_probability > 1.0) f.at("outlier_probability").fail("must be in [0, 1]");
+  if (!(p.position_sigma > 0.0) || !(p.attitude_sigma > 0.0))
+    f.fail("position_sigma and attitude_sigma must be positive (the EKF divides by them)");
+  return p;
+}
+
+Json to_json(const ImuParams& p) {
+  return Json{{"accel_noise_density", p.accel_noise_density},
+              {"gyro_noise_density", p.gyro_noise_density},
+              {"accel_bias_random_walk", p.accel_bias_random_walk},
+              {"gyro_bias_random_walk", p.gyro_bias_random_walk},
+              {"accel_bias_initial", p.accel_bias_initial},
+              {"gyro_bias_initial", p.gyro_bias_initial}};
+}
+
+Json to_json(const PoseParams& p) {
+  return Json{{"rate_hz", p.rate_hz},
+              {"delay_s", p.delay_s},
+              {"position_sigma", p.position_sigma},
+              {"attitude_sigma", p.attitude_sigma},
+              {"outlier_probability", p.outlier_probability},
+              {"outlier_magnitude", p.outlier_magnitude}};
+}
+
+}  // namespace miner::flight

@@ -1,0 +1,96 @@
+#pragma once
+/// \file
+/// Sensor models (REQ-FLIGHT-004): the N3's IMU and an external pose source (visual-
+/// inertial odometry or motion capture). Every random number comes from the caller's
+/// seeded miner::Rng, so a flight is reproducible to the bit.
+///
+/// IMU (continuous-time model, discretised at the sample period dt):
+///   accelerometer  a_m = R^T (p'' + g e3) + b_a + n_a,   n_a ~ N(0, sigma_a^2 / dt)
+///   gyroscope      w_m = omega + b_g + n_g,              n_g ~ N(0, sigma_g^2 / dt)
+///   biases         b_{k+1} = b_k + N(0, sigma_b^2 dt),   b_0 ~ N(0, sigma_b0^2)
+/// with sigma_a, sigma_g the noise densities and sigma_b the bias random walks.
+///
+/// Pose: position p + n_p and attitude q (x) Exp(n_theta) at `rate_hz`, delivered
+/// `delay_s` after the instant they describe; with probability `outlier_probability` a
+/// measurement is an outlier whose position is off by `outlier_magnitude_m` in a random
+/// direction (a VIO jump or a mocap marker swap).
+
+#include <cstdint>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "miner/core/json_io.hpp"
+#include "miner/core/rng.hpp"
+
+namespace miner::flight {
+
+struct ImuParams {
+  double accel_noise_density = 0.01;    ///< m/s^2/sqrt(Hz)
+  double gyro_noise_density = 0.001;    ///< rad/s/sqrt(Hz)
+  double accel_bias_random_walk = 1e-4; ///< m/s^3/sqrt(Hz)
+  double gyro_bias_random_walk = 1e-5;  ///< rad/s^2/sqrt(Hz)
+  double accel_bias_initial = 0.05;     ///< m/s^2, std of the turn-on bias per axis
+  double gyro_bias_initial = 0.005;     ///< rad/s, std of the turn-on bias per axis
+};
+
+struct ImuSample {
+  Eigen::Vector3d accel = Eigen::Vector3d::Zero();  ///< specific force, body, m/s^2
+  Eigen::Vector3d gyro = Eigen::Vector3d::Zero();   ///< body rates, rad/s
+};
+
+class ImuModel {
+ public:
+  /// Draws the turn-on biases from `rng`.
+  ImuModel(const ImuParams& params, double dt, Rng& rng);
+  /// One sample for attitude q, body rates omega and linear acceleration p''; then
+  /// advances the bias random walks.
+  ImuSample sample(const Eigen::Quaterniond& q, const Eigen::Vector3d& omega,
+                   const Eigen::Vector3d& acceleration);
+  const Eigen::Vector3d& accel_bias() const { return b_a_; }
+  const Eigen::Vector3d& gyro_bias() const { return b_g_; }
+  const ImuParams& params() const { return params_; }
+  double dt() const { return dt_; }
+
+ private:
+  ImuParams params_;
+  double dt_;
+  Rng* rng_;
+  Eigen::Vector3d b_a_, b_g_;
+};
+
+struct PoseParams {
+  double rate_hz = 50.0;                ///< 30-100 Hz for VIO / motion capture
+  double delay_s = 0.02;                ///< from the instant measured to delivery
+  double position_sigma = 0.02;         ///< m
+  double attitude_sigma = 0.01;         ///< rad
+  double outlier_probability = 0.01;
+  double outlier_magnitude = 1.0;       ///< m
+};
+
+struct PoseMeasurement {
+  double stamp = 0.0;                   ///< the instant it describes (s)
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
+  bool outlier = false;                 ///< ground truth, for tests; the EKF never reads it
+};
+
+/// A pose measurement of the true (p, q) taken at `stamp`.
+PoseMeasurement measure_pose(const PoseParams& params, double stamp, const Eigen::Vector3d& p,
+                             const Eigen::Quaterniond& q, Rng& rng);
+
+/// Exp: rotation vector -> unit quaternion; Log: the inverse (angle in [0, pi]).
+Eigen::Quaterniond quat_exp(const Eigen::Vector3d& theta);
+Eigen::Vector3d quat_log(const Eigen::Quaterniond& q);
+
+/// A vector of three independent N(0, sigma^2) draws.
+Eigen::Vector3d normal3(Rng& rng, double sigma);
+
+/// Reading and writing the "imu" and "pose" objects of a scenario (fields optional,
+/// defaults above; noise parameters >= 0, rates and delay checked for consistency).
+ImuParams imu_params_from_json(const JsonField& f);
+PoseParams pose_params_from_json(const JsonField& f);
+Json to_json(const ImuParams& p);
+Json to_json(const PoseParams& p);
+
+}  // namespace miner::flight

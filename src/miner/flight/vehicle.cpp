@@ -1,0 +1,134 @@
+#include "miner/flight/vehicle.hpp"
+
+#include <cmath>
+
+#include <Eigen/LU>
+
+#include "miner/core/error.hpp"
+
+namespace miner::flight {
+
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kTiltLimitRad = 35.0 * kPi / 180.0;
+
+[[noreturn]] void bad(const std::string& origin, const std::string& field, const std::string& why) {
+  throw Error(origin + ": " + field + ": " + why);
+}
+}  // namespace
+
+double min_thrust_to_weight() { return 1.0 / std::cos(kTiltLimitRad); }
+
+double VehicleParams::max_thrust() const {
+  return 4.0 * thrust_coefficient * rotor_speed_max * rotor_speed_max;
+}
+
+double VehicleParams::hover_rotor_speed() const {
+  return std::sqrt(weight() / (4.0 * thrust_coefficient));
+}
+
+void validate(const VehicleParams& v, const std::string& origin) {
+  auto positive = [&](double x, const char* field) {
+    if (!std::isfinite(x) || !(x > 0.0)) bad(origin, field, "must be a positive finite number, got " + std::to_string(x));
+  };
+  positive(v.mass, "mass_kg");
+  for (int i = 0; i < 3; ++i) positive(v.inertia[i], "inertia_kg_m2");
+  positive(v.arm_length, "arm_length_m");
+  positive(v.thrust_coefficient, "thrust_coefficient_N_per_rad_s2");
+  positive(v.torque_to_thrust_ratio, "torque_to_thrust_ratio_m");
+  positive(v.rotor_speed_max, "rotor_speed_max_rad_s");
+  positive(v.motor_time_constant_up, "motor_time_constant_up_s");
+  positive(v.motor_time_constant_down, "motor_time_constant_down_s");
+  positive(v.radius, "radius_m");
+  for (int i = 0; i < 3; ++i) {
+    if (!std::isfinite(v.linear_drag[i]) || v.linear_drag[i] < 0.0)
+      bad(origin, "linear_drag_N_s_per_m", "must be finite and >= 0");
+    const double j = v.inertia[i], a = v.inertia[(i + 1) % 3], b = v.inertia[(i + 2) % 3];
+    if (j > a + b)
+      bad(origin, "inertia_kg_m2", "principal moments violate the triangle inequality (" +
+                                       std::to_string(j) + " > " + std::to_string(a) + " + " +
+                                       std::to_string(b) + "): no rigid body has them");
+  }
+  if (!std::isfinite(v.rotor_speed_min) || v.rotor_speed_min < 0.0 ||
+      v.rotor_speed_min >= v.rotor_speed_max)
+    bad(origin, "rotor_speed_min_rad_s", "must satisfy 0 <= min < rotor_speed_max_rad_s");
+  if (v.thrust_to_weight() < min_thrust_to_weight())
+    bad(origin, "rotor_speed_max_rad_s",
+        "maximum thrust " + std::to_string(v.max_thrust()) + " N gives a thrust-to-weight ratio of " +
+            std::to_string(v.thrust_to_weight()) + " < " + std::to_string(min_thrust_to_weight()) +
+            " (weight " + std::to_string(v.weight()) +
+            " N): the vehicle cannot hold altitude at the 35 deg tilt limit");
+  if (4.0 * v.thrust_coefficient * v.rotor_speed_min * v.rotor_speed_min >= v.weight())
+    bad(origin, "rotor_speed_min_rad_s", "idle thrust carries the whole weight: the vehicle cannot descend");
+}
+
+VehicleParams vehicle_from_json(const Json& doc, const std::string& origin) {
+  const JsonField root(doc, "", origin);
+  if (!doc.is_object()) root.fail(std::string("expected a JSON object with \"format\": \"") + kVehicleFormat + "\"");
+  const std::string format = root.at("format").string();
+  if (format != kVehicleFormat)
+    root.at("format").fail("unknown format tag \"" + format + "\", expected \"" + kVehicleFormat + "\"");
+  VehicleParams v;
+  if (root.has("name")) v.name = root.at("name").string();
+  v.mass = root.at("mass_kg").number();
+  v.inertia = root.at("inertia_kg_m2").vec3();
+  v.arm_length = root.at("arm_length_m").number();
+  v.thrust_coefficient = root.at("thrust_coefficient_N_per_rad_s2").number();
+  v.torque_to_thrust_ratio = root.at("torque_to_thrust_ratio_m").number();
+  v.rotor_speed_min = root.at("rotor_speed_min_rad_s").number();
+  v.rotor_speed_max = root.at("rotor_speed_max_rad_s").number();
+  v.motor_time_constant_up = root.at("motor_time_constant_up_s").number();
+  v.motor_time_constant_down = root.at("motor_time_constant_down_s").number();
+  v.linear_drag = root.at("linear_drag_N_s_per_m").vec3();
+  v.radius = root.at("radius_m").number();
+  validate(v, origin);
+  return v;
+}
+
+VehicleParams load_vehicle(const std::string& path) { return vehicle_from_json(read_json_file(path), path); }
+
+Json to_json(const VehicleParams& v) {
+  return Json{{"format", kVehicleFormat},
+              {"name", v.name},
+              {"mass_kg", v.mass},
+              {"inertia_kg_m2", vec3_json(v.inertia)},
+              {"arm_length_m", v.arm_length},
+              {"thrust_coefficient_N_per_rad_s2", v.thrust_coefficient},
+              {"torque_to_thrust_ratio_m", v.torque_to_thrust_ratio},
+              {"rotor_speed_min_rad_s", v.rotor_speed_min},
+              {"rotor_speed_max_rad_s", v.rotor_speed_max},
+              {"motor_time_constant_up_s", v.motor_time_constant_up},
+              {"motor_time_constant_down_s", v.motor_time_constant_down},
+              {"linear_drag_N_s_per_m", vec3_json(v.linear_drag)},
+              {"radius_m", v.radius}};
+}
+
+Mixer::Mixer(const VehicleParams& v)
+    : k_f_(v.thrust_coefficient), w_min_(v.rotor_speed_min), w_max_(v.rotor_speed_max) {
+  const double c = v.arm_length / std::sqrt(2.0);
+  // Rotors at 45, 135, 225, 315 degrees: (x, y) = c (+,+), (-,+), (-,-), (+,-).
+  const double xs[4] = {c, -c, -c, c};
+  const double ys[4] = {c, c, -c, -c};
+  const double spin[4] = {1.0, -1.0, 1.0, -1.0};
+  for (int i = 0; i < 4; ++i) {
+    a_(0, i) = 1.0;
+    a_(1, i) = ys[i];
+    a_(2, i) = -xs[i];
+    a_(3, i) = spin[i] * v.torque_to_thrust_ratio;
+  }
+  a_inv_ = a_.inverse();
+}
+
+Eigen::Vector4d Mixer::rotor_speeds(double thrust, const Eigen::Vector3d& torque) const {
+  Eigen::Vector4d wrench;
+  wrench << thrust, torque;
+  const Eigen::Vector4d f = a_inv_ * wrench;
+  Eigen::Vector4d w;
+  for (int i = 0; i < 4; ++i) {
+    const double wi = std::sqrt(std::max(f[i], 0.0) / k_f_);
+    w[i] = std::min(std::max(wi, w_min_), w_max_);
+  }
+  return w;
+}
+
+}  // namespace miner::flight

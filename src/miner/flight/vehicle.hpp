@@ -1,0 +1,80 @@
+#pragma once
+/// \file
+/// The vehicle: a rigid-body quadrotor in X configuration (REQ-FLIGHT-001).
+///
+/// Parameters come from a `miner-vehicle-v1` JSON file whose keys carry their SI units
+/// (mass_kg, inertia_kg_m2, ...). The default is an N3-class 1.5 kg quadrotor
+/// (../shared/anchors.md: J = diag(0.029, 0.029, 0.055) kg m^2, arm 0.23 m,
+/// k_f = 5.84e-6 N/(rad/s)^2, motor tau 12.5 ms up / 25 ms down, hover thrust ~35 %).
+///
+/// Rotor i sits at angle 45 + 90 i degrees in the body x-y plane at `arm_length` from the
+/// centre and spins with sign s_i = (+1, -1, +1, -1); its thrust is f_i = k_f w_i^2 along
+/// body z and its drag torque s_i k_m w_i^2 about body z, with k_m = ratio k_f.
+
+#include <array>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "miner/core/json_io.hpp"
+
+namespace miner::flight {
+
+inline constexpr const char* kVehicleFormat = "miner-vehicle-v1";
+/// Standard gravity used by the dynamics, the N3 and the estimator alike (m/s^2).
+inline constexpr double kGravity = 9.81;
+
+struct VehicleParams {
+  std::string name = "n3-class-1.5kg";
+  double mass = 1.5;                                        ///< kg
+  Eigen::Vector3d inertia{0.029, 0.029, 0.055};             ///< kg m^2, principal axes
+  double arm_length = 0.23;                                 ///< m, centre to rotor axis
+  double thrust_coefficient = 5.84e-6;                      ///< k_f, N / (rad/s)^2
+  double torque_to_thrust_ratio = 0.016;                    ///< k_m / k_f, m
+  double rotor_speed_min = 100.0;                           ///< rad/s (idle)
+  double rotor_speed_max = 1340.0;                          ///< rad/s
+  double motor_time_constant_up = 0.0125;                   ///< s, spinning up
+  double motor_time_constant_down = 0.025;                  ///< s, spinning down
+  Eigen::Vector3d linear_drag{0.10, 0.10, 0.15};            ///< N/(m/s), body axes
+  double radius = 0.3;                                      ///< m, collision sphere
+
+  double weight() const { return mass * kGravity; }
+  /// Collective thrust with every rotor at rotor_speed_max (N).
+  double max_thrust() const;
+  /// Rotor speed at which four rotors carry the weight (rad/s).
+  double hover_rotor_speed() const;
+  /// Thrust-to-weight ratio max_thrust / weight.
+  double thrust_to_weight() const { return max_thrust() / weight(); }
+};
+
+/// Throws miner::Error naming the parameter unless the vehicle is physical: positive mass,
+/// inertia and coefficients; principal moments obeying the triangle inequality
+/// (J_x + J_y >= J_z and permutations); 0 <= w_min < w_max; and a thrust-to-weight ratio of
+/// at least kMinThrustToWeight, so altitude can be held at the N3's 35 degree tilt limit.
+void validate(const VehicleParams& v, const std::string& origin = "vehicle");
+
+/// 1 / cos(35 deg): the thrust-to-weight ratio needed to hold altitude at the tilt limit.
+double min_thrust_to_weight();
+
+/// Reads a `miner-vehicle-v1` document; every field is required (no silent defaults for a
+/// physical parameter), then validate().
+VehicleParams vehicle_from_json(const Json& doc, const std::string& origin);
+VehicleParams load_vehicle(const std::string& path);
+Json to_json(const VehicleParams& v);
+
+/// Collective thrust and body torques from the four rotor thrusts:
+/// [T, tau_x, tau_y, tau_z]^T = A f with rows (1, ...), (y_i), (-x_i), (s_i k_m/k_f).
+class Mixer {
+ public:
+  explicit Mixer(const VehicleParams& v);
+  /// Wrench (T, tau) of rotor thrusts f.
+  Eigen::Vector4d wrench(const Eigen::Vector4d& f) const { return a_ * f; }
+  /// Rotor speeds realising (thrust, torque), each clamped to [w_min, w_max].
+  Eigen::Vector4d rotor_speeds(double thrust, const Eigen::Vector3d& torque) const;
+
+ private:
+  Eigen::Matrix4d a_, a_inv_;
+  double k_f_, w_min_, w_max_;
+};
+
+}  // namespace miner::flight

@@ -186,6 +186,9 @@ FlightResult fly(const Scenario& s, const ReferencePlan& reference, const FlyOpt
   constexpr double kRestSpeed = 0.2;
   out.goal_reached = out.final_position_error <= s.goal_tolerance && out.final_speed <= kRestSpeed &&
                      out.collisions == 0;
+  out.final_sigma = ekf.covariance().diagonal().cwiseSqrt();
+  out.final_estimate = ekf.current();
+  out.final_truth = NavState{truth.p, truth.v, truth.q, imu.accel_bias(), imu.gyro_bias()};
   out.fused = ekf.fused();
   out.rejected = ekf.rejected();
   out.stale = ekf.stale();

@@ -15,6 +15,7 @@
 
 #include "miner/core/json_io.hpp"
 #include "miner/flight/dynamics.hpp"
+#include "miner/flight/ekf.hpp"
 #include "miner/flight/scenario.hpp"
 
 namespace miner::flight {
@@ -51,6 +52,8 @@ struct FlightResult {
   long n3_rejected_commands = 0;
   long rhs_evaluations = 0;
   std::vector<double> nees;       ///< with record_consistency
+  Vector15 final_sigma = Vector15::Zero();  ///< sqrt(diag P) at the end
+  NavState final_estimate, final_truth;     ///< at the EKF horizon / now
   std::vector<double> nis;        ///< of the accepted pose measurements
   Json summary;
 };

@@ -160,14 +160,6 @@ constexpr double kLimitSlack = 1e-6;
 /// Start/end states must match to this (m, m/s, m/s^2).
 constexpr double kEndpointTolerance = 1e-6;
 
-void scale_time(traj::PolynomialTrajectory& t, double k) {
-  auto& c = t.mutable_coefficients();
-  const int n = 2 * t.order();
-  for (int i = 0; i < t.segments(); ++i)
-    for (int j = 0; j < n; ++j) c.row(n * i + j) /= std::pow(k, j);
-  for (double& d : t.mutable_durations()) d *= k;
-}
-
 void check_envelope(const Scenario& s, const traj::PolynomialTrajectory& t) {
   const double max_tilt = kEnvelopeMargin * deg2rad(s.controller.max_tilt_deg);
   const double max_thrust = kEnvelopeMargin * s.vehicle.max_thrust();
@@ -188,6 +180,15 @@ void check_envelope(const Scenario& s, const traj::PolynomialTrajectory& t) {
 }
 
 }  // namespace
+
+void scale_time(traj::PolynomialTrajectory& t, double k) {
+  if (!(k > 0.0) || !std::isfinite(k)) throw Error("scale_time: k must be positive and finite");
+  auto& c = t.mutable_coefficients();
+  const int n = 2 * t.order();
+  for (int i = 0; i < t.segments(); ++i)
+    for (int j = 0; j < n; ++j) c.row(n * i + j) /= std::pow(k, j);
+  for (double& d : t.mutable_durations()) d *= k;
+}
 
 ReferencePlan build_reference(const Scenario& s) {
   ReferencePlan r;

@@ -33,7 +33,9 @@ void validate(const Config& c) {
   if (!(c.land_speed > 0.0) || !(c.max_horizontal_speed > 0.0) || !(c.max_vertical_speed > 0.0))
     fail("land_speed, max_horizontal_speed and max_vertical_speed must be positive");
   if (!(c.attitude_gain.minCoeff() > 0.0) || !(c.rate_gain.minCoeff() > 0.0) ||
-      !(c.horizontal_velocity_gain > 0.0) || !(c.vertical_velocity_gain > 0.0))
+      !(c.horizontal_velocity_gain > 0.0) || !(c.vertical_velocity_gain > 0.0) ||
+      !(c.horizontal_velocity_integral_gain > 0.0) || !(c.vertical_velocity_integral_gain > 0.0) ||
+      !(c.velocity_integral_limit > 0.0))
     fail("gains must be positive");
 }
 
@@ -164,10 +166,15 @@ void FlightController::fly_command(const Command& c, const QuadState& s, double 
     Eigen::Vector2d v_des(c.x, c.y);
     if (c.flag & kFrameBody) v_des = Eigen::Rotation2Dd(setpoint_.yaw) * v_des;
     if (v_des.norm() > config_.max_horizontal_speed) v_des *= config_.max_horizontal_speed / v_des.norm();
-    const Eigen::Vector2d a = config_.horizontal_velocity_gain * (v_des - s.v.head<2>());
+    const Eigen::Vector2d error = v_des - s.v.head<2>();
+    const double cap = config_.velocity_integral_limit / config_.horizontal_velocity_integral_gain;
+    for (int i = 0; i < 2; ++i) velocity_integral_[i] = std::clamp(velocity_integral_[i] + error[i] * dt, -cap, cap);
+    const Eigen::Vector2d a = config_.horizontal_velocity_gain * error +
+                              config_.horizontal_velocity_integral_gain * velocity_integral_.head<2>();
     tilt_from_acceleration(Eigen::Vector3d(a.x(), a.y(), 0.0), s);
   } else {
     // ANGLE: roll, pitch, each within the tilt limit, and the tilt of the pair too.
+    velocity_integral_.head<2>().setZero();
     Euler e{std::clamp(c.x, -max_tilt, max_tilt), std::clamp(c.y, -max_tilt, max_tilt), setpoint_.yaw};
     const Eigen::Vector3d z = rotation_zyx(e).col(2);
     if (std::acos(std::clamp(z.z(), -1.0, 1.0)) > max_tilt + 1e-12) {
@@ -181,9 +188,13 @@ void FlightController::fly_command(const Command& c, const QuadState& s, double 
   const double max_thrust = vehicle_.max_thrust();
   if ((c.flag & kVerticalMask) == kVerticalThrust) {
     setpoint_.thrust = std::clamp(c.z, 0.0, 100.0) / 100.0 * max_thrust;
+    velocity_integral_.z() = 0.0;
   } else {
     const double vz = std::clamp(c.z, -config_.max_vertical_speed, config_.max_vertical_speed);
-    const double az = config_.vertical_velocity_gain * (vz - s.v.z());
+    const double cap = config_.velocity_integral_limit / config_.vertical_velocity_integral_gain;
+    velocity_integral_.z() = std::clamp(velocity_integral_.z() + (vz - s.v.z()) * dt, -cap, cap);
+    const double az = config_.vertical_velocity_gain * (vz - s.v.z()) +
+                      config_.vertical_velocity_integral_gain * velocity_integral_.z();
     const double tilt_cos = std::max(std::cos(setpoint_.roll) * std::cos(setpoint_.pitch), std::cos(max_tilt));
     setpoint_.thrust = std::clamp(vehicle_.mass * (kGravity + az) / tilt_cos, 0.0, max_thrust);
   }

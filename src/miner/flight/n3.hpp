@@ -67,8 +67,11 @@ struct Config {
   double max_vertical_speed = 4.0;     ///< m/s, VELOCITY mode
   Eigen::Vector3d attitude_gain{6.0, 6.0, 3.0};  ///< 1/s, attitude error -> body rate
   Eigen::Vector3d rate_gain{30.0, 30.0, 15.0};   ///< 1/s, rate error -> angular acceleration
-  double horizontal_velocity_gain = 1.5;          ///< 1/s, VELOCITY mode
-  double vertical_velocity_gain = 2.0;            ///< 1/s, VELOCITY mode
+  double horizontal_velocity_gain = 2.0;          ///< 1/s, VELOCITY mode (P)
+  double vertical_velocity_gain = 2.0;            ///< 1/s, VELOCITY mode (P)
+  double horizontal_velocity_integral_gain = 1.0; ///< 1/s^2, VELOCITY mode (I): drag
+  double vertical_velocity_integral_gain = 1.0;   ///< 1/s^2, VELOCITY mode (I)
+  double velocity_integral_limit = 2.0;           ///< m/s^2, the I term's share
 };
 
 /// Reads the scenario's "n3" object (all fields optional) and checks it.
@@ -129,6 +132,7 @@ class FlightController {
   double last_step_time_ = 0.0;
   bool stepped_ = false;
   Command active_;
+  Eigen::Vector3d velocity_integral_ = Eigen::Vector3d::Zero();  ///< world x, y, z (m)
   std::deque<Pending> pending_;
   Setpoint setpoint_;
   long accepted_ = 0, rejected_ = 0;

@@ -1,0 +1,155 @@
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+#include "miner/core/rng.hpp"
+#include "miner/core/statistics.hpp"
+#include "miner/flight/closed_loop.hpp"
+#include "miner/flight/controller.hpp"
+#include "miner/flight/ekf.hpp"
+#include "miner/flight/flatness.hpp"
+#include "miner/testing/flight_scenarios.hpp"
+
+namespace flight = miner::flight;
+
+TEST_CASE("Chi-square quantiles match tabulated values", "[REQ-CORE-005]") {
+  CHECK(miner::chi_square_quantile(0.95, 1) == Approx(3.841458820694124).epsilon(1e-10));
+  // Even k has the closed form F(x; 2m) = 1 - e^{-x/2} sum_{j<m} (x/2)^j / j!; these
+  // quantiles come from it, solved in 50-digit decimal arithmetic.
+  CHECK(miner::chi_square_quantile(0.999, 6) == Approx(22.457744484825325).epsilon(1e-12));
+  CHECK(miner::chi_square_quantile(0.005, 300) == Approx(240.66338891651254).epsilon(1e-12));
+  CHECK(miner::chi_square_quantile(0.995, 300) == Approx(366.84444613490874).epsilon(1e-12));
+  CHECK(miner::chi_square_quantile(0.5, 15) == Approx(14.3389).epsilon(1e-5));  // odd k: tables
+  CHECK(miner::chi_square_cdf(miner::chi_square_quantile(0.3, 15), 15) == Approx(0.3).epsilon(1e-10));
+  CHECK(miner::chi_square_cdf(2.0, 2) == Approx(1.0 - std::exp(-1.0)).epsilon(1e-14));
+  CHECK_THROWS(miner::chi_square_quantile(1.0, 3));
+  CHECK_THROWS(miner::regularized_gamma_p(-1.0, 1.0));
+}
+
+namespace {
+/// An EKF at rest fed noiseless IMU samples for `ticks` ticks (level, hovering).
+struct RestingEkf {
+  flight::EkfParams params;
+  double dt = 1.0 / 400.0;
+  flight::Ekf ekf;
+  std::int64_t tick = 0;
+  explicit RestingEkf(int delay_ticks)
+      : ekf(params, 1.0 / 400.0, delay_ticks, flight::NavState{}, flight::initial_covariance(params)) {}
+  void run(int ticks) {
+    flight::ImuSample s;
+    s.accel = Eigen::Vector3d(0, 0, flight::kGravity);
+    for (int k = 0; k < ticks; ++k) ekf.push_imu(tick++, s);
+  }
+  flight::PoseMeasurement pose(double stamp, const Eigen::Vector3d& p = Eigen::Vector3d::Zero()) const {
+    flight::PoseMeasurement m;
+    m.stamp = stamp;
+    m.p = p;
+    return m;
+  }
+};
+}  // namespace
+
+TEST_CASE("The EKF fuses a delayed pose when its horizon reaches the stamp, and rejects stale ones", "[REQ-FLIGHT-005]") {
+  RestingEkf f(8);
+  f.run(20);  // latest tick 19, horizon 11
+  CHECK(f.ekf.horizon_tick() == 11);
+  // Stamped at tick 19 (now): waits for the horizon.
+  auto r = f.ekf.push_pose(f.pose(19 * f.dt));
+  CHECK_FALSE(r.accepted);
+  CHECK(f.ekf.fused() == 0);
+  f.run(8);
+  CHECK(f.ekf.fused() == 1);
+  // Stamped at tick 5, long behind the horizon: stale.
+  r = f.ekf.push_pose(f.pose(5 * f.dt));
+  CHECK(r.stale);
+  CHECK(f.ekf.stale() == 1);
+}
+
+TEST_CASE("The EKF rejects a pose outlier by its NIS gate", "[REQ-FLIGHT-005]") {
+  RestingEkf f(0);
+  for (int k = 0; k < 50; ++k) {  // converge on the origin
+    f.run(8);
+    REQUIRE(f.ekf.push_pose(f.pose(f.ekf.horizon_time())).accepted);
+  }
+  f.run(8);
+  const auto r = f.ekf.push_pose(f.pose(f.ekf.horizon_time(), Eigen::Vector3d(0.5, 0, 0)));
+  CHECK_FALSE(r.accepted);
+  CHECK(r.nis > f.ekf.gate());
+  CHECK(f.ekf.gate() == Approx(miner::chi_square_quantile(0.999, 6)));
+  CHECK(f.ekf.current().p.norm() < 0.01);  // the outlier moved nothing
+}
+
+TEST_CASE("In flight the EKF rejects injected outliers and its biases converge", "[REQ-FLIGHT-005]") {
+  Eigen::MatrixX3d points(4, 3);
+  points << 5, 5, 3, 10, 7, 4, 12, 12, 3, 6, 12, 5;
+  flight::Scenario s = miner::testing::open_room_scenario(points, 1.0, 1.0, 21);
+  s.pose.outlier_probability = 0.05;
+  s.ekf.pose = s.pose;
+  const auto r = flight::fly(s, flight::build_reference(s));
+  REQUIRE(r.outliers_injected > 20);
+  CHECK(r.outliers_rejected == r.outliers_injected);
+  CHECK(r.rejected - r.outliers_rejected <= 0.01 * r.fused + 3);  // gate at 99.9 %
+  // Biases: within 3 sigma of the truth, and sigma well below the turn-on sigma.
+  const flight::Vector15 e = flight::state_error(r.final_estimate, r.final_truth);
+  for (int i = 9; i < 15; ++i) CHECK(std::abs(e[i]) <= 3.0 * r.final_sigma[i]);
+  for (int i = 0; i < 3; ++i) {
+    CHECK(r.final_sigma[9 + i] < 0.5 * s.imu.accel_bias_initial);
+    CHECK(r.final_sigma[12 + i] < 0.5 * s.imu.gyro_bias_initial);
+  }
+  CHECK(r.estimation_rmse < 0.03);
+}
+
+TEST_CASE("The SE(3) controller turns a feed-forward acceleration into attitude and thrust", "[REQ-FLIGHT-006]") {
+  const flight::VehicleParams v;
+  flight::Se3Controller c(v, flight::ControllerParams{});
+  flight::Reference ref;
+  ref.a = Eigen::Vector3d(1.0, 0.0, 0.0);
+  ref.v = Eigen::Vector3d::Zero();
+  const flight::NavState at_ref;  // on the reference, level
+  const auto out = c.update(ref, at_ref, 0.01);
+  CHECK(out.command.flag == 0x22);
+  CHECK(out.command.y == Approx(std::atan(1.0 / flight::kGravity)));  // pitch forward
+  CHECK(out.command.x == Approx(0.0).margin(1e-12));
+  CHECK(out.command.z == Approx(100.0 * v.weight() / v.max_thrust()));  // f . (R e3) when level
+  CHECK_FALSE(out.saturated);
+
+  ref.a = Eigen::Vector3d(0.0, 20.0, 0.0);
+  const auto sat = c.update(ref, at_ref, 0.01);
+  CHECK(sat.saturated);
+  const Eigen::Vector3d z = flight::rotation_zyx({sat.command.x, sat.command.y, 0.0}).col(2);
+  CHECK(std::acos(z.z()) == Approx(flight::deg2rad(35)));
+  CHECK(sat.command.x < 0.0);  // roll negative tilts thrust toward +y
+}
+
+TEST_CASE("The position integrator does not wind up", "[REQ-FLIGHT-006]") {
+  const flight::VehicleParams v;
+  flight::ControllerParams p;
+  flight::Se3Controller c(v, p);
+  flight::Reference far;
+  far.p = Eigen::Vector3d(100, 0, 0);  // saturates the tilt
+  for (int k = 0; k < 1000; ++k) c.update(far, flight::NavState{}, 0.01);
+  CHECK(c.integral().norm() == 0.0);
+  flight::Reference near;
+  near.p = Eigen::Vector3d(0.5, 0, 0);  // small error, never saturated
+  for (int k = 0; k < 100000; ++k) c.update(near, flight::NavState{}, 0.01);
+  CHECK(p.ki.x() * c.integral().x() == Approx(p.integral_limit));
+}
+
+TEST_CASE("The controller flies on the EKF estimate, not silently on the truth", "[REQ-FLIGHT-006]") {
+  Eigen::MatrixX3d points(2, 3);
+  points << 5, 5, 3, 11, 9, 4;
+  auto run = [&](double position_sigma, bool truth) {
+    flight::Scenario s = miner::testing::open_room_scenario(points, 1.0, 1.0, 4);
+    s.pose.position_sigma = position_sigma;
+    s.ekf.pose = s.pose;
+    flight::FlyOptions o;
+    o.use_ground_truth = truth;
+    return flight::fly(s, flight::build_reference(s), o);
+  };
+  const auto quiet = run(0.01, false), noisy = run(0.10, false);
+  CHECK(noisy.position_rmse > 2.0 * quiet.position_rmse);  // sensor noise shows in tracking
+  CHECK(noisy.summary["controller_reads"] == "ekf");
+  const auto quiet_truth = run(0.01, true), noisy_truth = run(0.10, true);
+  CHECK(noisy_truth.position_rmse == quiet_truth.position_rmse);  // the truth ignores the sensor
+  CHECK(noisy_truth.summary["controller_reads"] == "ground-truth");
+}

@@ -1,0 +1,123 @@
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <unistd.h>
+
+#include "miner/core/error.hpp"
+#include "miner/flight/closed_loop.hpp"
+#include "miner/traj/problem_io.hpp"
+#include "miner/testing/flight_scenarios.hpp"
+
+using Catch::Matchers::Contains;
+namespace flight = miner::flight;
+
+namespace {
+const std::string kScenarios = std::string(MINER_SOURCE_DIR) + "/fixtures/scenarios";
+
+miner::Json default_doc() { return miner::read_json_file(kScenarios + "/default.json"); }
+
+void expect_scenario_error(const miner::Json& doc, const std::string& needle) {
+  REQUIRE_THROWS_WITH(flight::build_reference(flight::scenario_from_json(doc, "s.json", kScenarios)), Contains(needle));
+}
+
+std::string temp_dir() {
+  const auto p = std::filesystem::temp_directory_path() / ("miner_flight_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(p);
+  return p.string();
+}
+}  // namespace
+
+TEST_CASE("The embedded default scenario is the fixture file and flies to its goal", "[REQ-FLIGHT-007][REQ-FLIGHT-009]") {
+  const flight::Scenario s = flight::default_scenario();
+  const flight::Scenario f = flight::load_scenario(kScenarios + "/default.json");
+  CHECK(s.name == f.name);
+  CHECK(s.start == f.start);
+  CHECK(s.map->obstacles().size() == f.map->obstacles().size());
+  const auto ref = flight::build_reference(s);
+  CHECK(ref.source == "planner");
+  const auto r = flight::fly(s, ref);
+  CHECK(r.goal_reached);
+  CHECK(r.collisions == 0);
+  for (const char* key : {"goal_reached", "collisions", "position_mse", "velocity_mse", "max_position_error"})
+    CHECK(r.summary.contains(key));
+  CHECK(r.summary["position_mse"].size() == 3);
+}
+
+TEST_CASE("Same scenario and seed give the same flight log bytes; another seed does not", "[REQ-FLIGHT-009]") {
+  Eigen::MatrixX3d points(3, 3);
+  points << 5, 5, 3, 8, 7, 4, 11, 6, 3;
+  const auto s = miner::testing::open_room_scenario(points, 1.0, 1.0, 9);
+  const auto ref = flight::build_reference(s);
+  const std::string a = flight::flight_log_csv(flight::fly(s, ref));
+  const std::string b = flight::flight_log_csv(flight::fly(s, ref));
+  CHECK(a == b);
+  const auto other = miner::testing::open_room_scenario(points, 1.0, 1.0, 10);
+  CHECK(flight::flight_log_csv(flight::fly(other, ref)) != a);
+  CHECK(a.substr(0, a.find('\n')).find("true_x") != std::string::npos);
+}
+
+TEST_CASE("Bad scenarios are refused before flight with the fault named", "[REQ-FLIGHT-007]") {
+  miner::Json doc = default_doc();
+  doc["start"] = {4.6, 5.55, 1.7};  // inside an obstacle of indoor-1
+  expect_scenario_error(doc, "start");
+  doc = default_doc();
+  doc["vehicle"] = flight::to_json(flight::VehicleParams{});
+  doc["vehicle"]["mass_kg"] = -2;
+  expect_scenario_error(doc, "mass_kg");
+  doc = default_doc();
+  doc["trajectory"]["a_max"] = 9.0;
+  expect_scenario_error(doc, "deg of tilt");
+  doc = default_doc();
+  doc["pose"]["rate_hz"] = 60;
+  expect_scenario_error(doc, "must divide the N3 loop rate");
+  doc = default_doc();
+  doc["n3"]["rate_hz"] = 200;
+  expect_scenario_error(doc, "rate_hz must be >= 400");
+  doc = default_doc();
+  doc["format"] = "miner-scenario-v0";
+  expect_scenario_error(doc, "unknown format tag");
+  doc = default_doc();
+  doc["command_dropout_s"] = {2.0, 1.0};
+  expect_scenario_error(doc, "t0 < t1");
+}
+
+TEST_CASE("A trajectory file that exceeds the limits or misses the start is refused", "[REQ-FLIGHT-007]") {
+  Eigen::MatrixX3d points(2, 3);
+  points << 5, 5, 3, 12, 9, 4;
+  auto s = miner::testing::open_room_scenario(points, 2.0, 2.0);
+  const auto fast = flight::build_reference(s).trajectory;
+  const std::string path = temp_dir() + "/fast.json";
+  miner::write_file_atomic(path, miner::dump_json(miner::traj::answer_to_json(fast)));
+  miner::Json doc = default_doc();
+  doc["map"] = miner::Json{{"format", "miner-map-v1"}, {"bounds", {{"min", {0, 0, 0}}, {"max", {20, 20, 10}}}},
+                           {"resolution", 0.5}, {"obstacles", miner::Json::array()}};
+  doc["start"] = {5, 5, 3};
+  doc["goal"] = {12, 9, 4};
+  doc["trajectory"] = {{"file", path}, {"v_max", 0.5}, {"a_max", 0.5}};
+  expect_scenario_error(doc, "exceed the limits");
+  doc["trajectory"] = {{"file", path}, {"v_max", 2.0}, {"a_max", 2.0}};
+  CHECK(flight::build_reference(flight::scenario_from_json(doc, "s.json", kScenarios)).source == "file");
+  doc["start"] = {5, 6, 3};
+  expect_scenario_error(doc, "must start at start");
+}
+
+TEST_CASE("A run folder is replaced whole or not at all", "[REQ-CORE-004]") {
+  const std::string dir = temp_dir() + "/run";
+  miner::write_folder_atomic(dir, {{"a.txt", "one"}, {"b.txt", "two"}});
+  miner::write_folder_atomic(dir, {{"a.txt", "three"}});
+  CHECK(std::filesystem::exists(dir + "/a.txt"));
+  CHECK_FALSE(std::filesystem::exists(dir + "/b.txt"));
+  std::ifstream in(dir + "/a.txt");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  CHECK(ss.str() == "three");
+  // A file of that name is never replaced by a folder.
+  miner::write_file_atomic(temp_dir() + "/plain", "keep");
+  CHECK_THROWS_WITH(miner::write_folder_atomic(temp_dir() + "/plain", {{"x", "y"}}), Contains("not a folder"));
+  // A file that cannot be written leaves the previous folder as it was.
+  CHECK_THROWS(miner::write_folder_atomic(dir, {{"sub/x.txt", "y"}}));
+  CHECK(std::filesystem::exists(dir + "/a.txt"));
+}

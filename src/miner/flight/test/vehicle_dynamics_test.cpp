@@ -1,0 +1,126 @@
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+#include "miner/core/error.hpp"
+#include "miner/flight/closed_loop.hpp"
+#include "miner/flight/dynamics.hpp"
+#include "miner/flight/vehicle.hpp"
+#include "miner/testing/flight_scenarios.hpp"
+
+using Catch::Matchers::Contains;
+namespace flight = miner::flight;
+
+namespace {
+std::string fixture(const std::string& rel) { return std::string(MINER_SOURCE_DIR) + "/fixtures/" + rel; }
+
+miner::Json vehicle_doc() { return flight::to_json(flight::VehicleParams{}); }
+
+void expect_vehicle_error(miner::Json doc, const std::string& needle) {
+  REQUIRE_THROWS_WITH(flight::vehicle_from_json(doc, "v.json"), Contains(needle));
+}
+}  // namespace
+
+TEST_CASE("The N3-class vehicle file loads with its units and round-trips", "[REQ-FLIGHT-001]") {
+  const flight::VehicleParams v = flight::load_vehicle(fixture("vehicles/n3-1500g.json"));
+  CHECK(v.mass == 1.5);
+  CHECK(v.inertia.isApprox(Eigen::Vector3d(0.029, 0.029, 0.055)));
+  CHECK(v.thrust_to_weight() > 2.5);
+  CHECK(v.thrust_to_weight() < 3.0);  // hover thrust ~35 % of max, as the N3's
+  const flight::VehicleParams back = flight::vehicle_from_json(flight::to_json(v), "round trip");
+  CHECK(flight::to_json(back) == flight::to_json(v));
+  // Hover: four rotors at the hover speed carry the weight exactly.
+  CHECK(4 * v.thrust_coefficient * std::pow(v.hover_rotor_speed(), 2) == Approx(v.weight()).epsilon(1e-14));
+}
+
+TEST_CASE("Missing or non-physical vehicle parameters are refused naming the parameter", "[REQ-FLIGHT-001]") {
+  miner::Json doc = vehicle_doc();
+  doc["mass_kg"] = -1.5;
+  expect_vehicle_error(doc, "mass_kg");
+  doc = vehicle_doc();
+  doc["rotor_speed_max_rad_s"] = 600.0;  // 8.4 N of thrust for 14.7 N of weight
+  expect_vehicle_error(doc, "thrust-to-weight");
+  doc = vehicle_doc();
+  doc["inertia_kg_m2"] = {0.01, 0.01, 0.05};
+  expect_vehicle_error(doc, "triangle inequality");
+  doc = vehicle_doc();
+  doc.erase("motor_time_constant_up_s");
+  expect_vehicle_error(doc, "motor_time_constant_up_s: missing required field");
+  doc = vehicle_doc();
+  doc["linear_drag_N_s_per_m"] = {0.1, -0.1, 0.1};
+  expect_vehicle_error(doc, "linear_drag");
+  doc = vehicle_doc();
+  doc["format"] = "miner-vehicle-v0";
+  expect_vehicle_error(doc, "unknown format tag");
+}
+
+TEST_CASE("Hover is an equilibrium of the dynamics", "[REQ-FLIGHT-002]") {
+  const flight::VehicleParams v;
+  flight::Integrator integrator(v);
+  flight::QuadState s = flight::hover_state(v, {1, 2, 3}, 0.3);
+  const Eigen::Vector4d u = s.rotor;
+  for (int k = 0; k < 400; ++k) integrator.advance(s, k * 0.0025, (k + 1) * 0.0025, u);
+  CHECK((s.p - Eigen::Vector3d(1, 2, 3)).norm() < 1e-9);
+  CHECK(s.v.norm() < 1e-9);
+  CHECK(std::abs(s.q.norm() - 1.0) < 1e-15);
+}
+
+TEST_CASE("Free fall follows p = p0 - g t^2 / 2 and rotors follow their first-order lag", "[REQ-FLIGHT-002]") {
+  flight::VehicleParams v;
+  v.linear_drag.setZero();
+  flight::Integrator integrator(v, {1e-9, 5000});
+  flight::QuadState s;
+  s.p = Eigen::Vector3d(0, 0, 10);
+  const double w0 = 300.0, w_up = 900.0;
+  s.rotor.setConstant(0.0);
+  integrator.advance(s, 0.0, 1.0, Eigen::Vector4d::Zero());
+  CHECK(s.p.z() == Approx(10.0 - 0.5 * flight::kGravity).epsilon(1e-8));
+  CHECK(s.v.z() == Approx(-flight::kGravity).epsilon(1e-8));
+
+  flight::QuadState m;
+  m.rotor.setConstant(w0);
+  integrator.advance(m, 0.0, 0.02, Eigen::Vector4d::Constant(w_up));
+  const double expected_up = w_up + (w0 - w_up) * std::exp(-0.02 / v.motor_time_constant_up);
+  CHECK(m.rotor[0] == Approx(expected_up).epsilon(1e-8));
+  flight::QuadState d;
+  d.rotor.setConstant(w_up);
+  integrator.advance(d, 0.0, 0.02, Eigen::Vector4d::Constant(w0));
+  const double expected_down = w0 + (w_up - w0) * std::exp(-0.02 / v.motor_time_constant_down);
+  CHECK(d.rotor[0] == Approx(expected_down).epsilon(1e-8));
+}
+
+TEST_CASE("A torque-free spin conserves angular momentum and energy and keeps q unit", "[REQ-FLIGHT-002]") {
+  const flight::VehicleParams v;
+  flight::Integrator integrator(v, {1e-9, 50000});
+  flight::QuadState s;
+  s.omega = Eigen::Vector3d(1.0, -2.0, 3.0);  // rotors stopped: no torque, gravity at the CoM
+  auto momentum = [&](const flight::QuadState& x) { return Eigen::Vector3d(x.q * v.inertia.cwiseProduct(x.omega)); };
+  auto energy = [&](const flight::QuadState& x) { return 0.5 * x.omega.dot(v.inertia.cwiseProduct(x.omega)); };
+  const Eigen::Vector3d l0 = momentum(s);
+  const double e0 = energy(s);
+  for (int k = 0; k < 800; ++k) integrator.advance(s, k * 0.0025, (k + 1) * 0.0025, Eigen::Vector4d::Zero());
+  CHECK((momentum(s) - l0).norm() <= 1e-6 * l0.norm());
+  CHECK(std::abs(energy(s) - e0) <= 1e-6 * e0);
+  CHECK(std::abs(s.q.norm() - 1.0) < 1e-15);
+}
+
+TEST_CASE("The flight does not depend on the integrator's internal step: rtol 1e-6 and 1e-9 agree", "[REQ-FLIGHT-002]") {
+  Eigen::MatrixX3d points(3, 3);
+  points << 5, 5, 3, 9, 6, 4, 12, 10, 3;
+  const flight::Scenario s = miner::testing::open_room_scenario(points, 1.5, 1.5, 7);
+  const flight::ReferencePlan ref = flight::build_reference(s);
+  flight::FlyOptions coarse, fine;
+  coarse.integrator.relative_tolerance = 1e-6;
+  fine.integrator.relative_tolerance = 1e-9;
+  const auto a = flight::fly(s, ref, coarse);
+  const auto b = flight::fly(s, ref, fine);
+  REQUIRE(a.log.size() == b.log.size());
+  // Columns 7-9 are the true position: the stated bound is 1e-4 m over the whole flight
+  // (CVODE's local error control at 1e-6 gives ~1e-6 per tick; the closed loop damps it).
+  double worst = 0.0;
+  for (std::size_t k = 0; k < a.log.size(); ++k)
+    for (int c = 7; c <= 9; ++c) worst = std::max(worst, std::abs(a.log[k][c] - b.log[k][c]));
+  INFO("max true-position difference " << worst << " m");
+  CHECK(worst <= 1e-4);
+  CHECK(a.rhs_evaluations < b.rhs_evaluations);  // the tolerance did change the steps
+}

@@ -289,3 +289,49 @@ TEST_CASE("plan: bad input is named, an unreachable goal exits 3", "[REQ-CLI-004
                                     "--planner", "miner"});
   CHECK(miner_none.code == 3);
 }
+
+TEST_CASE("miner fly with no argument flies the default scenario and writes the run folder", "[REQ-FLIGHT-009]") {
+  const std::string run = dir() + "/fly-run";
+  const Run r = miner_cli({"fly", "--out", run, "--json"});
+  INFO(r.err);
+  REQUIRE(r.code == 0);
+  const miner::Json summary = miner::parse_json(r.out, "stdout");
+  CHECK(summary["goal_reached"] == true);
+  CHECK(summary["collisions"] == 0);
+  CHECK(summary["position_mse"].size() == 3);
+  CHECK(summary["velocity_mse"].size() == 3);
+  CHECK(summary["max_position_error"].get<double>() > 0.0);
+  CHECK(summary["run_folder"] == run);
+  for (const char* f : {"summary.json", "trajectory.json", "path.json", "flight_log.csv"})
+    CHECK(std::filesystem::exists(run + "/" + f));
+  // Human output: the paper's table and where the files went.
+  const Run human = miner_cli({"fly", "--out", run});
+  CHECK(human.code == 0);
+  CHECK_THAT(human.out, Contains("Pos. Err. x") && Contains("wrote " + run));
+  // Same seed, same bytes.
+  const std::string first = read(run + "/flight_log.csv");
+  REQUIRE(miner_cli({"fly", "--out", run, "--seed", "1"}).code == 0);
+  CHECK(read(run + "/flight_log.csv") == first);
+}
+
+TEST_CASE("miner fly refuses a bad scenario before flying", "[REQ-FLIGHT-007]") {
+  const std::string path = write("bad-scenario.json", R"({"format": "miner-scenario-v1",
+    "map": {"format": "miner-map-v1", "bounds": {"min": [0,0,0], "max": [10,10,10]}, "resolution": 1.0,
+            "obstacles": [{"type": "box", "min": [4,4,0], "max": [6,6,10]}]},
+    "start": [5, 5, 5], "goal": [9, 9, 5]})");
+  const Run r = miner_cli({"fly", "--scenario", path, "--out", dir() + "/bad-run"});
+  CHECK(r.code == 1);
+  CHECK_THAT(r.err, Contains("start") && Contains("lies inside"));
+  CHECK_FALSE(std::filesystem::exists(dir() + "/bad-run"));
+}
+
+TEST_CASE("miner bench sim reports the real-time factor", "[REQ-FLIGHT-010]") {
+  const Run r = miner_cli({"bench", "sim", "--runs", "1", "--json"});
+  INFO(r.err);
+  REQUIRE(r.code == 0);
+  const miner::Json doc = miner::parse_json(r.out, "stdout");
+  CHECK(doc["real_time_factor"].get<double>() > 0.0);
+  CHECK(doc["flight_time_s"].get<double>() > 10.0);
+  CHECK(doc["threads"] == 1);
+  CHECK(miner_cli({"bench", "sim", "--runs", "0"}).code == 2);
+}

@@ -29,6 +29,7 @@ TEST_CASE("EKF NEES and NIS stay inside their chi-square bounds over Monte Carlo
     nis.insert(nis.end(), r.nis.begin(), r.nis.end());
   }
   const std::size_t steps = nees.front().size();
+  const double n_steps = static_cast<double>(steps);
   const double lo = miner::chi_square_quantile(0.005, 15.0 * kRuns) / kRuns;
   const double hi = miner::chi_square_quantile(0.995, 15.0 * kRuns) / kRuns;
   std::size_t inside = 0;
@@ -39,6 +40,7 @@ TEST_CASE("EKF NEES and NIS stay inside their chi-square bounds over Monte Carlo
     total += mean;
     if (mean >= lo && mean <= hi) ++inside;
   }
+  const double inside_fraction = static_cast<double>(inside) / n_steps;
   const double n = static_cast<double>(nis.size());
   double nis_mean = 0.0, above = 0.0;
   const double q95 = miner::chi_square_quantile(0.95, 6.0);
@@ -46,16 +48,16 @@ TEST_CASE("EKF NEES and NIS stay inside their chi-square bounds over Monte Carlo
     nis_mean += x / n;
     above += x > q95 ? 1.0 / n : 0.0;
   }
-  INFO("NEES: " << steps << " control ticks x " << kRuns << " runs, " << double(inside) / steps
+  INFO("NEES: " << steps << " control ticks x " << kRuns << " runs, " << inside_fraction
                 << " of them inside the 99% band [" << lo << ", " << hi << "], time average "
-                << total / steps << "; NIS: " << nis.size() << " updates, mean " << nis_mean
+                << total / n_steps << "; NIS: " << nis.size() << " updates, mean " << nis_mean
                 << ", fraction above the chi2(6) 95% quantile " << above);
   // NEES: the Monte Carlo average at each tick lies in its two-sided 99% band; ticks are
   // correlated in time, so the fraction is not binomial: ask for 95% (99% expected; a
   // filter over- or under-confident by a factor 1.3 in variance leaves the band).
-  CHECK(double(inside) / steps >= 0.95);
-  CHECK(total / steps >= lo);
-  CHECK(total / steps <= hi);
+  CHECK(inside_fraction >= 0.95);
+  CHECK(total / n_steps >= lo);
+  CHECK(total / n_steps <= hi);
   // NIS of a consistent filter is white, so the updates are independent draws of chi2(6)
   // (truncated by the 99.9% gate, which lowers the mean by ~0.03): mean 6 +- 5 sigma with
   // sigma = sqrt(12 / n), and the exceedance of the 95% quantile 0.05 +- 5 sqrt(.05 .95 / n).

@@ -2,8 +2,8 @@
 /// \file
 /// `miner bench sim` (REQ-FLIGHT-010): how much faster than real time the full loop
 /// (CVODE dynamics, N3, IMU and pose sensors, EKF, controller) runs on one core. The
-/// reference is built once; each run flies it without keeping the log; the figure is
-/// simulated time / wall time, median over runs.
+/// reference is built once; after one untimed warm-up flight each run flies it without
+/// keeping the log; the figure is simulated time / wall time, median over runs.
 
 #include <iosfwd>
 

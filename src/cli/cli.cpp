@@ -77,6 +77,7 @@ int run_cli(const std::vector<std::string>& args, std::ostream& out, std::ostrea
   add_bench_commands(app, out);
   add_plan_commands(app, out);
   add_fly_commands(app, out);
+  add_heuristic_commands(app, out);
 
   // CLI11 parses in reverse order of the vector it is given.
   std::vector<std::string> reversed(args.rbegin(), args.rend());

@@ -66,5 +66,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out);
 void add_plan_commands(CLI::App& app, std::ostream& out);
 /// Registers `miner fly` and `miner bench sim` (fly_commands.cpp); after the bench commands.
 void add_fly_commands(CLI::App& app, std::ostream& out);
+/// Registers `miner dataset` (heuristic_commands.cpp).
+void add_heuristic_commands(CLI::App& app, std::ostream& out);
 
 }  // namespace miner::cli

@@ -335,3 +335,15 @@ TEST_CASE("miner bench sim reports the real-time factor", "[REQ-FLIGHT-010]") {
   CHECK(doc["threads"] == 1);
   CHECK(miner_cli({"bench", "sim", "--runs", "0"}).code == 2);
 }
+
+TEST_CASE("miner dataset writes the dataset folder and refuses a missing --out", "[REQ-HEUR-001][REQ-HEUR-003]") {
+  const std::string out = dir() + "/dataset";
+  const Run r = miner_cli({"dataset", "--preset", "indoor", "--count", "2", "--test-count", "1", "--out", out});
+  INFO(r.err);
+  REQUIRE(r.code == 0);
+  CHECK_THAT(r.out, Contains("2 train, 0 val, 1 test"));
+  CHECK(std::filesystem::exists(out + "/dataset.json"));
+  CHECK(r.err.empty());  // not a terminal: no progress bar
+  CHECK(miner_cli({"dataset", "--count", "2"}).code == 2);
+  CHECK(miner_cli({"dataset", "--count", "0", "--out", dir() + "/none"}).code == 1);
+}

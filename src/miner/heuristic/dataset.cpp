@@ -1,0 +1,225 @@
+#include "miner/heuristic/dataset.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "miner/core/error.hpp"
+#include "miner/core/progress.hpp"
+#include "miner/core/rng.hpp"
+#include "miner/plan/heuristic_region.hpp"
+#include "miner/world/astar.hpp"
+#include "miner/world/map_generator.hpp"
+#include "miner/world/voxel_grid.hpp"
+
+namespace miner::heuristic {
+
+namespace {
+
+/// Start/goal draws per map before falling back to the map's own (A*-checked) query.
+constexpr int kMaxQueryAttempts = 64;
+constexpr const char* kSplits[3] = {"train", "val", "test"};
+
+Eigen::Vector3d cell_size(const world::Box& b, const Eigen::Vector3i& dims) {
+  return (b.max - b.min).cwiseQuotient(dims.cast<double>());
+}
+
+std::size_t cell_index(const Eigen::Vector3i& dims, int i, int j, int k) {
+  return (static_cast<std::size_t>(k) * dims.y() + j) * dims.x() + i;
+}
+
+Eigen::Vector3i cell_of(const world::Box& b, const Eigen::Vector3i& dims, const Eigen::Vector3d& p) {
+  const Eigen::Vector3d c = cell_size(b, dims);
+  Eigen::Vector3i idx;
+  for (int a = 0; a < 3; ++a)
+    idx[a] = std::clamp(static_cast<int>(std::floor((p[a] - b.min[a]) / c[a])), 0, dims[a] - 1);
+  return idx;
+}
+
+std::string shard_name(const std::string& split, std::size_t i) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%s-%05zu.bin", split.c_str(), i);
+  return buf;
+}
+
+}  // namespace
+
+void validate(const DatasetOptions& o) {
+  world::generator_preset(o.preset);  // throws naming the known presets
+  if (o.count < 1) throw Error("dataset: --count must be >= 1");
+  if (o.test_count < 0) throw Error("dataset: --test-count must be >= 0");
+  if (!(o.val_fraction >= 0.0 && o.val_fraction < 1.0)) throw Error("dataset: --val-fraction must be in [0, 1)");
+  if ((o.dims.array() < 4).any() || (o.dims.array() > 256).any())
+    throw Error("dataset: --dims must be between 4 and 256 cells per axis");
+  if (o.dilation < 0 || o.dilation > 4) throw Error("dataset: --dilation must be in [0, 4]");
+  if (o.shard_size < 1) throw Error("dataset: --shard-size must be >= 1");
+  if (!(o.min_separation >= 0.0 && o.min_separation < 1.0)) throw Error("dataset: min_separation must be in [0, 1)");
+}
+
+std::vector<std::uint8_t> encode_environment(const world::Map& map, const Eigen::Vector3i& dims, double radius) {
+  const world::Box& b = map.bounds();
+  const Eigen::Vector3d c = cell_size(b, dims);
+  std::vector<std::uint8_t> e(static_cast<std::size_t>(dims.prod()), 0);
+  for (const world::Box& o : map.obstacles()) {
+    // Cell i's closed box [b + i c, b + (i+1) c] meets [omin - r, omax + r] iff
+    // (omin - r - b)/c - 1 <= i <= (omax + r - b)/c.
+    Eigen::Vector3i lo, hi;
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::max(0, static_cast<int>(std::ceil((o.min[a] - radius - b.min[a]) / c[a] - 1.0)));
+      hi[a] = std::min(dims[a] - 1, static_cast<int>(std::floor((o.max[a] + radius - b.min[a]) / c[a])));
+    }
+    for (int k = lo.z(); k <= hi.z(); ++k)
+      for (int j = lo.y(); j <= hi.y(); ++j)
+        for (int i = lo.x(); i <= hi.x(); ++i) e[cell_index(dims, i, j, k)] = 1;
+  }
+  return e;
+}
+
+std::vector<std::uint8_t> encode_state(const world::Box& b, const Eigen::Vector3i& dims, const Eigen::Vector3d& start,
+                                       const Eigen::Vector3d& goal, int dilation) {
+  std::vector<std::uint8_t> s(static_cast<std::size_t>(dims.prod()), 0);
+  for (const Eigen::Vector3d& p : {start, goal}) {
+    const Eigen::Vector3i c = cell_of(b, dims, p);
+    for (int k = std::max(0, c.z() - dilation); k <= std::min(dims.z() - 1, c.z() + dilation); ++k)
+      for (int j = std::max(0, c.y() - dilation); j <= std::min(dims.y() - 1, c.y() + dilation); ++j)
+        for (int i = std::max(0, c.x() - dilation); i <= std::min(dims.x() - 1, c.x() + dilation); ++i)
+          s[cell_index(dims, i, j, k)] = 1;
+  }
+  return s;
+}
+
+Sample make_sample(const DatasetOptions& o, std::uint64_t k) {
+  const world::GeneratorPreset preset = world::generator_preset(o.preset);
+  Sample s;
+  s.map_seed = splitmix64(o.seed ^ k);
+  const world::Map map = world::generate_map(preset, s.map_seed);
+  const double r = preset.robot_radius;
+  const world::VoxelGrid grid(map, r);
+  const world::Box& b = map.bounds();
+  const double min_distance = o.min_separation * (b.max - b.min).norm();
+  Rng rng(s.map_seed, 0x9e3779b97f4a7c15ULL);  // a stream the generator never uses
+  std::optional<world::GridPath> path;
+  for (int attempt = 0; attempt < kMaxQueryAttempts && !path; ++attempt) {
+    Eigen::Vector3d p[2];
+    for (auto& q : p)
+      for (int a = 0; a < 3; ++a) q[a] = rng.uniform(b.min[a] + r, b.max[a] - r);
+    if ((p[1] - p[0]).norm() < min_distance || !map.is_free(p[0], r) || !map.is_free(p[1], r)) continue;
+    try {
+      path = world::astar(map, grid, p[0], p[1]);
+      s.start = p[0];
+      s.goal = p[1];
+    } catch (const Error&) {
+      // an occupied grid cell or no grid path: draw again
+    }
+  }
+  if (!path) {  // the generator's own query is solvable by construction
+    s.start = map.query()->start;
+    s.goal = map.query()->goal;
+    path = world::astar(map, grid, s.start, s.goal);
+  }
+  s.astar_cost = path->cost;
+  s.environment = encode_environment(map, o.dims, r);
+  s.state = encode_state(b, o.dims, s.start, s.goal, o.dilation);
+  const auto region = plan::HeuristicRegion::from_path(b, o.dims, path->points, o.dilation, "astar-dilated");
+  s.target.assign(static_cast<std::size_t>(o.dims.prod()), 0);
+  for (std::size_t c : region.cells()) s.target[c] = 1;
+  return s;
+}
+
+Json write_dataset(const DatasetOptions& o, const std::string& dir, std::ostream* progress) {
+  validate(o);
+  const int val = static_cast<int>(std::lround(o.val_fraction * o.count));
+  const int counts[3] = {o.count - val, val, o.test_count};
+  const std::uint64_t first[3] = {0, static_cast<std::uint64_t>(o.count - val), static_cast<std::uint64_t>(o.count)};
+  const std::size_t cells = static_cast<std::size_t>(o.dims.prod());
+  std::vector<std::pair<std::string, std::string>> files;
+  Json splits = Json::object();
+  ProgressBar bar(progress, "dataset", static_cast<std::size_t>(o.count + o.test_count));
+  std::size_t done = 0;
+  for (int sp = 0; sp < 3; ++sp) {
+    Json shards = Json::array();
+    Json index = Json::array();
+    std::string shard;
+    int in_shard = 0;
+    auto flush = [&] {
+      if (in_shard == 0) return;
+      const std::string name = shard_name(kSplits[sp], shards.size());
+      shards.push_back({{"file", name}, {"count", in_shard}});
+      files.emplace_back(name, std::move(shard));
+      shard.clear();
+      in_shard = 0;
+    };
+    for (int i = 0; i < counts[sp]; ++i) {
+      const std::uint64_t k = first[sp] + static_cast<std::uint64_t>(i);
+      const Sample s = make_sample(o, k);
+      for (const auto* channel : {&s.environment, &s.state, &s.target})
+        shard.append(reinterpret_cast<const char*>(channel->data()), cells);
+      index.push_back({{"k", k}, {"map_seed", s.map_seed}, {"start", vec3_json(s.start)},
+                       {"goal", vec3_json(s.goal)}, {"astar_cost", s.astar_cost}});
+      if (++in_shard == o.shard_size) flush();
+      bar.update(++done);
+    }
+    flush();
+    splits[kSplits[sp]] = {{"count", counts[sp]}, {"shards", shards}, {"index", std::string(kSplits[sp]) + "-index.json"}};
+    files.emplace_back(std::string(kSplits[sp]) + "-index.json", dump_json(index));
+  }
+  bar.finish();
+  const world::GeneratorPreset preset = world::generator_preset(o.preset);
+  Json doc = {{"format", kDatasetFormat},
+              {"preset", o.preset},
+              {"seed", o.seed},
+              {"dims", {o.dims.x(), o.dims.y(), o.dims.z()}},
+              {"bounds", {{"min", vec3_json(preset.bounds.min)}, {"max", vec3_json(preset.bounds.max)}}},
+              {"channels", {"environment", "state", "target"}},
+              {"dtype", "uint8"},
+              {"layout", "sample, channel, z, y, x (x fastest)"},
+              {"robot_radius", preset.robot_radius},
+              {"dilation", o.dilation},
+              {"min_separation", o.min_separation},
+              {"map_seed_rule", "splitmix64(seed ^ k); train and val: k < count, test: k >= count"},
+              {"splits", splits}};
+  files.emplace_back("dataset.json", dump_json(doc));
+  write_folder_atomic(dir, files);
+  return doc;
+}
+
+std::vector<Sample> read_split(const std::string& dir, const std::string& split) {
+  const Json doc = read_json_file(dir + "/dataset.json");
+  const JsonField root(doc, "", dir + "/dataset.json");
+  if (root.at("format").string() != kDatasetFormat) root.at("format").fail("not a miner-dataset-v1 folder");
+  const JsonField dims_field = root.at("dims");
+  const Eigen::Vector3i dims(dims_field.at(0).integer(), dims_field.at(1).integer(), dims_field.at(2).integer());
+  const std::size_t cells = static_cast<std::size_t>(dims.prod());
+  const JsonField sp = root.at("splits").at(split);
+  const Json index = read_json_file(dir + "/" + sp.at("index").string());
+  std::vector<Sample> out;
+  for (std::size_t i = 0; i < sp.at("shards").array_size(); ++i) {
+    const JsonField shard = sp.at("shards").at(i);
+    const std::string path = dir + "/" + shard.at("file").string();
+    const auto n = static_cast<std::size_t>(shard.at("count").integer());
+    std::ifstream in(path, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (bytes.size() != n * 3 * cells)
+      throw Error(path + ": expected " + std::to_string(n * 3 * cells) + " bytes (" + std::to_string(n) +
+                  " samples of 3 x " + std::to_string(cells) + "), found " + std::to_string(bytes.size()));
+    for (std::size_t s = 0; s < n; ++s) {
+      Sample sample;
+      const JsonField meta(index.at(out.size()), split + "-index[" + std::to_string(out.size()) + "]", dir);
+      sample.map_seed = index.at(out.size()).at("map_seed").get<std::uint64_t>();
+      sample.start = meta.at("start").vec3();
+      sample.goal = meta.at("goal").vec3();
+      sample.astar_cost = meta.at("astar_cost").number();
+      const auto* base = reinterpret_cast<const std::uint8_t*>(bytes.data()) + s * 3 * cells;
+      sample.environment.assign(base, base + cells);
+      sample.state.assign(base + cells, base + 2 * cells);
+      sample.target.assign(base + 2 * cells, base + 3 * cells);
+      out.push_back(std::move(sample));
+    }
+  }
+  return out;
+}
+
+}  // namespace miner::heuristic

@@ -1,0 +1,84 @@
+#pragma once
+/// \file
+/// The sGAN's training data (paper Sec. V-A.1; REQ-HEUR-001..003): random cluttered maps
+/// with a random start and goal, the A* path as ground truth, encoded on a fixed heuristic
+/// grid over the map bounds as three channels of 0/1 bytes:
+///   E (environment)  1 where the cell, grown by the robot radius, meets an obstacle;
+///   S (state)        1 in the 3x3x3 cubes of cells around the start and the goal cells;
+///   T (target)       1 in the cells the A* path passes through, dilated to 3x3x3 cubes
+///                    (HeuristicRegion::from_path, the same region `miner region astar`
+///                    writes and the MINER planner samples).
+/// Grid: 32^3 by default. A 100 m sim map gives 3.1 x 3.1 x 1.25 m cells, about a quarter
+/// of the preset's smallest obstacle side (4 m) horizontally, so obstacles survive the
+/// encoding while a 3D convolution over 32^3 stays within the 5 ms CPU budget of the
+/// issue (~0.45 GFLOP per 16->16 channel layer, ../shared/anchors.md).
+///
+/// Layout on disk (`miner-dataset-v1`): DIR/dataset.json describes everything; each split
+/// (train, val, test) is a series of shards `<split>-NNNNN.bin`, each the raw bytes of
+/// uint8[n][3][nz][ny][nx] (channel order E, S, T; x fastest), readable with
+/// numpy.fromfile(..., dtype=uint8).reshape(n, 3, nz, ny, nx); DIR/<split>-index.json
+/// lists each sample's map seed, start, goal and A* cost.
+///
+/// Seeds: sample k (0 <= k < count + test_count) uses map seed splitmix64(seed ^ k), a
+/// bijection of k, so the test samples (k >= count) come from map seeds never used in
+/// training or validation. The last round(val_fraction count) of the first `count` are the
+/// validation split.
+
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "miner/core/json_io.hpp"
+#include "miner/world/map.hpp"
+
+namespace miner::heuristic {
+
+inline constexpr const char* kDatasetFormat = "miner-dataset-v1";
+
+struct DatasetOptions {
+  std::string preset = "sim";
+  int count = 1000;         ///< train + validation samples
+  int test_count = 100;     ///< samples from unseen map seeds
+  double val_fraction = 0.1;
+  std::uint64_t seed = 1;
+  Eigen::Vector3i dims{32, 32, 32};
+  int dilation = 1;         ///< 3x3x3 cubes
+  int shard_size = 256;     ///< samples per shard file
+  /// Start and goal at least this fraction of the bounds' diagonal apart, so the path
+  /// crosses the clutter (the paper's queries span the map).
+  double min_separation = 0.5;
+};
+
+/// Throws miner::Error naming the option unless the options are usable.
+void validate(const DatasetOptions& o);
+
+struct Sample {
+  std::uint64_t map_seed = 0;
+  Eigen::Vector3d start = Eigen::Vector3d::Zero();
+  Eigen::Vector3d goal = Eigen::Vector3d::Zero();
+  double astar_cost = 0.0;
+  std::vector<std::uint8_t> environment, state, target;  ///< each dims.prod(), x fastest
+};
+
+/// E: cell boxes grown by `radius` that overlap an obstacle.
+std::vector<std::uint8_t> encode_environment(const world::Map& map, const Eigen::Vector3i& dims, double radius);
+/// S: the (2 dilation + 1)^3 cubes around the cells of start and goal.
+std::vector<std::uint8_t> encode_state(const world::Box& bounds, const Eigen::Vector3i& dims,
+                                       const Eigen::Vector3d& start, const Eigen::Vector3d& goal, int dilation);
+
+/// Sample k of the dataset: the preset's map for seed splitmix64(seed ^ k) with a random
+/// start and goal (free for the robot radius, min_separation apart, A*-connected; drawn
+/// again from the next RNG stream otherwise).
+Sample make_sample(const DatasetOptions& o, std::uint64_t k);
+
+/// Generates the whole dataset into `dir` (written as a whole: REQ-CORE-004). Progress
+/// goes to `progress` when it is not null.
+Json write_dataset(const DatasetOptions& o, const std::string& dir, std::ostream* progress);
+
+/// Reads split `split` back: one Sample per record (metadata from the index).
+std::vector<Sample> read_split(const std::string& dir, const std::string& split);
+
+}  // namespace miner::heuristic

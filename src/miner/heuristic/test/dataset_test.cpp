@@ -1,0 +1,160 @@
+#include <catch2/catch.hpp>
+
+#include <deque>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <unistd.h>
+
+#include "miner/core/error.hpp"
+#include "miner/core/progress.hpp"
+#include "miner/heuristic/dataset.hpp"
+
+using Catch::Matchers::Contains;
+namespace heuristic = miner::heuristic;
+
+namespace {
+
+std::string temp_dir() {
+  const auto p = std::filesystem::temp_directory_path() / ("miner_heuristic_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(p);
+  return p.string();
+}
+
+heuristic::DatasetOptions small_options() {
+  heuristic::DatasetOptions o;
+  o.preset = "indoor";
+  o.count = 6;
+  o.test_count = 2;
+  o.val_fraction = 0.34;
+  o.seed = 5;
+  o.shard_size = 3;
+  return o;
+}
+
+std::string read_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+}  // namespace
+
+TEST_CASE("Environment cells are exactly those whose box grown by the radius meets an obstacle", "[REQ-HEUR-002]") {
+  using miner::world::Box;
+  const miner::world::Map map(Box{{0, 0, 0}, {8, 8, 4}}, 0.5,
+                              {Box{{1.0, 1.0, 0.0}, {2.0, 3.0, 1.0}}, Box{{5.3, 5.9, 2.2}, {5.4, 6.0, 2.3}}});
+  const Eigen::Vector3i dims(8, 8, 4);  // 1 m cells
+  const double r = 0.2;
+  const auto e = heuristic::encode_environment(map, dims, r);
+  for (int k = 0; k < 4; ++k)
+    for (int j = 0; j < 8; ++j)
+      for (int i = 0; i < 8; ++i) {
+        const Box cell{Eigen::Vector3d(i, j, k), Eigen::Vector3d(i + 1, j + 1, k + 1)};
+        bool hit = false;
+        for (const Box& o : map.obstacles()) {
+          const Box g = o.inflated(r);
+          hit = hit || ((cell.min.array() <= g.max.array()).all() && (g.min.array() <= cell.max.array()).all());
+        }
+        CHECK(e[(static_cast<std::size_t>(k) * 8 + j) * 8 + i] == (hit ? 1 : 0));
+      }
+}
+
+TEST_CASE("A sample's state marks 3x3x3 cubes at start and goal and its target is a connected region between them",
+          "[REQ-HEUR-002]") {
+  const auto o = small_options();
+  const heuristic::Sample s = heuristic::make_sample(o, 0);
+  const Eigen::Vector3i d = o.dims;
+  const std::size_t n = static_cast<std::size_t>(d.prod());
+  REQUIRE(s.environment.size() == n);
+  const auto count = [](const std::vector<std::uint8_t>& v) { return std::count(v.begin(), v.end(), 1); };
+  CHECK(count(s.state) <= 54);
+  CHECK(count(s.state) >= 27);  // two cubes, overlapping or clipped at the border at most
+  CHECK((s.goal - s.start).norm() >= o.min_separation * Eigen::Vector3d(10, 10, 5).norm());
+  auto cell = [&](const Eigen::Vector3d& p) {
+    const Eigen::Vector3d c = Eigen::Vector3d(10, 10, 5).cwiseQuotient(d.cast<double>());
+    Eigen::Vector3i i = p.cwiseQuotient(c).array().floor().cast<int>();
+    return (static_cast<std::size_t>(i.z()) * d.y() + i.y()) * d.x() + i.x();
+  };
+  REQUIRE(s.target[cell(s.start)] == 1);
+  REQUIRE(s.target[cell(s.goal)] == 1);
+  // 26-connected flood fill inside T from the start's cell reaches the goal's cell.
+  std::vector<std::uint8_t> seen(n, 0);
+  std::deque<std::size_t> queue{cell(s.start)};
+  seen[queue.front()] = 1;
+  while (!queue.empty()) {
+    const std::size_t c = queue.front();
+    queue.pop_front();
+    const int x = static_cast<int>(c % d.x()), y = static_cast<int>((c / d.x()) % d.y()), z = static_cast<int>(c / (d.x() * d.y()));
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int a = x + dx, b = y + dy, e = z + dz;
+          if (a < 0 || b < 0 || e < 0 || a >= d.x() || b >= d.y() || e >= d.z()) continue;
+          const std::size_t m = (static_cast<std::size_t>(e) * d.y() + b) * d.x() + a;
+          if (s.target[m] && !seen[m]) {
+            seen[m] = 1;
+            queue.push_back(m);
+          }
+        }
+  }
+  CHECK(seen[cell(s.goal)] == 1);
+  CHECK(s.astar_cost >= (s.goal - s.start).norm());
+}
+
+TEST_CASE("The dataset has its splits, unseen test seeds and the same bytes for a seed", "[REQ-HEUR-001]") {
+  const auto o = small_options();
+  const std::string a = temp_dir() + "/a", b = temp_dir() + "/b";
+  const miner::Json doc = heuristic::write_dataset(o, a, nullptr);
+  heuristic::write_dataset(o, b, nullptr);
+  CHECK(doc["splits"]["train"]["count"] == 4);
+  CHECK(doc["splits"]["val"]["count"] == 2);
+  CHECK(doc["splits"]["test"]["count"] == 2);
+  CHECK(doc["splits"]["train"]["shards"].size() == 2);  // shard size 3
+  for (const char* f : {"dataset.json", "train-00000.bin", "train-00001.bin", "val-00000.bin", "test-00000.bin",
+                        "train-index.json", "test-index.json"})
+    CHECK(read_bytes(a + "/" + f) == read_bytes(b + "/" + f));
+  const auto train = heuristic::read_split(a, "train"), val = heuristic::read_split(a, "val"),
+             test = heuristic::read_split(a, "test");
+  REQUIRE(train.size() == 4);
+  std::set<std::uint64_t> seen;
+  for (const auto* split : {&train, &val})
+    for (const auto& s : *split) seen.insert(s.map_seed);
+  for (const auto& s : test) CHECK(seen.count(s.map_seed) == 0);
+  // What is read back is what make_sample produces.
+  const heuristic::Sample again = heuristic::make_sample(o, 5);  // k = 5: the second val sample
+  CHECK(val[1].target == again.target);
+  CHECK(val[1].environment == again.environment);
+  CHECK(val[1].start == again.start);
+  // A truncated shard is refused naming the file and the sizes.
+  std::filesystem::resize_file(a + "/test-00000.bin", 100);
+  CHECK_THROWS_WITH(heuristic::read_split(a, "test"), Contains("test-00000.bin") && Contains("expected"));
+}
+
+TEST_CASE("Bad dataset options are refused naming the option", "[REQ-HEUR-003]") {
+  auto o = small_options();
+  o.count = 0;
+  CHECK_THROWS_WITH(heuristic::write_dataset(o, temp_dir() + "/bad", nullptr), Contains("--count"));
+  o = small_options();
+  o.dims = Eigen::Vector3i(2, 32, 32);
+  CHECK_THROWS_WITH(heuristic::validate(o), Contains("--dims"));
+  o = small_options();
+  o.preset = "forest";
+  CHECK_THROWS_WITH(heuristic::validate(o), Contains("forest"));
+  CHECK_FALSE(std::filesystem::exists(temp_dir() + "/bad"));
+}
+
+TEST_CASE("The progress bar draws only to a given stream and ends its line", "[REQ-CORE-006]") {
+  std::ostringstream os;
+  {
+    miner::ProgressBar bar(&os, "work", 4);
+    for (std::size_t i = 1; i <= 4; ++i) bar.update(i);
+  }
+  CHECK_THAT(os.str(), Contains("work [") && Contains("4/4"));
+  CHECK(os.str().back() == '\n');
+  miner::ProgressBar quiet(nullptr, "work", 4);
+  quiet.update(2);  // no stream: nothing happens, nothing crashes
+}

@@ -29,6 +29,7 @@ void add_heuristic_commands(CLI::App& app, std::ostream& out) {
   d->add_option("--dims", o->dims, "heuristic grid nx ny nz")->expected(3)->capture_default_str();
   d->add_option("--dilation", o->dataset.dilation, "cells around start, goal and path cells (1: 3x3x3)")->capture_default_str();
   d->add_option("--shard-size", o->dataset.shard_size, "samples per shard file")->capture_default_str();
+  d->add_option("--jobs", o->dataset.jobs, "worker threads (the output does not depend on it)")->capture_default_str();
   d->add_option("--out", o->out, "output folder (written as a whole)")->required();
   d->callback([o, &out] {
     heuristic::DatasetOptions options = o->dataset;

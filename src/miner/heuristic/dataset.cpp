@@ -1,5 +1,10 @@
 #include "miner/heuristic/dataset.hpp"
 
+#include <atomic>
+#include <exception>
+#include <mutex>
+#include <thread>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -10,6 +15,7 @@
 #include "miner/core/error.hpp"
 #include "miner/core/progress.hpp"
 #include "miner/core/rng.hpp"
+#include "miner/heuristic/grid.hpp"
 #include "miner/plan/heuristic_region.hpp"
 #include "miner/world/astar.hpp"
 #include "miner/world/map_generator.hpp"
@@ -22,22 +28,6 @@ namespace {
 /// Start/goal draws per map before falling back to the map's own (A*-checked) query.
 constexpr int kMaxQueryAttempts = 64;
 constexpr const char* kSplits[3] = {"train", "val", "test"};
-
-Eigen::Vector3d cell_size(const world::Box& b, const Eigen::Vector3i& dims) {
-  return (b.max - b.min).cwiseQuotient(dims.cast<double>());
-}
-
-std::size_t cell_index(const Eigen::Vector3i& dims, int i, int j, int k) {
-  return (static_cast<std::size_t>(k) * dims.y() + j) * dims.x() + i;
-}
-
-Eigen::Vector3i cell_of(const world::Box& b, const Eigen::Vector3i& dims, const Eigen::Vector3d& p) {
-  const Eigen::Vector3d c = cell_size(b, dims);
-  Eigen::Vector3i idx;
-  for (int a = 0; a < 3; ++a)
-    idx[a] = std::clamp(static_cast<int>(std::floor((p[a] - b.min[a]) / c[a])), 0, dims[a] - 1);
-  return idx;
-}
 
 std::string shard_name(const std::string& split, std::size_t i) {
   char buf[64];
@@ -56,39 +46,8 @@ void validate(const DatasetOptions& o) {
     throw Error("dataset: --dims must be between 4 and 256 cells per axis");
   if (o.dilation < 0 || o.dilation > 4) throw Error("dataset: --dilation must be in [0, 4]");
   if (o.shard_size < 1) throw Error("dataset: --shard-size must be >= 1");
+  if (o.jobs < 1 || o.jobs > 256) throw Error("dataset: --jobs must be in [1, 256]");
   if (!(o.min_separation >= 0.0 && o.min_separation < 1.0)) throw Error("dataset: min_separation must be in [0, 1)");
-}
-
-std::vector<std::uint8_t> encode_environment(const world::Map& map, const Eigen::Vector3i& dims, double radius) {
-  const world::Box& b = map.bounds();
-  const Eigen::Vector3d c = cell_size(b, dims);
-  std::vector<std::uint8_t> e(static_cast<std::size_t>(dims.prod()), 0);
-  for (const world::Box& o : map.obstacles()) {
-    // Cell i's closed box [b + i c, b + (i+1) c] meets [omin - r, omax + r] iff
-    // (omin - r - b)/c - 1 <= i <= (omax + r - b)/c.
-    Eigen::Vector3i lo, hi;
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = std::max(0, static_cast<int>(std::ceil((o.min[a] - radius - b.min[a]) / c[a] - 1.0)));
-      hi[a] = std::min(dims[a] - 1, static_cast<int>(std::floor((o.max[a] + radius - b.min[a]) / c[a])));
-    }
-    for (int k = lo.z(); k <= hi.z(); ++k)
-      for (int j = lo.y(); j <= hi.y(); ++j)
-        for (int i = lo.x(); i <= hi.x(); ++i) e[cell_index(dims, i, j, k)] = 1;
-  }
-  return e;
-}
-
-std::vector<std::uint8_t> encode_state(const world::Box& b, const Eigen::Vector3i& dims, const Eigen::Vector3d& start,
-                                       const Eigen::Vector3d& goal, int dilation) {
-  std::vector<std::uint8_t> s(static_cast<std::size_t>(dims.prod()), 0);
-  for (const Eigen::Vector3d& p : {start, goal}) {
-    const Eigen::Vector3i c = cell_of(b, dims, p);
-    for (int k = std::max(0, c.z() - dilation); k <= std::min(dims.z() - 1, c.z() + dilation); ++k)
-      for (int j = std::max(0, c.y() - dilation); j <= std::min(dims.y() - 1, c.y() + dilation); ++j)
-        for (int i = std::max(0, c.x() - dilation); i <= std::min(dims.x() - 1, c.x() + dilation); ++i)
-          s[cell_index(dims, i, j, k)] = 1;
-  }
-  return s;
 }
 
 Sample make_sample(const DatasetOptions& o, std::uint64_t k) {
@@ -124,8 +83,10 @@ Sample make_sample(const DatasetOptions& o, std::uint64_t k) {
   s.environment = encode_environment(map, o.dims, r);
   s.state = encode_state(b, o.dims, s.start, s.goal, o.dilation);
   const auto region = plan::HeuristicRegion::from_path(b, o.dims, path->points, o.dilation, "astar-dilated");
+  // T leaves out the solid cells the dilation reaches into (no free point there); the path's
+  // own cells are never solid, so T stays connected.
   s.target.assign(static_cast<std::size_t>(o.dims.prod()), 0);
-  for (std::size_t c : region.cells()) s.target[c] = 1;
+  for (std::size_t c : region.cells()) s.target[c] = s.environment[c] == kSolid ? 0 : 1;
   return s;
 }
 
@@ -152,15 +113,39 @@ Json write_dataset(const DatasetOptions& o, const std::string& dir, std::ostream
       shard.clear();
       in_shard = 0;
     };
-    for (int i = 0; i < counts[sp]; ++i) {
-      const std::uint64_t k = first[sp] + static_cast<std::uint64_t>(i);
-      const Sample s = make_sample(o, k);
-      for (const auto* channel : {&s.environment, &s.state, &s.target})
-        shard.append(reinterpret_cast<const char*>(channel->data()), cells);
-      index.push_back({{"k", k}, {"map_seed", s.map_seed}, {"start", vec3_json(s.start)},
-                       {"goal", vec3_json(s.goal)}, {"astar_cost", s.astar_cost}});
-      if (++in_shard == o.shard_size) flush();
-      bar.update(++done);
+    // Samples are independent, so `jobs` threads make a shard's worth at a time; the bytes
+    // do not depend on the number of threads.
+    for (int i0 = 0; i0 < counts[sp]; i0 += o.shard_size) {
+      const int n = std::min(o.shard_size, counts[sp] - i0);
+      std::vector<Sample> batch(static_cast<std::size_t>(n));
+      std::atomic<int> next{0};
+      std::exception_ptr failure;
+      std::mutex failure_mutex;
+      auto worker = [&] {
+        for (int i = next++; i < n; i = next++) {
+          try {
+            batch[static_cast<std::size_t>(i)] = make_sample(o, first[sp] + static_cast<std::uint64_t>(i0 + i));
+          } catch (...) {
+            const std::lock_guard<std::mutex> lock(failure_mutex);
+            if (!failure) failure = std::current_exception();
+          }
+        }
+      };
+      std::vector<std::thread> pool;
+      for (int t = 1; t < std::min(o.jobs, n); ++t) pool.emplace_back(worker);
+      worker();
+      for (auto& t : pool) t.join();
+      if (failure) std::rethrow_exception(failure);
+      for (int i = 0; i < n; ++i) {
+        const Sample& s = batch[static_cast<std::size_t>(i)];
+        for (const auto* channel : {&s.environment, &s.state, &s.target})
+          shard.append(reinterpret_cast<const char*>(channel->data()), cells);
+        index.push_back({{"k", first[sp] + static_cast<std::uint64_t>(i0 + i)}, {"map_seed", s.map_seed},
+                         {"start", vec3_json(s.start)}, {"goal", vec3_json(s.goal)}, {"astar_cost", s.astar_cost}});
+        if (++in_shard == o.shard_size) flush();
+      }
+      done += static_cast<std::size_t>(n);
+      bar.update(done);
     }
     flush();
     splits[kSplits[sp]] = {{"count", counts[sp]}, {"shards", shards}, {"index", std::string(kSplits[sp]) + "-index.json"}};
@@ -174,6 +159,7 @@ Json write_dataset(const DatasetOptions& o, const std::string& dir, std::ostream
               {"dims", {o.dims.x(), o.dims.y(), o.dims.z()}},
               {"bounds", {{"min", vec3_json(preset.bounds.min)}, {"max", vec3_json(preset.bounds.max)}}},
               {"channels", {"environment", "state", "target"}},
+              {"environment_levels", {{"free", 0}, {"partial", 1}, {"solid", 2}}},
               {"dtype", "uint8"},
               {"layout", "sample, channel, z, y, x (x fastest)"},
               {"robot_radius", preset.robot_radius},

@@ -3,11 +3,12 @@
 /// The sGAN's training data (paper Sec. V-A.1; REQ-HEUR-001..003): random cluttered maps
 /// with a random start and goal, the A* path as ground truth, encoded on a fixed heuristic
 /// grid over the map bounds as three channels of 0/1 bytes:
-///   E (environment)  1 where the cell, grown by the robot radius, meets an obstacle;
+///   E (environment)  0 free, 1 partially occupied, 2 solid (grid.hpp: the cell against the
+///                    obstacles grown by the robot radius);
 ///   S (state)        1 in the 3x3x3 cubes of cells around the start and the goal cells;
 ///   T (target)       1 in the cells the A* path passes through, dilated to 3x3x3 cubes
 ///                    (HeuristicRegion::from_path, the same region `miner region astar`
-///                    writes and the MINER planner samples).
+///                    writes and the MINER planner samples), less its solid cells.
 /// Grid: 32^3 by default. A 100 m sim map gives 3.1 x 3.1 x 1.25 m cells, about a quarter
 /// of the preset's smallest obstacle side (4 m) horizontally, so obstacles survive the
 /// encoding while a 3D convolution over 32^3 stays within the 5 ms CPU budget of the
@@ -32,6 +33,7 @@
 #include <Eigen/Core>
 
 #include "miner/core/json_io.hpp"
+#include "miner/heuristic/grid.hpp"
 #include "miner/world/map.hpp"
 
 namespace miner::heuristic {
@@ -47,6 +49,7 @@ struct DatasetOptions {
   Eigen::Vector3i dims{32, 32, 32};
   int dilation = 1;         ///< 3x3x3 cubes
   int shard_size = 256;     ///< samples per shard file
+  int jobs = 1;             ///< worker threads (the output does not depend on it)
   /// Start and goal at least this fraction of the bounds' diagonal apart, so the path
   /// crosses the clutter (the paper's queries span the map).
   double min_separation = 0.5;
@@ -62,12 +65,6 @@ struct Sample {
   double astar_cost = 0.0;
   std::vector<std::uint8_t> environment, state, target;  ///< each dims.prod(), x fastest
 };
-
-/// E: cell boxes grown by `radius` that overlap an obstacle.
-std::vector<std::uint8_t> encode_environment(const world::Map& map, const Eigen::Vector3i& dims, double radius);
-/// S: the (2 dilation + 1)^3 cubes around the cells of start and goal.
-std::vector<std::uint8_t> encode_state(const world::Box& bounds, const Eigen::Vector3i& dims,
-                                       const Eigen::Vector3d& start, const Eigen::Vector3d& goal, int dilation);
 
 /// Sample k of the dataset: the preset's map for seed splitmix64(seed ^ k) with a random
 /// start and goal (free for the robot radius, min_separation apart, A*-connected; drawn

@@ -43,7 +43,8 @@ std::string read_bytes(const std::string& path) {
 
 }  // namespace
 
-TEST_CASE("Environment cells are exactly those whose box grown by the radius meets an obstacle", "[REQ-HEUR-002]") {
+TEST_CASE("Environment cells are free, partial where a grown obstacle meets them, solid where grown obstacles cover them",
+          "[REQ-HEUR-002]") {
   using miner::world::Box;
   const miner::world::Map map(Box{{0, 0, 0}, {8, 8, 4}}, 0.5,
                               {Box{{1.0, 1.0, 0.0}, {2.0, 3.0, 1.0}}, Box{{5.3, 5.9, 2.2}, {5.4, 6.0, 2.3}}});
@@ -59,8 +60,52 @@ TEST_CASE("Environment cells are exactly those whose box grown by the radius mee
           const Box g = o.inflated(r);
           hit = hit || ((cell.min.array() <= g.max.array()).all() && (g.min.array() <= cell.max.array()).all());
         }
-        CHECK(e[(static_cast<std::size_t>(k) * 8 + j) * 8 + i] == (hit ? 1 : 0));
+        // Covered: every point of a fine lattice over the closed cell is in a grown box.
+        bool covered = hit;
+        for (int a = 0; a <= 8 && covered; ++a)
+          for (int b = 0; b <= 8 && covered; ++b)
+            for (int c = 0; c <= 8 && covered; ++c) {
+              const Eigen::Vector3d p = cell.min + Eigen::Vector3d(a, b, c) / 8.0;
+              bool in = false;
+              for (const Box& o : map.obstacles()) {
+                const Box g = o.inflated(r);
+                in = in || ((p.array() >= g.min.array()).all() && (p.array() <= g.max.array()).all());
+              }
+              covered = in;
+            }
+        CHECK(e[(static_cast<std::size_t>(k) * 8 + j) * 8 + i] == (covered ? 2 : hit ? 1 : 0));
       }
+  CHECK(e[(0 * 8 + 1) * 8 + 1] == heuristic::kSolid);  // [1,2]x[1,2]x[0,1] inside [0.8,2.2]x[0.8,3.2]x[-0.2,1.2]
+}
+
+TEST_CASE("A cell covered only by the union of two boxes is covered; a gap of any width is found", "[REQ-HEUR-002]") {
+  using miner::world::Box;
+  const Box cell{{0, 0, 0}, {1, 1, 1}};
+  CHECK(heuristic::box_covered(cell, {Box{{-1, -1, -1}, {0.4, 2, 2}}, Box{{0.4, -1, -1}, {2, 2, 2}}}));
+  CHECK_FALSE(heuristic::box_covered(cell, {Box{{-1, -1, -1}, {0.4, 2, 2}}, Box{{0.41, -1, -1}, {2, 2, 2}}}));
+  CHECK_FALSE(heuristic::box_covered(cell, {Box{{-1, -1, -1}, {2, 2, 0.999}}}));
+  CHECK_FALSE(heuristic::box_covered(cell, {}));
+}
+
+TEST_CASE("Regions connect through faces, edges and corners only", "[REQ-HEUR-004]") {
+  const Eigen::Vector3i d(4, 4, 4);
+  std::vector<std::uint8_t> m(64, 0);
+  auto set = [&](int i, int j, int k) { m[heuristic::cell_index(d, i, j, k)] = 1; };
+  set(0, 0, 0);
+  set(1, 1, 1);  // corner neighbour
+  set(3, 3, 3);  // two cells away from (1,1,1)
+  CHECK(heuristic::connects(m, d, {0, 0, 0}, {1, 1, 1}));
+  CHECK_FALSE(heuristic::connects(m, d, {0, 0, 0}, {3, 3, 3}));
+  CHECK_FALSE(heuristic::connects(m, d, {0, 0, 0}, {2, 2, 2}));  // the end cell is not in the region
+  set(2, 2, 2);
+  CHECK(heuristic::connects(m, d, {0, 0, 0}, {3, 3, 3}));
+  const auto labels = heuristic::label_components(m, d);
+  CHECK(labels[heuristic::cell_index(d, 3, 3, 3)] == 1);
+  CHECK(labels[heuristic::cell_index(d, 0, 1, 0)] == 0);
+  std::vector<std::uint8_t> env(64, heuristic::kFree);
+  env[heuristic::cell_index(d, 2, 2, 2)] = heuristic::kSolid;
+  env[heuristic::cell_index(d, 0, 1, 0)] = heuristic::kSolid;  // outside the region
+  CHECK(heuristic::solid_cells_in(m, env) == 1);
 }
 
 TEST_CASE("A sample's state marks 3x3x3 cubes at start and goal and its target is a connected region between them",
@@ -102,6 +147,7 @@ TEST_CASE("A sample's state marks 3x3x3 cubes at start and goal and its target i
         }
   }
   CHECK(seen[cell(s.goal)] == 1);
+  CHECK(heuristic::solid_cells_in(s.target, s.environment) == 0);
   CHECK(s.astar_cost >= (s.goal - s.start).norm());
 }
 
@@ -109,7 +155,9 @@ TEST_CASE("The dataset has its splits, unseen test seeds and the same bytes for 
   const auto o = small_options();
   const std::string a = temp_dir() + "/a", b = temp_dir() + "/b";
   const miner::Json doc = heuristic::write_dataset(o, a, nullptr);
-  heuristic::write_dataset(o, b, nullptr);
+  auto parallel = o;
+  parallel.jobs = 3;
+  heuristic::write_dataset(parallel, b, nullptr);
   CHECK(doc["splits"]["train"]["count"] == 4);
   CHECK(doc["splits"]["val"]["count"] == 2);
   CHECK(doc["splits"]["test"]["count"] == 2);
@@ -144,6 +192,9 @@ TEST_CASE("Bad dataset options are refused naming the option", "[REQ-HEUR-003]")
   o = small_options();
   o.preset = "forest";
   CHECK_THROWS_WITH(heuristic::validate(o), Contains("forest"));
+  o = small_options();
+  o.jobs = 0;
+  CHECK_THROWS_WITH(heuristic::validate(o), Contains("--jobs"));
   CHECK_FALSE(std::filesystem::exists(temp_dir() + "/bad"));
 }
 

@@ -1,0 +1,151 @@
+#include "miner/heuristic/grid.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+
+#include "miner/world/map.hpp"
+
+namespace miner::heuristic {
+
+Eigen::Vector3i cell_coords(const Eigen::Vector3i& dims, std::size_t index) {
+  const auto nx = static_cast<std::size_t>(dims.x());
+  const auto ny = static_cast<std::size_t>(dims.y());
+  return {static_cast<int>(index % nx), static_cast<int>((index / nx) % ny), static_cast<int>(index / (nx * ny))};
+}
+
+Eigen::Vector3d cell_size(const world::Box& b, const Eigen::Vector3i& dims) {
+  return (b.max - b.min).cwiseQuotient(dims.cast<double>());
+}
+
+Eigen::Vector3i cell_of(const world::Box& b, const Eigen::Vector3i& dims, const Eigen::Vector3d& p) {
+  const Eigen::Vector3d c = cell_size(b, dims);
+  Eigen::Vector3i idx;
+  for (int a = 0; a < 3; ++a) {
+    const double f = std::floor((p[a] - b.min[a]) / c[a]);
+    idx[a] = static_cast<int>(std::clamp(f, 0.0, static_cast<double>(dims[a] - 1)));
+  }
+  return idx;
+}
+
+world::Box cell_box(const world::Box& b, const Eigen::Vector3i& dims, const Eigen::Vector3i& c) {
+  const Eigen::Vector3d s = cell_size(b, dims);
+  const Eigen::Vector3d lo = b.min + c.cast<double>().cwiseProduct(s);
+  return {lo, lo + s};
+}
+
+bool box_covered(const world::Box& cell, const std::vector<world::Box>& boxes) {
+  // Breakpoints of every box face strictly inside the cell, per axis: between two
+  // consecutive ones no face is crossed, so each sub-box's centre decides for all of it.
+  std::vector<double> cuts[3];
+  for (int a = 0; a < 3; ++a) {
+    cuts[a] = {cell.min[a], cell.max[a]};
+    for (const world::Box& o : boxes)
+      for (double v : {o.min[a], o.max[a]})
+        if (v > cell.min[a] && v < cell.max[a]) cuts[a].push_back(v);
+    std::sort(cuts[a].begin(), cuts[a].end());
+    cuts[a].erase(std::unique(cuts[a].begin(), cuts[a].end()), cuts[a].end());
+  }
+  for (std::size_t i = 0; i + 1 < cuts[0].size(); ++i)
+    for (std::size_t j = 0; j + 1 < cuts[1].size(); ++j)
+      for (std::size_t k = 0; k + 1 < cuts[2].size(); ++k) {
+        const Eigen::Vector3d mid(0.5 * (cuts[0][i] + cuts[0][i + 1]), 0.5 * (cuts[1][j] + cuts[1][j + 1]),
+                                  0.5 * (cuts[2][k] + cuts[2][k + 1]));
+        const bool inside = std::any_of(boxes.begin(), boxes.end(), [&](const world::Box& o) {
+          return (mid.array() >= o.min.array()).all() && (mid.array() <= o.max.array()).all();
+        });
+        if (!inside) return false;
+      }
+  return true;
+}
+
+std::vector<std::uint8_t> encode_environment(const world::Map& map, const Eigen::Vector3i& dims, double radius) {
+  const world::Box& b = map.bounds();
+  const Eigen::Vector3d c = cell_size(b, dims);
+  const auto cells = static_cast<std::size_t>(dims.prod());
+  std::vector<std::uint8_t> e(cells, kFree);
+  std::vector<std::vector<int>> touching(cells);  // grown obstacles meeting each cell
+  std::vector<world::Box> grown;
+  for (const world::Box& o : map.obstacles()) {
+    grown.push_back(o.inflated(radius));
+    const world::Box& g = grown.back();
+    // Cell i's closed box [b + i c, b + (i+1) c] meets [g.min, g.max] iff
+    // (g.min - b)/c - 1 <= i <= (g.max - b)/c.
+    Eigen::Vector3i lo, hi;
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::max(0, static_cast<int>(std::ceil((g.min[a] - b.min[a]) / c[a] - 1.0)));
+      hi[a] = std::min(dims[a] - 1, static_cast<int>(std::floor((g.max[a] - b.min[a]) / c[a])));
+    }
+    for (int k = lo.z(); k <= hi.z(); ++k)
+      for (int j = lo.y(); j <= hi.y(); ++j)
+        for (int i = lo.x(); i <= hi.x(); ++i) {
+          const std::size_t idx = cell_index(dims, i, j, k);
+          e[idx] = kPartial;
+          touching[idx].push_back(static_cast<int>(grown.size() - 1));
+        }
+  }
+  std::vector<world::Box> local;
+  for (std::size_t idx = 0; idx < cells; ++idx) {
+    if (e[idx] == kFree) continue;
+    local.clear();
+    for (int o : touching[idx]) local.push_back(grown[static_cast<std::size_t>(o)]);
+    if (box_covered(cell_box(b, dims, cell_coords(dims, idx)), local)) e[idx] = kSolid;
+  }
+  return e;
+}
+
+std::vector<std::uint8_t> encode_state(const world::Box& b, const Eigen::Vector3i& dims, const Eigen::Vector3d& start,
+                                       const Eigen::Vector3d& goal, int dilation) {
+  std::vector<std::uint8_t> s(static_cast<std::size_t>(dims.prod()), 0);
+  for (const Eigen::Vector3d& p : {start, goal}) {
+    const Eigen::Vector3i c = cell_of(b, dims, p);
+    for (int k = std::max(0, c.z() - dilation); k <= std::min(dims.z() - 1, c.z() + dilation); ++k)
+      for (int j = std::max(0, c.y() - dilation); j <= std::min(dims.y() - 1, c.y() + dilation); ++j)
+        for (int i = std::max(0, c.x() - dilation); i <= std::min(dims.x() - 1, c.x() + dilation); ++i)
+          s[cell_index(dims, i, j, k)] = 1;
+  }
+  return s;
+}
+
+std::vector<int> label_components(const std::vector<std::uint8_t>& mask, const Eigen::Vector3i& dims) {
+  std::vector<int> label(mask.size(), 0);
+  std::deque<std::size_t> queue;
+  int next = 0;
+  for (std::size_t seed = 0; seed < mask.size(); ++seed) {
+    if (!mask[seed] || label[seed]) continue;
+    label[seed] = ++next;
+    queue.push_back(seed);
+    while (!queue.empty()) {
+      const Eigen::Vector3i c = cell_coords(dims, queue.front());
+      queue.pop_front();
+      for (int dk = -1; dk <= 1; ++dk)
+        for (int dj = -1; dj <= 1; ++dj)
+          for (int di = -1; di <= 1; ++di) {
+            const Eigen::Vector3i n = c + Eigen::Vector3i(di, dj, dk);
+            if ((n.array() < 0).any() || (n.array() >= dims.array()).any()) continue;
+            const std::size_t ni = cell_index(dims, n.x(), n.y(), n.z());
+            if (!mask[ni] || label[ni]) continue;
+            label[ni] = next;
+            queue.push_back(ni);
+          }
+    }
+  }
+  return label;
+}
+
+bool connects(const std::vector<std::uint8_t>& mask, const Eigen::Vector3i& dims, const Eigen::Vector3i& a,
+              const Eigen::Vector3i& b) {
+  const std::size_t ia = cell_index(dims, a.x(), a.y(), a.z());
+  const std::size_t ib = cell_index(dims, b.x(), b.y(), b.z());
+  if (!mask[ia] || !mask[ib]) return false;
+  const std::vector<int> label = label_components(mask, dims);
+  return label[ia] == label[ib];
+}
+
+std::size_t solid_cells_in(const std::vector<std::uint8_t>& mask, const std::vector<std::uint8_t>& env) {
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < mask.size(); ++i) n += (mask[i] && env[i] == kSolid) ? 1 : 0;
+  return n;
+}
+
+}  // namespace miner::heuristic

@@ -1,0 +1,70 @@
+#pragma once
+/// \file
+/// The heuristic grid: a fixed dims grid over the map bounds on which the sGAN sees the
+/// world and predicts the region (paper Sec. IV-A.2), and the exact, computable meaning of
+/// the paper's "connected" and "safe" regions (Sec. V-A.1, ../shared/design.md errata).
+///
+/// Cell (i, j, k) is the closed box bounds.min + [i, i+1] x [j, j+1] x [k, k+1] * cell with
+/// cell = (bounds.max - bounds.min) / dims; index (k ny + j) nx + i (x fastest), the same
+/// convention as plan::HeuristicRegion and the dataset shards.
+///
+/// Environment levels (channel E):
+///   kFree    the cell box does not meet any obstacle grown by the robot radius;
+///   kPartial it meets one, but free space remains in it (a path may cross it);
+///   kSolid   it is covered by the union of the grown obstacles: no collision-free point
+///            lies in its interior, so sampling there is wasted. These are the paper's
+///            "obstacles that exceed the size of one grid" (Sec. V-A.1).
+/// A region (a set of cells) is *safe* iff it holds no kSolid cell, and *connected* iff the
+/// cells of the start and of the goal are in it and a chain of its cells, consecutive ones
+/// sharing a face, an edge or a corner (26-connectivity), joins them (REQ-HEUR-004).
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "miner/world/box.hpp"
+
+namespace miner::world {
+class Map;
+}
+
+namespace miner::heuristic {
+
+enum EnvLevel : std::uint8_t { kFree = 0, kPartial = 1, kSolid = 2 };
+
+inline std::size_t cell_index(const Eigen::Vector3i& dims, int i, int j, int k) {
+  return (static_cast<std::size_t>(k) * static_cast<std::size_t>(dims.y()) + static_cast<std::size_t>(j)) *
+             static_cast<std::size_t>(dims.x()) +
+         static_cast<std::size_t>(i);
+}
+Eigen::Vector3i cell_coords(const Eigen::Vector3i& dims, std::size_t index);
+Eigen::Vector3d cell_size(const world::Box& bounds, const Eigen::Vector3i& dims);
+/// The cell holding p (clamped onto the grid for points on or beyond the bounds).
+Eigen::Vector3i cell_of(const world::Box& bounds, const Eigen::Vector3i& dims, const Eigen::Vector3d& p);
+world::Box cell_box(const world::Box& bounds, const Eigen::Vector3i& dims, const Eigen::Vector3i& c);
+
+/// Whether the closed box `cell` lies inside the union of `boxes` (exact: the boxes'
+/// faces cut the cell into sub-boxes, each of which is inside one box or outside all).
+bool box_covered(const world::Box& cell, const std::vector<world::Box>& boxes);
+
+/// Channel E: kFree / kPartial / kSolid per cell for obstacles grown by `radius`.
+std::vector<std::uint8_t> encode_environment(const world::Map& map, const Eigen::Vector3i& dims, double radius);
+
+/// Channel S: the (2 dilation + 1)^3 cubes around the cells of start and goal.
+std::vector<std::uint8_t> encode_state(const world::Box& bounds, const Eigen::Vector3i& dims,
+                                       const Eigen::Vector3d& start, const Eigen::Vector3d& goal, int dilation);
+
+/// Labels the 26-connected components of the cells with mask != 0: label 0 for cells
+/// outside the mask, 1.. for components in order of their lowest index.
+std::vector<int> label_components(const std::vector<std::uint8_t>& mask, const Eigen::Vector3i& dims);
+
+/// Whether the region `mask` is connected between the cells a and b (see the file comment).
+bool connects(const std::vector<std::uint8_t>& mask, const Eigen::Vector3i& dims, const Eigen::Vector3i& a,
+              const Eigen::Vector3i& b);
+
+/// Number of kSolid cells of `env` inside the region `mask` (the region is safe iff 0).
+std::size_t solid_cells_in(const std::vector<std::uint8_t>& mask, const std::vector<std::uint8_t>& env);
+
+}  // namespace miner::heuristic

@@ -1,6 +1,7 @@
 #include "bench/frontend_bench.hpp"
 
 #include <algorithm>
+#include <optional>
 #include <chrono>
 #include <cmath>
 #include <ctime>
@@ -13,6 +14,9 @@
 #include "bench/ompl_planners.hpp"
 #include "miner/core/error.hpp"
 #include "miner/core/json_io.hpp"
+#include "bench/campaign_stats.hpp"
+#include "miner/heuristic/region_filter.hpp"
+#include "miner/heuristic/sgan.hpp"
 #include "miner/plan/heuristic_region.hpp"
 #include "miner/plan/reference.hpp"
 #include "miner/world/map.hpp"
@@ -23,34 +27,13 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-/// NaN marks an unknown value: a statistic over a list with one is unknown too.
-bool any_unknown(const std::vector<double>& v) {
-  return std::any_of(v.begin(), v.end(), [](double x) { return std::isnan(x); });
-}
-
-double median(std::vector<double> v) {
-  if (v.empty() || any_unknown(v)) return NAN;
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  // Lower median for even n keeps "+inf in the upper half" well defined.
-  const double m = n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-  return std::isfinite(m) ? m : NAN;
-}
-
-double mean(const std::vector<double>& v) {
-  if (v.empty() || any_unknown(v)) return NAN;
-  double s = 0.0;
-  for (double x : v) s += x;
-  return s / static_cast<double>(v.size());
-}
-
-nlohmann::json num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
 
 }  // namespace
 
 std::vector<std::string> default_frontend_planners() {
   std::vector<std::string> names;
   for (plan::PlannerKind k : plan::all_planners()) names.push_back(plan::planner_name(k));
+  names.push_back(kMinerSgan);
   for (const auto& n : ompl_planner_names()) names.push_back(n);
   return names;
 }
@@ -153,6 +136,7 @@ FrontendBenchResult run_frontend_bench(const world::Map& map, const std::string&
   out.region_source = options.region_file.empty() ? region.source() : options.region_file;
   out.region_cells = region.cells().size();
 
+  std::optional<heuristic::Sgan> sgan;
   init_ompl(options.seed);
   const auto ompl_options = [&](const std::string& name) {
     OmplRunOptions o;
@@ -176,7 +160,15 @@ FrontendBenchResult run_frontend_bench(const world::Map& map, const std::string&
                     "ompl:BITstar, ompl:ABITstar, ompl:AITstar, ompl:RRTConnect)");
       }
     }
-    const plan::PlannerKind kind = ompl ? plan::PlannerKind::kRrtStar : plan::planner_from_name(name);
+    const bool sgan_planner = name == kMinerSgan;
+    const plan::PlannerKind kind =
+        ompl ? plan::PlannerKind::kRrtStar : sgan_planner ? plan::PlannerKind::kMiner : plan::planner_from_name(name);
+    if (sgan_planner && !sgan) {
+      sgan.emplace(options.weights_file.empty() ? heuristic::Sgan::builtin() : heuristic::Sgan::load(options.weights_file));
+      // Warm-up query: the first oneDNN execution pays one-time page faults, as it would
+      // once at start-up on board.
+      heuristic::query_region(*sgan, map, start, goal, robot_radius, options.seed);
+    }
     for (int run = 0; run < options.runs; ++run) {
       RunRecord record;
       record.planner = name;
@@ -188,7 +180,19 @@ FrontendBenchResult run_frontend_bench(const world::Map& map, const std::string&
         po.planner = kind;
         po.seed = options.seed;
         po.stream = static_cast<std::uint64_t>(run);  // common random numbers across planners
-        record.result = plan::plan(problem, po, kind == plan::PlannerKind::kMiner ? &region : nullptr);
+        if (sgan_planner) {
+          // End to end: encoding, inference and filtering count in every time (Alg. 1 lines 2-3).
+          const Clock::time_point t0 = Clock::now();
+          const heuristic::HeuristicQuery q =
+              heuristic::query_region(*sgan, map, start, goal, robot_radius, options.seed + static_cast<std::uint64_t>(run));
+          const double region_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+          record.result = plan::plan(problem, po, &q.region);
+          record.result.time_ms += region_ms;
+          if (record.result.first) record.result.first->time_ms += region_ms;
+          if (record.result.target) record.result.target->time_ms += region_ms;
+        } else {
+          record.result = plan::plan(problem, po, kind == plan::PlannerKind::kMiner ? &region : nullptr);
+        }
       }
       out.runs.push_back(std::move(record));
     }

@@ -37,10 +37,15 @@ struct FrontendBenchOptions {
   Eigen::Vector3i region_dims{32, 32, 32};
   int region_dilation = 1;
   std::string region_file;      ///< miner: this region instead of the A*-dilated one
+  std::string weights_file;     ///< miner-sgan: these weights instead of the shipped ones
   /// Throughput check: the project's RRT* and OMPL's RRTstar both run this many
   /// iterations with no target, and iterations per second are compared. 0: skip.
   std::size_t throughput_iterations = 20000;
 };
+
+/// MINER with the filtered sGAN region computed per run, its time included in every
+/// figure (the end-to-end front end); "miner" itself uses the A*-dilated oracle region.
+inline constexpr const char* kMinerSgan = "miner-sgan";
 
 /// One run of one planner.
 struct RunRecord {

@@ -9,6 +9,8 @@
 
 #include "bench/backend_bench.hpp"
 #include "bench/frontend_bench.hpp"
+#include "bench/heuristic_bench.hpp"
+#include "miner/core/progress.hpp"
 #include "cli/cli.hpp"
 #include "miner/core/json_io.hpp"
 
@@ -91,6 +93,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   fc->add_option("--goal-radius", f->bench.planner_options.goal_radius, "goal radius in m (default 2 x resolution)")
       ->check(CLI::PositiveNumber);
   fc->add_option("--region", f->bench.region_file, "miner's region file (default: the A*-dilated region)");
+  fc->add_option("--weights", f->bench.weights_file, "miner-sgan's weights (default: the shipped fixtures/sgan/sgan.bin)");
   fc->add_option("--region-dims", f->region_dims, "A*-dilated region grid")->expected(3)->check(CLI::PositiveNumber);
   fc->add_option("--throughput-iterations", f->bench.throughput_iterations,
                  "iterations of the rrtstar vs ompl:RRTstar throughput check (0: skip)")
@@ -99,6 +102,30 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   fc->add_flag("--quiet", f->quiet, "no progress lines on stderr");
   add_output_options(fc, f->output);
   fc->callback([f, &out] { run_frontend(*f, out); });
+
+  struct HeuristicOptions {
+    bench::HeuristicBenchOptions bench;
+    OutputOptions output;
+  };
+  auto h = std::make_shared<HeuristicOptions>();
+  CLI::App* hc = bench_cmd->add_subcommand(
+      "heuristic", "sGAN quality like the paper's heuristic table, and what its region buys MINER over RRT*");
+  hc->add_option("--data", h->bench.data, "a `miner dataset` folder")->required();
+  hc->add_option("--split", h->bench.split, "split to measure (test: map seeds never trained on)")->capture_default_str();
+  hc->add_option("--samples", h->bench.samples, "first N samples of the split (0: all)")->capture_default_str();
+  hc->add_option("--weights", h->bench.weights, "sGAN weights (default: the shipped fixtures/sgan/sgan.bin)");
+  hc->add_option("--seed", h->bench.seed, "noise seed (sample k: seed + k) and planner seed")->capture_default_str();
+  hc->add_option("--iterations", h->bench.max_iterations, "planner iteration budget per query")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  hc->add_option("--target-factor", h->bench.target_factor, "target cost = this x the sample's A* cost")
+      ->capture_default_str();
+  hc->add_flag("!--no-planners", h->bench.planners, "quality only: do not run MINER and RRT*");
+  add_output_options(hc, h->output);
+  hc->callback([h, &out] {
+    const bench::HeuristicBenchResult r = bench::run_heuristic_bench(h->bench, terminal_stream());
+    emit(h->output, bench::to_json(r), bench::to_text(r), out);
+  });
 }
 
 }  // namespace miner::cli

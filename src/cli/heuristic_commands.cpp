@@ -1,12 +1,19 @@
-// `miner dataset` (REQ-HEUR-001..003).
+// `miner dataset` (REQ-HEUR-001..003) and `miner heuristic` (REQ-HEUR-008).
+#include <algorithm>
+#include <iomanip>
 #include <memory>
 #include <ostream>
+#include <sstream>
 
 #include <CLI/CLI.hpp>
 
 #include "cli/cli.hpp"
+#include "miner/core/error.hpp"
 #include "miner/core/progress.hpp"
 #include "miner/heuristic/dataset.hpp"
+#include "miner/heuristic/region_filter.hpp"
+#include "miner/heuristic/sgan.hpp"
+#include "miner/plan/rrt_star.hpp"
 
 namespace miner::cli {
 
@@ -16,6 +23,51 @@ struct DatasetCliOptions {
   std::vector<int> dims = {32, 32, 32};
   std::string out;
 };
+
+struct HeuristicCliOptions {
+  QueryOptions query;
+  std::string weights;
+  std::uint64_t seed = 1;
+  bool raw = false;
+  std::string region_out;
+  OutputOptions output;
+};
+
+Json report_json(const heuristic::FilterReport& r) {
+  return {{"raw_cells", r.raw_cells},         {"raw_connected", r.raw_connected}, {"raw_safe", r.raw_safe},
+          {"solid_dropped", r.solid_dropped}, {"island_dropped", r.island_dropped}, {"bridge_cells", r.bridge_cells},
+          {"cells", r.cells},                 {"connected", r.connected},           {"safe", r.safe}};
+}
+
+void run_heuristic(const HeuristicCliOptions& o, std::ostream& out) {
+  const ResolvedQuery q = resolve_query(o.query);
+  plan::PlanningProblem::make(q.map, q.start, q.goal, q.radius);  // start/goal checks, named errors
+  const heuristic::Sgan sgan = o.weights.empty() ? heuristic::Sgan::builtin() : heuristic::Sgan::load(o.weights);
+  const heuristic::HeuristicQuery h = heuristic::query_region(sgan, q.map, q.start, q.goal, q.radius, o.seed, !o.raw);
+  h.region.save(o.region_out);
+  Json doc = {{"region", o.region_out},
+              {"source", h.region.source()},
+              {"weights", sgan.path()},
+              {"seed", o.seed},
+              {"dims", {h.region.dims().x(), h.region.dims().y(), h.region.dims().z()}},
+              {"filter", report_json(h.report)},
+              {"encode_ms", h.encode_ms},
+              {"inference_ms", h.inference_ms},
+              {"filter_ms", h.filter_ms}};
+  std::ostringstream s;
+  const auto& r = h.report;
+  s << "wrote " << o.region_out << " (" << h.region.source() << "): " << h.region.cells().size() << " of "
+    << h.region.dims().prod() << " cells\n"
+    << "raw output: " << r.raw_cells << " cells, " << (r.raw_connected ? "connected" : "not connected") << ", "
+    << (r.raw_safe ? "safe" : "unsafe") << "\n"
+    << "filter: -" << r.solid_dropped << " solid, -" << r.island_dropped << " island, +" << r.bridge_cells
+    << " bridge -> " << r.cells << " cells, " << (r.connected ? "connected" : "not connected") << ", "
+    << (r.safe ? "safe" : "unsafe") << "\n"
+    << std::fixed << std::setprecision(2) << "time: encode " << h.encode_ms << " ms, inference " << h.inference_ms
+    << " ms, filter " << h.filter_ms << " ms\n";
+  emit(o.output, doc, s.str(), out);
+}
+
 }  // namespace
 
 void add_heuristic_commands(CLI::App& app, std::ostream& out) {
@@ -39,6 +91,42 @@ void add_heuristic_commands(CLI::App& app, std::ostream& out) {
     out << "wrote " << o->out << ": " << s["train"]["count"] << " train, " << s["val"]["count"] << " val, "
         << s["test"]["count"] << " test samples of 3 x " << o->dims[0] << "x" << o->dims[1] << "x" << o->dims[2]
         << " (dataset.json describes the layout)\n";
+  });
+
+  auto h = std::make_shared<HeuristicCliOptions>();
+  CLI::App* c = app.add_subcommand("heuristic", "the sGAN's heuristic region for a map and query (Alg. 1 lines 2-3)");
+  add_query_options(c, h->query);
+  c->add_option("--weights", h->weights, "sGAN weights file (default: the shipped fixtures/sgan/sgan.bin)");
+  c->add_option("--seed", h->seed, "seed of the generator's noise")->capture_default_str();
+  c->add_flag("--raw", h->raw, "write the thresholded network output's probabilities, unfiltered");
+  c->add_option("--out", h->region_out, "region file to write (miner-region-v1)")->required();
+  c->add_flag("--json", h->output.json, "print the summary as JSON");
+  c->callback([h, &out] { run_heuristic(*h, out); });
+
+  struct CheckOptions {
+    std::string weights, reference;
+    bool json = false;
+  };
+  auto k = std::make_shared<CheckOptions>();
+  CLI::App* sg = app.add_subcommand("sgan", "sGAN weights tools");
+  sg->require_subcommand(1);
+  CLI::App* chk = sg->add_subcommand("check", "C++ inference against PyTorch's reference tensors (max |diff| <= 1e-4)");
+  chk->add_option("--weights", k->weights, "weights file (default: the shipped fixtures/sgan/sgan.bin)");
+  chk->add_option("--reference", k->reference, "reference.bin written by train.py")->required();
+  chk->add_flag("--json", k->json, "print the result as JSON");
+  chk->callback([k, &out] {
+    const heuristic::Sgan sgan = k->weights.empty() ? heuristic::Sgan::builtin() : heuristic::Sgan::load(k->weights);
+    const std::vector<double> errors = heuristic::reference_errors(sgan, k->reference);
+    const double worst = *std::max_element(errors.begin(), errors.end());
+    const bool ok = worst <= heuristic::kReferenceTolerance;
+    std::ostringstream s;
+    s << sgan.path() << " vs " << k->reference << ": " << errors.size() << " samples, max |C++ - PyTorch| = "
+      << worst << (ok ? " (<= 1e-4)\n" : "\n");
+    emit(OutputOptions{k->json, ""},
+         {{"weights", sgan.path()}, {"reference", k->reference}, {"max_abs_error", errors}, {"agrees", ok}}, s.str(), out);
+    if (!ok)
+      throw Error(k->reference + ": C++ and PyTorch disagree by " + std::to_string(worst) +
+                  " (> 1e-4): the weights and the reference do not belong together");
   });
 }
 

@@ -9,6 +9,8 @@
 
 #include "cli/cli.hpp"
 #include "miner/core/error.hpp"
+#include "miner/heuristic/region_filter.hpp"
+#include "miner/heuristic/sgan.hpp"
 #include "miner/plan/heuristic_region.hpp"
 #include "miner/plan/reference.hpp"
 #include "miner/plan/rrt_star.hpp"
@@ -35,7 +37,8 @@ void add_region_grid_options(CLI::App* cmd, RegionGridOptions& r) {
 struct PlanCliOptions {
   QueryOptions query;
   std::string planner = "miner";
-  std::string region;
+  std::string region = "sgan";
+  std::string weights;
   RegionGridOptions grid;
   plan::PlannerOptions planner_options;
   double target_factor = 0.0;
@@ -66,12 +69,17 @@ void run_plan(PlanCliOptions o, std::ostream& out) {
   if (o.target_factor > 0.0) o.planner_options.target_cost = o.target_factor * need_reference().cost;
 
   std::optional<plan::HeuristicRegion> region;
+  std::optional<heuristic::HeuristicQuery> sgan_query;
   if (o.planner_options.planner == plan::PlannerKind::kMiner) {
-    if (!o.region.empty()) {
-      region = plan::HeuristicRegion::load(o.region);
-    } else {
+    if (o.region == "sgan") {
+      const heuristic::Sgan sgan = o.weights.empty() ? heuristic::Sgan::builtin() : heuristic::Sgan::load(o.weights);
+      sgan_query = heuristic::query_region(sgan, q.map, q.start, q.goal, q.radius, o.planner_options.seed);
+      region = sgan_query->region;
+    } else if (o.region == "astar") {
       const Eigen::Vector3i dims(o.grid.dims[0], o.grid.dims[1], o.grid.dims[2]);
       region = plan::astar_dilated_region(problem, need_reference(), dims, o.grid.dilation);
+    } else {
+      region = plan::HeuristicRegion::load(o.region);
     }
   }
   const plan::PlanResult r = plan::plan(problem, o.planner_options, region ? &*region : nullptr);
@@ -97,9 +105,15 @@ void run_plan(PlanCliOptions o, std::ostream& out) {
               {"target", stage_json(r.target, o.timing)},
               {"path", path}};
   if (region) {
-    doc["region"] = {{"source", o.region.empty() ? region->source() : o.region},
+    const bool named = o.region == "sgan" || o.region == "astar";
+    doc["region"] = {{"source", named ? region->source() : o.region},
                      {"cells", region->cells().size()},
                      {"volume", region->volume()}};
+    if (sgan_query) {
+      doc["region"]["connected"] = sgan_query->report.connected;
+      doc["region"]["bridge_cells"] = sgan_query->report.bridge_cells;
+      if (o.timing) doc["region"]["time_ms"] = sgan_query->encode_ms + sgan_query->inference_ms + sgan_query->filter_ms;
+    }
   }
   if (o.timing) doc["time_ms"] = r.time_ms;
   if (o.tree) {
@@ -112,8 +126,14 @@ void run_plan(PlanCliOptions o, std::ostream& out) {
   h << o.planner << " on " << o.query.map << ": " << format_point(q.start) << " -> " << format_point(q.goal)
     << " (seed " << o.planner_options.seed << ")\n";
   if (region) {
-    h << "heuristic region: " << (o.region.empty() ? region->source() + " (A* oracle; the sGAN is not wired yet)" : o.region)
-      << ", " << region->cells().size() << " cells\n";
+    h << "heuristic region: "
+      << (o.region == "astar" ? "astar-dilated (A* oracle)" : o.region == "sgan" ? "sGAN, filtered" : o.region) << ", "
+      << region->cells().size() << " cells";
+    if (sgan_query)
+      h << " (" << std::fixed << std::setprecision(1)
+        << sgan_query->encode_ms + sgan_query->inference_ms + sgan_query->filter_ms << " ms"
+        << (sgan_query->report.bridge_cells ? ", bridged" : "") << ")";
+    h << "\n";
   }
   if (r.first) {
     h << "first solution: iteration " << r.first->iteration << ", " << r.first->nodes << " nodes, cost "
@@ -161,7 +181,10 @@ void add_plan_commands(CLI::App& app, std::ostream& out) {
       ->capture_default_str();
   p->add_option("--seed", po->planner_options.seed, "random seed")->capture_default_str();
   p->add_option("--region", po->region,
-                "heuristic region file (miner-region-v1) for --planner miner (default: the A*-dilated region)");
+                "miner's region: sgan (the network, filtered), astar (the A*-dilated oracle) or a "
+                "miner-region-v1 file")
+      ->capture_default_str();
+  p->add_option("--weights", po->weights, "sGAN weights file (default: the shipped fixtures/sgan/sgan.bin)");
   add_region_grid_options(p, po->grid);
   p->add_option("--iterations", po->planner_options.max_iterations, "iteration budget (Alg. 1's N)")
       ->check(CLI::PositiveNumber)

@@ -1,5 +1,6 @@
 #include <catch2/catch.hpp>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -8,6 +9,7 @@
 
 #include "cli/cli.hpp"
 #include "miner/core/json_io.hpp"
+#include "miner/plan/heuristic_region.hpp"
 
 using Catch::Matchers::Contains;
 
@@ -241,13 +243,23 @@ TEST_CASE("plan prints a path and --json is the same bytes for the same seed", "
   CHECK(timed["tree"]["vertices"].size() == timed["nodes"].get<std::size_t>() + 1);
 }
 
-TEST_CASE("plan --planner miner uses the A*-dilated region by default or a region file", "[REQ-CLI-004][REQ-PLAN-005]") {
+TEST_CASE("plan --planner miner uses the filtered sGAN region by default, the A* oracle or a region file",
+          "[REQ-CLI-004][REQ-PLAN-005][REQ-HEUR-008]") {
   const std::string map = dir() + "/indoor-plan.json";
   REQUIRE(miner_cli({"map", "gen", "--preset", "indoor", "--seed", "2", "--out", map}).code == 0);
-  const Run def = miner_cli({"plan", "--map", map, "--planner", "miner", "--iterations", "3000", "--target-factor",
-                             "1.02"});
+  const Run def = miner_cli({"plan", "--map", map, "--planner", "miner", "--iterations", "3000", "--json"});
   REQUIRE(def.code == 0);
-  CHECK_THAT(def.out, Contains("astar-dilated (A* oracle") && Contains("target cost"));
+  const auto sgan = miner::parse_json(def.out, "stdout");
+  CHECK(sgan["region"]["source"] == "sgan-filtered");
+  CHECK(sgan["region"]["connected"] == true);
+  CHECK(sgan["solved"] == true);
+  const Run oracle = miner_cli({"plan", "--map", map, "--planner", "miner", "--region", "astar", "--iterations", "3000",
+                                "--target-factor", "1.02"});
+  REQUIRE(oracle.code == 0);
+  CHECK_THAT(oracle.out, Contains("astar-dilated (A* oracle") && Contains("target cost"));
+  const Run weights = miner_cli({"plan", "--map", map, "--planner", "miner", "--weights", dir() + "/none.bin"});
+  CHECK(weights.code == 1);
+  CHECK_THAT(weights.err, Contains("none.bin") && Contains("cannot open"));
   const std::string region = dir() + "/region.json";
   const Run reg = miner_cli({"region", "astar", "--map", map, "--dims", "16", "16", "8", "--out", region});
   REQUIRE(reg.code == 0);
@@ -284,10 +296,14 @@ TEST_CASE("plan: bad input is named, an unreachable goal exits 3", "[REQ-CLI-004
   CHECK(none.code == 3);
   CHECK_THAT(none.err, Contains("no path to the goal region") && Contains("1000 iterations"));
   CHECK(miner::parse_json(none.out, "stdout")["solved"] == false);
-  // miner's default region needs the A* path, which does not exist here either.
+  // The A* oracle region needs the A* path, which does not exist here; the sGAN region
+  // cannot be bridged either, so miner runs out of budget.
   const Run miner_none = miner_cli({"plan", "--map", closed, "--start", "1", "1", "1", "--goal", "9", "1", "1",
-                                    "--planner", "miner"});
+                                    "--planner", "miner", "--region", "astar"});
   CHECK(miner_none.code == 3);
+  const Run sgan_none = miner_cli({"plan", "--map", closed, "--start", "1", "1", "1", "--goal", "9", "1", "1",
+                                   "--planner", "miner", "--iterations", "1000"});
+  CHECK(sgan_none.code == 3);
 }
 
 TEST_CASE("miner fly with no argument flies the default scenario and writes the run folder", "[REQ-FLIGHT-009]") {
@@ -346,4 +362,102 @@ TEST_CASE("miner dataset writes the dataset folder and refuses a missing --out",
   CHECK(r.err.empty());  // not a terminal: no progress bar
   CHECK(miner_cli({"dataset", "--count", "2"}).code == 2);
   CHECK(miner_cli({"dataset", "--count", "0", "--out", dir() + "/none"}).code == 1);
+}
+
+TEST_CASE("miner heuristic writes the filtered region and reports raw and filtered quality", "[REQ-HEUR-008]") {
+  const std::string map = dir() + "/sim-heur.json";
+  REQUIRE(miner_cli({"map", "gen", "--preset", "sim", "--seed", "4", "--out", map}).code == 0);
+  const std::string region = dir() + "/sgan-region.json";
+  const Run r = miner_cli({"heuristic", "--map", map, "--out", region, "--json"});
+  INFO(r.err);
+  REQUIRE(r.code == 0);
+  const miner::Json doc = miner::parse_json(r.out, "stdout");
+  CHECK(doc["filter"]["connected"] == true);
+  CHECK(doc["filter"]["safe"] == true);
+  CHECK(doc["inference_ms"].get<double>() > 0.0);
+  const auto loaded = miner::plan::HeuristicRegion::load(region);
+  CHECK(loaded.source() == "sgan-filtered");
+  CHECK(loaded.cells().size() == doc["filter"]["cells"].get<std::size_t>());
+  const Run raw = miner_cli({"heuristic", "--map", map, "--out", dir() + "/raw-region.json", "--raw"});
+  REQUIRE(raw.code == 0);
+  CHECK_THAT(raw.out, Contains("sgan-raw") && Contains("raw output"));
+  CHECK(miner::plan::HeuristicRegion::load(dir() + "/raw-region.json").probabilities().size() == 32768);
+  const Run weights = miner_cli({"heuristic", "--map", map, "--out", dir() + "/x.json", "--weights", map});
+  CHECK(weights.code == 1);
+  CHECK_THAT(weights.err, Contains("magic"));
+  CHECK(miner_cli({"heuristic", "--map", map}).code == 2);
+  const Run inside = miner_cli({"heuristic", "--map", write("pillar-heur.json", kPillarMap), "--start", "5", "5", "5",
+                                "--goal", "9", "5", "5", "--out", dir() + "/y.json"});
+  CHECK(inside.code == 1);
+  CHECK_THAT(inside.err, Contains("start"));
+  CHECK_FALSE(std::filesystem::exists(dir() + "/y.json"));
+}
+
+TEST_CASE("miner sgan check compares C++ inference with PyTorch's reference tensors", "[REQ-HEUR-005]") {
+  const std::string ref = std::string(MINER_SOURCE_DIR) + "/fixtures/sgan/reference.bin";
+  const Run ok = miner_cli({"sgan", "check", "--reference", ref, "--json"});
+  INFO(ok.err);
+  REQUIRE(ok.code == 0);
+  CHECK(miner::parse_json(ok.out, "stdout")["agrees"] == true);
+  const Run bad = miner_cli({"sgan", "check", "--reference", dir() + "/missing.bin"});
+  CHECK(bad.code == 1);
+  CHECK_THAT(bad.err, Contains("missing.bin"));
+}
+
+TEST_CASE("miner bench heuristic measures raw and filtered quality and the planners on unseen maps",
+          "[REQ-HEUR-009]") {
+  const std::string data = dir() + "/bench-data";
+  REQUIRE(miner_cli({"dataset", "--preset", "sim", "--count", "1", "--test-count", "3", "--seed", "8", "--out", data})
+              .code == 0);
+  const Run r = miner_cli({"bench", "heuristic", "--data", data, "--iterations", "3000", "--json"});
+  INFO(r.err);
+  REQUIRE(r.code == 0);
+  const miner::Json doc = miner::parse_json(r.out, "stdout");
+  CHECK(doc["samples"] == 3);
+  for (const char* k : {"connectivity_rate_raw", "safety_rate_raw"}) {
+    CHECK(doc[k].get<double>() >= 0.0);
+    CHECK(doc[k].get<double>() <= 1.0);
+  }
+  // Every dataset query is A*-solvable, so the filter always connects, and never keeps a solid cell.
+  CHECK(doc["connectivity_rate_filtered"] == 1.0);
+  CHECK(doc["safety_rate_filtered"] == 1.0);
+  CHECK(doc["inference_ms"].get<double>() > 0.0);
+  CHECK(doc["miner"]["success_rate"].get<double>() > 0.0);
+  CHECK(doc["rrtstar"].contains("target_time_ms"));
+  const Run text = miner_cli({"bench", "heuristic", "--data", data, "--samples", "1", "--no-planners"});
+  REQUIRE(text.code == 0);
+  CHECK_THAT(text.out, Contains("connectivity: raw") && !Contains("rrtstar"));
+  CHECK(miner_cli({"bench", "heuristic", "--data", data, "--split", "val"}).code == 1);  // no val samples
+  CHECK(miner_cli({"bench", "heuristic", "--data", dir() + "/nope"}).code == 1);
+}
+
+TEST_CASE("Training is deterministic for a seed and exports weights C++ loads and agrees with", "[REQ-HEUR-010]") {
+  const std::string data = dir() + "/train-data";
+  REQUIRE(miner_cli({"dataset", "--preset", "sim", "--count", "10", "--test-count", "0", "--val-fraction", "0.2",
+                     "--seed", "21", "--out", data})
+              .code == 0);
+  const std::string train = std::string(MINER_TORCH_PYTHON) + " " + MINER_SOURCE_DIR + "/src/python/sgan/train.py --data " +
+                            data + " --epochs 1 --batch 4 --width 4 --threads 1 --seed 3";
+  REQUIRE(std::system((train + " --out " + dir() + "/train-a > /dev/null").c_str()) == 0);
+  REQUIRE(std::system((train + " --out " + dir() + "/train-b > /dev/null").c_str()) == 0);
+  for (const char* f : {"/sgan.bin", "/reference.bin", "/metrics.json"}) {
+    std::ifstream a(dir() + "/train-a" + f, std::ios::binary), b(dir() + "/train-b" + f, std::ios::binary);
+    std::stringstream sa, sb;
+    sa << a.rdbuf();
+    sb << b.rdbuf();
+    INFO(f);
+    CHECK(sa.str().size() > 10);
+    CHECK(sa.str() == sb.str());
+  }
+  const Run check = miner_cli({"sgan", "check", "--weights", dir() + "/train-a/sgan.bin", "--reference",
+                               dir() + "/train-a/reference.bin"});
+  INFO(check.err);
+  CHECK(check.code == 0);
+  const miner::Json metrics = miner::read_json_file(dir() + "/train-a/metrics.json");
+  CHECK(metrics["training"]["data_seed"] == 21);
+  CHECK_THAT(metrics["training"]["command"].get<std::string>(), Contains("train.py"));
+  CHECK(std::system((train + " --epochs 0 --out " + dir() + "/train-c 2> /dev/null").c_str()) != 0);
+  CHECK(std::system((std::string(MINER_TORCH_PYTHON) + " " + MINER_SOURCE_DIR + "/src/python/sgan/train.py --data " +
+                     dir() + "/nope --out " + dir() + "/train-d 2> /dev/null")
+                        .c_str()) != 0);
 }

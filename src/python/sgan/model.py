@@ -3,15 +3,18 @@ noise N, the environment grid E and the state grid S to the heuristic region R, 
 conditional discriminators, one judging R against S (connectivity) and one against E
 (safety).
 
-Generator (width w, grid n^3 with n divisible by 4; "encoded at several scales"):
+Generator (width w, grid n^3 with n divisible by 8; "encoded at several scales", the
+conditions c_k = maxpool_k([E/2, S]) enter at every scale; the 1/8 level sees the whole
+grid, so every cell knows where both start and goal are):
     x   = [E/2, S, N]                                   3 x n^3
     a1  = relu(conv3(x))                                w  x n^3
-    c2  = maxpool2([E/2, S])                            2  x (n/2)^3   conditions, scale 1/2
     a2  = relu(conv3_stride2(a1))                       2w x (n/2)^3
-    c3  = maxpool4([E/2, S])                            2  x (n/4)^3   conditions, scale 1/4
     a3  = relu(conv3_stride2([a2, c2]))                 4w x (n/4)^3
-    m   = relu(conv3([a3, c3]))                         2w x (n/4)^3
-    d2  = relu(conv3([up2(m), a2, c2]))                 2w x (n/2)^3   decoder with skips
+    a4  = relu(conv3_stride2([a3, c4]))                 4w x (n/8)^3
+    m1  = relu(conv3([a4, c8]))                         4w x (n/8)^3
+    m2  = relu(conv3(m1))                               4w x (n/8)^3
+    d3  = relu(conv3([up2(m2), a3, c4]))                2w x (n/4)^3   decoder with skips
+    d2  = relu(conv3([up2(d3), a2, c2]))                2w x (n/2)^3
     R   = sigmoid(conv3([up2(d2), a1, E/2, S]))         1  x n^3
 conv3: 3x3x3 kernel, padding 1, bias; up2: nearest-neighbour upsampling by 2; maxpool
 kernel = stride. The C++ inference (src/miner/heuristic/sgan.hpp) runs exactly this graph
@@ -32,7 +35,10 @@ GENERATOR_LAYERS = [
     ("enc1", lambda w: (3, w), 1),
     ("enc2", lambda w: (w, 2 * w), 2),
     ("enc3", lambda w: (2 * w + 2, 4 * w), 2),
-    ("mid", lambda w: (4 * w + 2, 2 * w), 1),
+    ("enc4", lambda w: (4 * w + 2, 4 * w), 2),
+    ("mid1", lambda w: (4 * w + 2, 4 * w), 1),
+    ("mid2", lambda w: (4 * w, 4 * w), 1),
+    ("dec3", lambda w: (4 * w + 4 * w + 2, 2 * w), 1),
     ("dec2", lambda w: (2 * w + 2 * w + 2, 2 * w), 1),
     ("dec1", lambda w: (2 * w + w + 2, 1), 1),
 ]
@@ -51,14 +57,17 @@ class Generator(nn.Module):
         """env: E/2 in {0, 0.5, 1}; state: S in {0, 1}; noise: N(0, 1); each B x 1 x n^3."""
         c = self.convs
         cond1 = torch.cat([env, state], 1)
+        c2, c4, c8 = (F.max_pool3d(cond1, k) for k in (2, 4, 8))
+        up = lambda t: F.interpolate(t, scale_factor=2, mode="nearest")  # noqa: E731
         a1 = F.relu(c["enc1"](torch.cat([env, state, noise], 1)))
-        c2 = F.max_pool3d(cond1, 2)
         a2 = F.relu(c["enc2"](a1))
-        c3 = F.max_pool3d(cond1, 4)
         a3 = F.relu(c["enc3"](torch.cat([a2, c2], 1)))
-        m = F.relu(c["mid"](torch.cat([a3, c3], 1)))
-        d2 = F.relu(c["dec2"](torch.cat([F.interpolate(m, scale_factor=2, mode="nearest"), a2, c2], 1)))
-        return c["dec1"](torch.cat([F.interpolate(d2, scale_factor=2, mode="nearest"), a1, cond1], 1))
+        a4 = F.relu(c["enc4"](torch.cat([a3, c4], 1)))
+        m1 = F.relu(c["mid1"](torch.cat([a4, c8], 1)))
+        m2 = F.relu(c["mid2"](m1))
+        d3 = F.relu(c["dec3"](torch.cat([up(m2), a3, c4], 1)))
+        d2 = F.relu(c["dec2"](torch.cat([up(d3), a2, c2], 1)))
+        return c["dec1"](torch.cat([up(d2), a1, cond1], 1))
 
     def forward(self, env, state, noise):
         return torch.sigmoid(self.logits(env, state, noise))

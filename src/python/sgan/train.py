@@ -40,7 +40,11 @@ DEFAULTS = dict(epochs=4, batch=8, lr_g=2e-3, lr_d=2e-4, kappa=1.0, alpha1=0.05,
 
 
 def load_split(data, split):
-    meta = json.load(open(os.path.join(data, "dataset.json")))
+    path = os.path.join(data, "dataset.json")
+    if not os.path.isfile(path):
+        raise SystemExit(f"train: {path} not found (make one with `miner dataset`)")
+    with open(path) as f:
+        meta = json.load(f)
     if meta.get("format") != "miner-dataset-v1":
         raise SystemExit(f"train: {data}/dataset.json is not a miner-dataset-v1 folder")
     nx, ny, nz = meta["dims"]
@@ -90,8 +94,8 @@ def main(argv=None):
         train = train[:a.max_train]
     if len(train) == 0 or len(val) == 0:
         raise SystemExit("train: the dataset needs train and val samples")
-    if any(d % 4 for d in meta["dims"]):
-        raise SystemExit("train: the grid dims must be divisible by 4")
+    if any(d % 8 for d in meta["dims"]):
+        raise SystemExit("train: the grid dims must be divisible by 8")
 
     gen = torch.Generator().manual_seed(a.seed)
     G = sgan.Generator(a.width).to(dev)
@@ -131,14 +135,24 @@ def main(argv=None):
             opt_g.step()
             sums += [loss.item(), adv.item(), l_bce.item(), l_cont.item(), l_safe.item(), (l_dc + l_ds).item()]
         q = evaluate(G, val, a, dev)
-        entry = {"epoch": epoch + 1, "seconds": round(time.time() - t0, 1),
+        entry = {"epoch": epoch + 1,
                  **{k: float(v / steps_per_epoch) for k, v in
                     zip(["loss_g", "adversarial", "bce", "continuity", "safety", "loss_d"], sums)}, **q}
-        log.append(entry)
-        print(json.dumps(entry), flush=True)
+        log.append(entry)  # the files hold no wall-clock time: same seed, same bytes
+        print(json.dumps({**entry, "seconds": round(time.time() - t0, 1)}), flush=True)
 
     os.makedirs(a.out, exist_ok=True)
-    export(G, a, meta, val, log, dev, argv if argv is not None else sys.argv[1:])
+    args = list(argv if argv is not None else sys.argv[1:])
+    # The recorded command leaves out where the files went, so the same training gives
+    # the same bytes wherever it writes them.
+    for i, x in enumerate(args):
+        if x == "--out":
+            del args[i:i + 2]
+            break
+        if x.startswith("--out="):
+            del args[i]
+            break
+    export(G, a, meta, val, log, dev, args)
 
 
 def evaluate(G, val, a, dev):
@@ -169,13 +183,13 @@ def export(G, a, meta, val, log, dev, argv):
         conv = G.convs[name]
         weights.append((name + ".weight", conv.weight.detach().numpy()))
         weights.append((name + ".bias", conv.bias.detach().numpy()))
-    arch = {"name": "sgan-unet3", "width": a.width, "dims": meta["dims"], "layers": names,
+    arch = {"name": "sgan-unet4", "width": a.width, "dims": meta["dims"], "layers": names,
             "environment_scale": 0.5, "threshold": a.threshold}
     training = {k: getattr(a, k) for k in DEFAULTS}
     training.update({"data": os.path.basename(os.path.normpath(a.data)), "data_seed": meta["seed"],
-                     "data_preset": meta["preset"], "train_samples": int(min(len(val) * 0 + meta["splits"]["train"]["count"],
-                                                                             a.max_train or 1 << 30)),
-                     "command": "python3 src/python/sgan/train.py " + " ".join(argv)})
+                     "data_preset": meta["preset"],
+                     "train_samples": int(min(meta["splits"]["train"]["count"], a.max_train or 1 << 30)),
+                     "command": "python3 src/python/sgan/train.py " + " ".join(argv) + " --out OUT"})
     tensors.write(os.path.join(a.out, "sgan.bin"), "sgan-weights", weights,
                   {"architecture": arch, "training": training, "final": log[-1]})
     # Reference tensors: the first validation samples with fixed noise, through PyTorch.

@@ -1,0 +1,50 @@
+#pragma once
+/// \file
+/// `miner bench heuristic` (REQ-HEUR-009): the sGAN measured like the paper's heuristic
+/// quality table (connectivity and safety rates, Sec. V-A.2) on a dataset split of maps
+/// never seen in training, plus what the region buys the planner: iterations and time to
+/// the first solution and to the target cost for MINER with the filtered sGAN region
+/// (region time included) and for RRT*, on the same queries with the same random streams.
+
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "miner/plan/rrt_star.hpp"
+
+namespace miner::bench {
+
+struct HeuristicBenchOptions {
+  std::string data;             ///< a `miner dataset` folder
+  std::string split = "test";
+  int samples = 0;              ///< first N samples of the split (0: all)
+  std::string weights;          ///< empty: the shipped weights
+  std::uint64_t seed = 1;       ///< noise of sample k: seed + k; planner stream k
+  std::size_t max_iterations = 20000;
+  double target_factor = 1.0;   ///< target cost = factor x the sample's A* cost
+  bool planners = true;         ///< also run MINER and RRT* (false: quality only)
+};
+
+struct HeuristicSampleRecord {
+  std::uint64_t map_seed = 0;
+  bool raw_connected = false, raw_safe = false, connected = false, safe = false;
+  std::size_t raw_cells = 0, cells = 0, bridge_cells = 0;
+  double inference_ms = 0.0, region_ms = 0.0;  ///< region: encode + inference + filter
+  plan::PlanResult miner, rrtstar;
+};
+
+struct HeuristicBenchResult {
+  HeuristicBenchOptions options;
+  std::string preset;
+  std::vector<HeuristicSampleRecord> samples;
+  double total_s = 0.0;
+};
+
+HeuristicBenchResult run_heuristic_bench(const HeuristicBenchOptions& options, std::ostream* progress);
+nlohmann::json to_json(const HeuristicBenchResult& r);
+std::string to_text(const HeuristicBenchResult& r);
+
+}  // namespace miner::bench

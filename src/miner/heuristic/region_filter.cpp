@@ -1,0 +1,152 @@
+#include "miner/heuristic/region_filter.hpp"
+
+#include <chrono>
+#include <functional>
+#include <limits>
+#include <queue>
+
+#include "miner/core/error.hpp"
+#include "miner/core/rng.hpp"
+#include "miner/heuristic/grid.hpp"
+#include "miner/heuristic/sgan.hpp"
+#include "miner/world/map.hpp"
+
+namespace miner::heuristic {
+
+namespace {
+
+/// RNG stream of the generator's noise ("SGAN"), apart from the planners' streams.
+constexpr std::uint64_t kNoiseStream = 0x5347414e;
+
+template <typename F>
+void for_neighbours(const Eigen::Vector3i& dims, const Eigen::Vector3i& c, F&& f) {
+  for (int dk = -1; dk <= 1; ++dk)
+    for (int dj = -1; dj <= 1; ++dj)
+      for (int di = -1; di <= 1; ++di) {
+        if (!di && !dj && !dk) continue;
+        const Eigen::Vector3i n = c + Eigen::Vector3i(di, dj, dk);
+        if ((n.array() < 0).any() || (n.array() >= dims.array()).any()) continue;
+        f(n, cell_index(dims, n.x(), n.y(), n.z()));
+      }
+}
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
+FilteredRegion filter_region(const std::vector<float>& p, const std::vector<std::uint8_t>& env,
+                             const Eigen::Vector3i& dims, const Eigen::Vector3i& start_cell,
+                             const Eigen::Vector3i& goal_cell, double threshold) {
+  const auto n = static_cast<std::size_t>(dims.prod());
+  if (p.size() != n || env.size() != n) throw Error("region filter: grids of different sizes");
+  FilteredRegion out;
+  FilterReport& r = out.report;
+  std::vector<std::uint8_t> mask(n, 0);
+  for (std::size_t i = 0; i < n; ++i) mask[i] = p[i] >= threshold ? 1 : 0;
+  r.raw_cells = static_cast<std::size_t>(std::count(mask.begin(), mask.end(), 1));
+  r.raw_connected = connects(mask, dims, start_cell, goal_cell);
+  r.raw_safe = solid_cells_in(mask, env) == 0;
+  // 2. safety
+  for (std::size_t i = 0; i < n; ++i)
+    if (mask[i] && env[i] == kSolid) {
+      mask[i] = 0;
+      ++r.solid_dropped;
+    }
+  const std::size_t is = cell_index(dims, start_cell.x(), start_cell.y(), start_cell.z());
+  const std::size_t ig = cell_index(dims, goal_cell.x(), goal_cell.y(), goal_cell.z());
+  for (std::size_t i : {is, ig})
+    if (env[i] != kSolid) mask[i] = 1;
+  // 3. islands
+  std::vector<int> label = label_components(mask, dims);
+  for (std::size_t i = 0; i < n; ++i)
+    if (mask[i] && label[i] != label[is] && label[i] != label[ig]) {
+      mask[i] = 0;
+      ++r.island_dropped;
+    }
+  // 4. bridge: Dijkstra over non-solid cells from the start's component to the goal's.
+  if (mask[is] && mask[ig] && label[is] != label[ig]) {
+    const double inf = std::numeric_limits<double>::infinity();
+    std::vector<double> dist(n, inf);
+    std::vector<std::size_t> parent(n, n);
+    using Item = std::pair<double, std::size_t>;
+    std::priority_queue<Item, std::vector<Item>, std::greater<>> open;
+    for (std::size_t i = 0; i < n; ++i)
+      if (mask[i] && label[i] == label[is]) {
+        dist[i] = 0.0;
+        open.emplace(0.0, i);
+      }
+    std::size_t reached = n;
+    while (!open.empty()) {
+      const auto [d, u] = open.top();
+      open.pop();
+      if (d > dist[u]) continue;
+      if (mask[u] && label[u] == label[ig]) {
+        reached = u;
+        break;
+      }
+      for_neighbours(dims, cell_coords(dims, u), [&](const Eigen::Vector3i&, std::size_t v) {
+        if (env[v] == kSolid) return;
+        const double step = mask[v] ? 0.0 : 1.0 + (1.0 - static_cast<double>(p[v]));
+        if (d + step < dist[v]) {
+          dist[v] = d + step;
+          parent[v] = u;
+          open.emplace(dist[v], v);
+        }
+      });
+    }
+    if (reached != n) {
+      std::vector<std::size_t> chain;
+      for (std::size_t c = reached; c != n; c = parent[c])
+        if (!mask[c]) chain.push_back(c);
+      for (std::size_t c : chain) {
+        if (!mask[c]) {
+          mask[c] = 1;
+          ++r.bridge_cells;
+        }
+        for_neighbours(dims, cell_coords(dims, c), [&](const Eigen::Vector3i&, std::size_t v) {
+          if (!mask[v] && env[v] != kSolid) {
+            mask[v] = 1;
+            ++r.bridge_cells;
+          }
+        });
+      }
+    }
+  }
+  r.cells = static_cast<std::size_t>(std::count(mask.begin(), mask.end(), 1));
+  r.connected = connects(mask, dims, start_cell, goal_cell);
+  r.safe = solid_cells_in(mask, env) == 0;
+  out.mask = std::move(mask);
+  return out;
+}
+
+HeuristicQuery query_region(const Sgan& sgan, const world::Map& map, const Eigen::Vector3d& start,
+                            const Eigen::Vector3d& goal, double robot_radius, std::uint64_t seed, bool filter) {
+  const SganArchitecture& arch = sgan.architecture();
+  const world::Box& b = map.bounds();
+  const Eigen::Vector3i dims = arch.dims;
+  auto t0 = std::chrono::steady_clock::now();
+  std::vector<std::uint8_t> env = encode_environment(map, dims, robot_radius);
+  // The network was trained with the dataset's 3x3x3 state cubes (dilation 1).
+  const std::vector<std::uint8_t> state = encode_state(b, dims, start, goal, 1);
+  const double encode_ms = ms_since(t0);
+  t0 = std::chrono::steady_clock::now();
+  Rng rng(seed, kNoiseStream);
+  std::vector<float> prob = sgan.predict(env, state, rng);
+  const double inference_ms = ms_since(t0);
+  t0 = std::chrono::steady_clock::now();
+  FilteredRegion f = filter_region(prob, env, dims, cell_of(b, dims, start), cell_of(b, dims, goal), arch.threshold);
+  std::vector<double> probabilities(prob.size(), 0.0);
+  if (filter) {
+    for (std::size_t i = 0; i < prob.size(); ++i) probabilities[i] = f.mask[i] ? 1.0 : 0.0;
+  } else {
+    for (std::size_t i = 0; i < prob.size(); ++i) probabilities[i] = static_cast<double>(prob[i]);
+  }
+  const double filter_ms = ms_since(t0);
+  plan::HeuristicRegion region(b, dims, std::move(probabilities), filter ? 0.5 : arch.threshold,
+                               filter ? "sgan-filtered" : "sgan-raw");
+  return {std::move(region), std::move(prob), std::move(env), f.report, encode_ms, inference_ms, filter_ms};
+}
+
+}  // namespace miner::heuristic

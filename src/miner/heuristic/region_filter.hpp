@@ -1,0 +1,74 @@
+#pragma once
+/// \file
+/// Alg. 1 line 3, H <- Filter(H), and the whole heuristic query: encode E and S for a map
+/// and a query, run the sGAN, threshold, filter, hand the region to the MINER sampler.
+///
+/// The filter (REQ-HEUR-007), on the heuristic grid (grid.hpp):
+///   1. threshold: raw H = {cells with R >= threshold};
+///   2. safety: drop the solid cells; add the start and goal cells (never solid: the query
+///      points are free for the robot radius);
+///   3. islands: keep only the 26-connected components that hold the start or the goal cell;
+///   4. bridge: if start and goal are still apart, add the cheapest chain of non-solid cells
+///      joining their components (a cell already in H costs 0, any other 1 + (1 - R)), grown
+///      by one cell within the non-solid cells so the planner has room to sample around it.
+/// The result is safe by construction and connected whenever the non-solid cells connect
+/// start and goal at all (always when A* finds a path: its cells are never solid). The
+/// report says what each step changed, so the raw network's quality stays visible.
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "miner/plan/heuristic_region.hpp"
+#include "miner/world/box.hpp"
+
+namespace miner {
+namespace world {
+class Map;
+}
+}  // namespace miner
+
+namespace miner::heuristic {
+
+class Sgan;
+
+struct FilterReport {
+  std::size_t raw_cells = 0;       ///< cells with R >= threshold
+  bool raw_connected = false;      ///< REQ-HEUR-004 on the raw cells
+  bool raw_safe = false;
+  std::size_t solid_dropped = 0;   ///< step 2
+  std::size_t island_dropped = 0;  ///< step 3
+  std::size_t bridge_cells = 0;    ///< step 4 (0: no bridge was needed or none exists)
+  std::size_t cells = 0;           ///< cells in the filtered region
+  bool connected = false;          ///< REQ-HEUR-004 on the filtered region
+  bool safe = false;
+};
+
+struct FilteredRegion {
+  std::vector<std::uint8_t> mask;  ///< 1 = in H, x fastest
+  FilterReport report;
+};
+
+FilteredRegion filter_region(const std::vector<float>& probabilities, const std::vector<std::uint8_t>& environment,
+                             const Eigen::Vector3i& dims, const Eigen::Vector3i& start_cell,
+                             const Eigen::Vector3i& goal_cell, double threshold);
+
+/// One heuristic query (Alg. 1 lines 2-3) for `map` and a start and goal.
+struct HeuristicQuery {
+  plan::HeuristicRegion region;            ///< filtered (source "sgan-filtered") or raw ("sgan-raw")
+  std::vector<float> probabilities;        ///< R, the network output
+  std::vector<std::uint8_t> environment;   ///< E levels
+  FilterReport report;
+  double encode_ms = 0.0, inference_ms = 0.0, filter_ms = 0.0;
+};
+
+/// Encodes E (obstacles grown by robot_radius) and S on the network's grid over the map
+/// bounds, runs the generator with noise from Rng(seed, stream 0x5347414e) and filters
+/// (or, with filter = false, only thresholds) the output.
+HeuristicQuery query_region(const Sgan& sgan, const world::Map& map, const Eigen::Vector3d& start,
+                            const Eigen::Vector3d& goal, double robot_radius, std::uint64_t seed, bool filter = true);
+
+}  // namespace miner::heuristic

@@ -1,0 +1,360 @@
+#include "miner/heuristic/sgan.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <fstream>
+#include <iterator>
+#include <utility>
+
+#include <omp.h>
+
+#include <oneapi/dnnl/dnnl.hpp>
+
+#include "miner/core/error.hpp"
+#include "miner/core/rng.hpp"
+#include "miner/heuristic/grid.hpp"
+#include "miner/heuristic/tensor_file.hpp"
+
+namespace miner::heuristic {
+
+extern const unsigned char kBuiltinSganWeights[];
+extern const std::size_t kBuiltinSganWeightsSize;
+
+namespace {
+
+using dnnl::memory;
+using Tag = memory::format_tag;
+using Type = memory::data_type;
+
+/// Channels-last activation buffer: value (voxel v, channel c) at data[v * channels + c],
+/// voxel v = (z ny + y) nx + x — one sample, oneDNN's ndhwc.
+struct Activation {
+  int channels = 0;
+  Eigen::Vector3i dims{0, 0, 0};  // nx, ny, nz
+  std::vector<float> data;
+  Activation() = default;
+  Activation(int c, const Eigen::Vector3i& d) : channels(c), dims(d), data(static_cast<std::size_t>(c) * d.prod()) {}
+  memory::desc desc() const { return {{1, channels, dims.z(), dims.y(), dims.x()}, Type::f32, Tag::ndhwc}; }
+  std::size_t voxels() const { return static_cast<std::size_t>(dims.prod()); }
+};
+
+/// dst <- [srcs...] along channels; every source is at dst's resolution or, with
+/// `upsample` set for it, at half of it (nearest-neighbour upsampling by 2, as
+/// torch.nn.functional.interpolate(scale_factor=2, mode="nearest")).
+void concat(Activation& dst, const std::vector<std::pair<const Activation*, bool>>& srcs) {
+  const Eigen::Vector3i d = dst.dims;
+  const auto dc = static_cast<std::size_t>(dst.channels);
+  std::size_t offset = 0;  // channel offset of the current source in dst
+  for (const auto& [src, up] : srcs) {
+    const auto sc = static_cast<std::size_t>(src->channels);
+    const auto sx = static_cast<std::size_t>(src->dims.x()), sy = static_cast<std::size_t>(src->dims.y());
+    float* out = dst.data.data() + offset;
+    const float* in = src->data.data();
+    for (int z = 0; z < d.z(); ++z)
+      for (int y = 0; y < d.y(); ++y) {
+        const std::size_t row = up ? (static_cast<std::size_t>(z / 2) * sy + static_cast<std::size_t>(y / 2)) * sx
+                                   : (static_cast<std::size_t>(z) * sy + static_cast<std::size_t>(y)) * sx;
+        for (int x = 0; x < d.x(); ++x, out += dc) {
+          const float* v = in + (row + static_cast<std::size_t>(up ? x / 2 : x)) * sc;
+          for (std::size_t ch = 0; ch < sc; ++ch) out[ch] = v[ch];
+        }
+      }
+    offset += sc;
+  }
+}
+
+/// dst <- max over k^3 blocks of src (kernel = stride = k).
+void max_pool(Activation& dst, const Activation& src, int k) {
+  const Eigen::Vector3i d = dst.dims, s = src.dims;
+  const auto c = static_cast<std::size_t>(src.channels);
+  std::fill(dst.data.begin(), dst.data.end(), -INFINITY);
+  std::size_t v = 0;
+  for (int z = 0; z < s.z(); ++z)
+    for (int y = 0; y < s.y(); ++y)
+      for (int x = 0; x < s.x(); ++x, ++v) {
+        const std::size_t dv = (static_cast<std::size_t>(z / k) * static_cast<std::size_t>(d.y()) +
+                                static_cast<std::size_t>(y / k)) * static_cast<std::size_t>(d.x()) +
+                               static_cast<std::size_t>(x / k);
+        for (std::size_t ch = 0; ch < c; ++ch)
+          dst.data[dv * c + ch] = std::max(dst.data[dv * c + ch], src.data[v * c + ch]);
+      }
+}
+
+/// One 3x3x3 convolution (padding 1) with its fused activation.
+struct Conv {
+  dnnl::convolution_forward primitive;
+  memory weights, bias, src, dst;  // src and dst wrap the Activation buffers
+};
+
+constexpr std::size_t kConvs = 9;
+constexpr const char* kLayers[kConvs] = {"enc1", "enc2", "enc3", "enc4", "mid1", "mid2", "dec3", "dec2", "dec1"};
+constexpr int kStrides[kConvs] = {1, 2, 2, 2, 1, 1, 1, 1, 1};
+
+}  // namespace
+
+struct Sgan::Impl {
+  std::string path;
+  Json meta;
+  SganArchitecture arch;
+  dnnl::engine engine{dnnl::engine::kind::cpu, 0};
+  // Buffers, in graph order (model.py's names; cat* are the concatenated conv inputs).
+  Activation x0, cond1, a1, c2, a2, cat2, c4, a3, cat3, c8, a4, cat4, m1, m2, catd3, d3, catd2, d2, catd1, out;
+  Activation taps;                      // the last layer's 27 tap products per voxel
+  std::vector<float> last_tap_weights;  // [27][cin], oidhw of the 1x1x1 tap convolution
+  float last_bias = 0.0f;
+  std::array<Conv, kConvs> conv;
+  std::array<std::pair<Activation*, Activation*>, kConvs> io;
+
+  /// out[v] = sigmoid(bias + sum over taps t = (dz, dy, dx) of taps[v + (dz-1, dy-1, dx-1)][t]),
+  /// skipping taps outside the grid (zero padding): the 3x3x3 last layer, finished.
+  void shift_sum();
+
+  void build(const TensorFile& f);
+};
+
+void Sgan::Impl::build(const TensorFile& f) {
+  const JsonField a(f.meta, "meta", f.path);
+  const JsonField ar = a.at("architecture");
+  if (ar.at("name").string() != "sgan-unet4") ar.at("name").fail("unknown architecture (expected sgan-unet4)");
+  arch.width = ar.at("width").integer();
+  if (arch.width < 1 || arch.width > 256) ar.at("width").fail("must be in [1, 256]");
+  const JsonField dims = ar.at("dims");
+  arch.dims = Eigen::Vector3i(dims.at(0).integer(), dims.at(1).integer(), dims.at(2).integer());
+  if ((arch.dims.array() < 8).any() || (arch.dims.array() > 256).any() || arch.dims.x() % 8 != 0 ||
+      arch.dims.y() % 8 != 0 || arch.dims.z() % 8 != 0)
+    dims.fail("each must be a multiple of 8 in [8, 256]");
+  arch.environment_scale = ar.at("environment_scale").number();
+  arch.threshold = ar.at("threshold").number();
+  if (!(arch.threshold > 0.0 && arch.threshold < 1.0)) ar.at("threshold").fail("must be in (0, 1)");
+
+  const int w = arch.width;
+  const Eigen::Vector3i n1 = arch.dims, n2 = n1 / 2, n4 = n1 / 4, n8 = n1 / 8;
+  x0 = Activation(3, n1);
+  cond1 = Activation(2, n1);
+  a1 = Activation(w, n1);
+  c2 = Activation(2, n2);
+  a2 = Activation(2 * w, n2);
+  cat2 = Activation(2 * w + 2, n2);
+  c4 = Activation(2, n4);
+  a3 = Activation(4 * w, n4);
+  cat3 = Activation(4 * w + 2, n4);
+  c8 = Activation(2, n8);
+  a4 = Activation(4 * w, n8);
+  cat4 = Activation(4 * w + 2, n8);
+  m1 = Activation(4 * w, n8);
+  m2 = Activation(4 * w, n8);
+  catd3 = Activation(4 * w + 4 * w + 2, n4);
+  d3 = Activation(2 * w, n4);
+  catd2 = Activation(2 * w + 2 * w + 2, n2);
+  d2 = Activation(2 * w, n2);
+  catd1 = Activation(2 * w + w + 2, n1);
+  out = Activation(1, n1);
+  io = {{{&x0, &a1}, {&a1, &a2}, {&cat2, &a3}, {&cat3, &a4}, {&cat4, &m1}, {&m1, &m2}, {&catd3, &d3},
+         {&catd2, &d2}, {&catd1, &out}}};
+
+  dnnl::stream stream(engine);
+  for (std::size_t l = 0; l < kConvs; ++l) {
+    Activation& src = *io[l].first;
+    Activation& dst = *io[l].second;
+    const int cin = src.channels, cout = dst.channels;
+    const Tensor& wt = f.at(std::string(kLayers[l]) + ".weight", {cout, cin, 3, 3, 3});
+    const Tensor& bt = f.at(std::string(kLayers[l]) + ".bias", {cout});
+    for (const auto* t : {&wt, &bt})
+      for (float v : t->values)
+        if (!std::isfinite(v)) throw Error(f.path + ": layer " + kLayers[l] + " has a non-finite weight");
+    const bool last = l + 1 == kConvs;
+    Conv& c = conv[l];
+    if (last) {
+      // A single output channel keeps oneDNN's kernels ~5 % busy; instead a 1x1x1
+      // convolution computes, per voxel u, the 27 tap products Y[u][t] = sum_c W[0][c][t]
+      // in[u][c] (a GEMM), and shift_sum() adds Y[v + offset_t][t] over the taps.
+      taps = Activation(27, n1);
+      const dnnl::convolution_forward::primitive_desc pd(
+          dnnl::convolution_forward::desc(dnnl::prop_kind::forward_inference, dnnl::algorithm::convolution_direct,
+                                          src.desc(), memory::desc({27, cin, 1, 1, 1}, Type::f32, Tag::any),
+                                          taps.desc(), {1, 1, 1}, {0, 0, 0}, {0, 0, 0}),
+          engine);
+      c.primitive = dnnl::convolution_forward(pd);
+      std::vector<float> tap_weights(static_cast<std::size_t>(27 * cin));
+      for (int ch = 0; ch < cin; ++ch)
+        for (int t = 0; t < 27; ++t)
+          tap_weights[static_cast<std::size_t>(t * cin + ch)] = wt.values[static_cast<std::size_t>(ch * 27 + t)];
+      last_tap_weights = std::move(tap_weights);
+      memory user(memory::desc({27, cin, 1, 1, 1}, Type::f32, Tag::oidhw), engine, last_tap_weights.data());
+      c.weights = memory(pd.weights_desc(), engine);
+      dnnl::reorder(user, c.weights).execute(stream, user, c.weights);
+      last_bias = bt.values[0];
+      c.src = memory(src.desc(), engine, src.data.data());
+      c.dst = memory(taps.desc(), engine, taps.data.data());
+      continue;
+    }
+    const memory::dims wdims = {cout, cin, 3, 3, 3};
+    const memory::desc wany(wdims, Type::f32, Tag::any);
+    const memory::desc bdesc({cout}, Type::f32, Tag::a);
+    const memory::dims s = {kStrides[l], kStrides[l], kStrides[l]};
+    const dnnl::convolution_forward::desc cd(dnnl::prop_kind::forward_inference, dnnl::algorithm::convolution_direct,
+                                             src.desc(), wany, bdesc, dst.desc(), s, {1, 1, 1}, {1, 1, 1});
+    dnnl::post_ops po;
+    po.append_eltwise(1.0f, dnnl::algorithm::eltwise_relu, 0.0f, 0.0f);
+    dnnl::primitive_attr attr;
+    attr.set_post_ops(po);
+    const dnnl::convolution_forward::primitive_desc pd(cd, attr, engine);
+    c.primitive = dnnl::convolution_forward(pd);
+    memory user(memory::desc(wdims, Type::f32, Tag::oidhw), engine, const_cast<float*>(wt.values.data()));
+    c.weights = memory(pd.weights_desc(), engine);
+    dnnl::reorder(user, c.weights).execute(stream, user, c.weights);
+    c.bias = memory(bdesc, engine);
+    std::copy(bt.values.begin(), bt.values.end(), static_cast<float*>(c.bias.get_data_handle()));
+    c.src = memory(src.desc(), engine, src.data.data());
+    c.dst = memory(dst.desc(), engine, dst.data.data());
+  }
+  stream.wait();
+  // Every tensor of the file must be one the graph uses: a file for another graph that
+  // happens to contain these names is still refused.
+  if (f.tensors.size() != 2 * kConvs)
+    throw Error(f.path + ": " + std::to_string(f.tensors.size()) + " tensors, the sgan-unet4 graph has " +
+                std::to_string(2 * kConvs));
+}
+
+void Sgan::Impl::shift_sum() {
+  const Eigen::Vector3i d = out.dims;
+  const float* y = taps.data.data();
+  std::size_t v = 0;
+  for (int z = 0; z < d.z(); ++z)
+    for (int yy = 0; yy < d.y(); ++yy)
+      for (int x = 0; x < d.x(); ++x, ++v) {
+        float sum = last_bias;
+        for (int dz = -1; dz <= 1; ++dz) {
+          if (z + dz < 0 || z + dz >= d.z()) continue;
+          for (int dy = -1; dy <= 1; ++dy) {
+            if (yy + dy < 0 || yy + dy >= d.y()) continue;
+            for (int dx = -1; dx <= 1; ++dx) {
+              if (x + dx < 0 || x + dx >= d.x()) continue;
+              const std::size_t u = cell_index(d, x + dx, yy + dy, z + dz);
+              sum += y[u * 27 + static_cast<std::size_t>((dz + 1) * 9 + (dy + 1) * 3 + (dx + 1))];
+            }
+          }
+        }
+        out.data[v] = 1.0f / (1.0f + std::exp(-sum));
+      }
+}
+
+Sgan::Sgan(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+Sgan::~Sgan() = default;
+Sgan::Sgan(Sgan&&) noexcept = default;
+Sgan& Sgan::operator=(Sgan&&) noexcept = default;
+
+Sgan Sgan::from_bytes(const std::string& blob, const std::string& origin) {
+  const TensorFile f = parse_tensor_file(blob, origin, "sgan-weights");
+  auto impl = std::make_unique<Impl>();
+  impl->path = origin;
+  impl->meta = f.meta;
+  try {
+    impl->build(f);
+  } catch (const dnnl::error& e) {
+    throw Error(origin + ": oneDNN refused the network (" + e.what() + ")");
+  }
+  return Sgan(std::move(impl));
+}
+
+Sgan Sgan::load(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path + ": cannot open the sGAN weights file");
+  const std::string blob((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  return from_bytes(blob, path);
+}
+
+Sgan Sgan::builtin() {
+  return from_bytes(std::string(reinterpret_cast<const char*>(kBuiltinSganWeights), kBuiltinSganWeightsSize),
+                    "builtin fixtures/sgan/sgan.bin");
+}
+
+const SganArchitecture& Sgan::architecture() const { return impl_->arch; }
+const Json& Sgan::meta() const { return impl_->meta; }
+const std::string& Sgan::path() const { return impl_->path; }
+
+std::vector<float> Sgan::forward(const std::vector<float>& env, const std::vector<float>& state,
+                                 const std::vector<float>& noise) const {
+  Impl& g = *impl_;
+  const std::size_t n = g.x0.voxels();
+  if (env.size() != n || state.size() != n || noise.size() != n)
+    throw Error("sgan: inputs must have " + std::to_string(n) + " cells each (the weights' grid)");
+  for (std::size_t v = 0; v < n; ++v) {
+    g.x0.data[3 * v] = env[v];
+    g.x0.data[3 * v + 1] = state[v];
+    g.x0.data[3 * v + 2] = noise[v];
+    g.cond1.data[2 * v] = env[v];
+    g.cond1.data[2 * v + 1] = state[v];
+  }
+  // Single-threaded by design (the budget is per query on one core); oneDNN's
+  // OpenMP runtime reads this thread's setting.
+  const int previous = omp_get_max_threads();
+  omp_set_num_threads(1);
+  dnnl::stream stream(g.engine);
+  auto run = [&](std::size_t l) {
+    g.conv[l].primitive.execute(stream, {{DNNL_ARG_SRC, g.conv[l].src},
+                                         {DNNL_ARG_WEIGHTS, g.conv[l].weights},
+                                         {DNNL_ARG_BIAS, g.conv[l].bias},
+                                         {DNNL_ARG_DST, g.conv[l].dst}});
+    stream.wait();
+  };
+  run(0);  // a1
+  run(1);  // a2
+  max_pool(g.c2, g.cond1, 2);
+  max_pool(g.c4, g.cond1, 4);
+  max_pool(g.c8, g.cond1, 8);
+  concat(g.cat2, {{&g.a2, false}, {&g.c2, false}});
+  run(2);  // a3
+  concat(g.cat3, {{&g.a3, false}, {&g.c4, false}});
+  run(3);  // a4
+  concat(g.cat4, {{&g.a4, false}, {&g.c8, false}});
+  run(4);  // m1
+  run(5);  // m2
+  concat(g.catd3, {{&g.m2, true}, {&g.cat3, false}});
+  run(6);  // d3
+  concat(g.catd2, {{&g.d3, true}, {&g.cat2, false}});
+  run(7);  // d2
+  concat(g.catd1, {{&g.d2, true}, {&g.a1, false}, {&g.cond1, false}});
+  run(8);  // tap products of the last layer
+  g.shift_sum();  // R
+  omp_set_num_threads(previous);
+  return g.out.data;
+}
+
+std::vector<float> Sgan::predict(const std::vector<std::uint8_t>& environment, const std::vector<std::uint8_t>& state,
+                                 Rng& rng) const {
+  const std::size_t n = impl_->x0.voxels();
+  if (environment.size() != n || state.size() != n)
+    throw Error("sgan: E and S must have " + std::to_string(n) + " cells each (the weights' grid)");
+  std::vector<float> e(n), s(n), z(n);
+  const auto scale = static_cast<float>(impl_->arch.environment_scale);
+  for (std::size_t v = 0; v < n; ++v) {
+    e[v] = scale * static_cast<float>(environment[v]);
+    s[v] = static_cast<float>(state[v]);
+    z[v] = static_cast<float>(rng.normal());
+  }
+  return forward(e, s, z);
+}
+
+std::vector<double> reference_errors(const Sgan& sgan, const std::string& reference_path) {
+  const TensorFile ref = read_tensor_file(reference_path, "sgan-reference");
+  const Eigen::Vector3i d = sgan.architecture().dims;
+  const std::vector<int> shape = {d.z(), d.y(), d.x()};
+  const JsonField samples = JsonField(ref.meta, "meta", reference_path).at("samples");
+  if (samples.integer() < 1) samples.fail("must be >= 1");
+  std::vector<double> errors;
+  for (int k = 0; k < samples.integer(); ++k) {
+    const std::string p = std::to_string(k) + ".";
+    const auto out = sgan.forward(ref.at(p + "environment", shape).values, ref.at(p + "state", shape).values,
+                                  ref.at(p + "noise", shape).values);
+    const auto& want = ref.at(p + "output", shape).values;
+    double worst = 0.0;
+    for (std::size_t i = 0; i < out.size(); ++i)
+      worst = std::max(worst, std::abs(static_cast<double>(out[i]) - static_cast<double>(want[i])));
+    errors.push_back(worst);
+  }
+  return errors;
+}
+
+}  // namespace miner::heuristic

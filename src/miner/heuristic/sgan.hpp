@@ -1,0 +1,85 @@
+#pragma once
+/// \file
+/// C++ inference of the sGAN generator (paper Sec. IV-A.2, Alg. 1 line 2), exactly the graph
+/// of src/python/sgan/model.py (c_k = maxpool_k([E/2, S])):
+///     a1 = relu(conv3([E/2, S, N]))          w  x n^3
+///     a2 = relu(conv3_s2(a1))                2w x (n/2)^3
+///     a3 = relu(conv3_s2([a2, c2]))          4w x (n/4)^3
+///     a4 = relu(conv3_s2([a3, c4]))          4w x (n/8)^3
+///     m1 = relu(conv3([a4, c8]))             4w x (n/8)^3
+///     m2 = relu(conv3(m1))                   4w x (n/8)^3
+///     d3 = relu(conv3([up2(m2), a3, c4]))    2w x (n/4)^3
+///     d2 = relu(conv3([up2(d3), a2, c2]))    2w x (n/2)^3
+///     R  = sigmoid(conv3([up2(d2), a1, E/2, S]))
+/// The convolutions run in oneDNN (channels-last activations, weights reordered once to the
+/// kernel's preferred layout); pooling, upsampling and concatenation are copies done here.
+/// Weights come from a `miner-tensors-v1` file of kind "sgan-weights" (tensor_file.hpp);
+/// a missing, truncated, altered or mismatched file is refused naming the fault (REQ-HEUR-006).
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "miner/core/json_io.hpp"
+
+namespace miner {
+class Rng;
+}
+
+namespace miner::heuristic {
+
+struct SganArchitecture {
+  int width = 8;
+  Eigen::Vector3i dims{32, 32, 32};  ///< nx, ny, nz; each divisible by 8
+  double environment_scale = 0.5;   ///< E levels 0/1/2 enter the network as E * scale
+  double threshold = 0.5;           ///< cell in the raw region iff R >= threshold
+};
+
+class Sgan {
+ public:
+  /// Loads and checks the weights file; builds the oneDNN primitives for one query.
+  static Sgan load(const std::string& path);
+  /// The same from the file's bytes (`origin` names them in messages).
+  static Sgan from_bytes(const std::string& blob, const std::string& origin);
+  /// The weights shipped in fixtures/sgan/sgan.bin, compiled into the library (nothing is
+  /// read or downloaded at run time).
+  static Sgan builtin();
+  ~Sgan();
+  Sgan(Sgan&&) noexcept;
+  Sgan& operator=(Sgan&&) noexcept;
+
+  const SganArchitecture& architecture() const;
+  /// The file's "meta" object (architecture, training command, seeds, metrics).
+  const Json& meta() const;
+  const std::string& path() const;
+
+  /// R = G(N | E, S) on the grid: three inputs of dims.prod() floats (x fastest) — the
+  /// One query at a time per object (the buffers are reused). Inputs: the
+  /// environment already scaled, the state, the noise — and dims.prod() probabilities out.
+  std::vector<float> forward(const std::vector<float>& environment_scaled, const std::vector<float>& state,
+                             const std::vector<float>& noise) const;
+
+  /// The same from the dataset encoding (E levels 0/1/2, S 0/1), with N(0, 1) noise drawn
+  /// from `rng`.
+  std::vector<float> predict(const std::vector<std::uint8_t>& environment, const std::vector<std::uint8_t>& state,
+                             Rng& rng) const;
+
+ private:
+  struct Impl;
+  explicit Sgan(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Agreement with PyTorch: float32 convolutions summed in another order differ by a few ulps
+/// per layer; the bound on the probabilities.
+inline constexpr double kReferenceTolerance = 1e-4;
+
+/// Runs every sample of a "sgan-reference" file (inputs and PyTorch's output, written by
+/// train.py) through `sgan`; returns max |C++ - PyTorch| per sample. Throws miner::Error
+/// naming the file if its tensors do not fit the weights' grid.
+std::vector<double> reference_errors(const Sgan& sgan, const std::string& reference_path);
+
+}  // namespace miner::heuristic

@@ -1,0 +1,108 @@
+#include "miner/heuristic/tensor_file.hpp"
+
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+
+#include "miner/core/error.hpp"
+
+namespace miner::heuristic {
+
+namespace {
+
+constexpr char kMagic[8] = {'M', 'I', 'N', 'E', 'R', 'T', 'S', '1'};
+/// A header is a few kB; a length beyond this means the file is not what it claims.
+constexpr std::uint32_t kMaxHeaderBytes = 1u << 24;
+
+std::string shape_text(const std::vector<int>& s) {
+  std::string t = "[";
+  for (std::size_t i = 0; i < s.size(); ++i) t += (i ? ", " : "") + std::to_string(s[i]);
+  return t + "]";
+}
+
+}  // namespace
+
+std::uint64_t fnv1a64(const std::uint8_t* data, std::size_t size) {
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  for (std::size_t i = 0; i < size; ++i) {
+    h ^= data[i];
+    h *= 0x100000001b3ULL;
+  }
+  return h;
+}
+
+const Tensor& TensorFile::at(const std::string& name, const std::vector<int>& shape) const {
+  const auto it = tensors.find(name);
+  if (it == tensors.end()) throw Error(path + ": no tensor '" + name + "'");
+  if (it->second.shape != shape)
+    throw Error(path + ": tensor '" + name + "' has shape " + shape_text(it->second.shape) + ", expected " +
+                shape_text(shape));
+  return it->second;
+}
+
+TensorFile read_tensor_file(const std::string& path, const std::string& kind) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path + ": cannot open the " + kind + " file");
+  const std::string blob((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  return parse_tensor_file(blob, path, kind);
+}
+
+TensorFile parse_tensor_file(const std::string& blob, const std::string& path, const std::string& kind) {
+  if (blob.size() < 12 || std::memcmp(blob.data(), kMagic, 8) != 0)
+    throw Error(path + ": not a miner-tensors-v1 file (bad magic)");
+  std::uint32_t header_bytes = 0;
+  for (int i = 3; i >= 0; --i) header_bytes = (header_bytes << 8) | static_cast<std::uint8_t>(blob[8 + static_cast<std::size_t>(i)]);
+  if (header_bytes > kMaxHeaderBytes || 12 + static_cast<std::size_t>(header_bytes) > blob.size())
+    throw Error(path + ": truncated (the header runs past the end of the file)");
+  TensorFile f;
+  f.path = path;
+  Json header;
+  try {
+    header = Json::parse(blob.substr(12, header_bytes));
+  } catch (const std::exception& e) {
+    throw Error(path + ": the header is not valid JSON (" + e.what() + ")");
+  }
+  const JsonField root(header, "", path);
+  if (root.at("format").string() != "miner-tensors-v1") root.at("format").fail("expected miner-tensors-v1");
+  f.kind = root.at("kind").string();
+  if (f.kind != kind) root.at("kind").fail("expected '" + kind + "'");
+  f.meta = header.contains("meta") ? header["meta"] : Json::object();
+  const std::size_t data_start = 12 + header_bytes;
+  const std::size_t data_bytes = blob.size() - data_start;
+  const auto declared = static_cast<std::size_t>(root.at("data_bytes").integer());
+  if (declared != data_bytes)
+    throw Error(path + ": truncated or padded: " + std::to_string(data_bytes) + " data bytes, header says " +
+                std::to_string(declared));
+  const auto* data = reinterpret_cast<const std::uint8_t*>(blob.data()) + data_start;
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(fnv1a64(data, data_bytes)));
+  if (root.at("data_fnv1a64").string() != hex)
+    throw Error(path + ": checksum mismatch (the data was altered or the file is damaged)");
+  const JsonField list = root.at("tensors");
+  for (std::size_t t = 0; t < list.array_size(); ++t) {
+    const JsonField e = list.at(t);
+    const std::string name = e.at("name").string();
+    Tensor tensor;
+    std::size_t product = 1;
+    const JsonField shape = e.at("shape");
+    for (std::size_t d = 0; d < shape.array_size(); ++d) {
+      const long long v = shape.at(d).integer();
+      if (v < 1) shape.at(d).fail("must be >= 1");
+      tensor.shape.push_back(static_cast<int>(v));
+      product *= static_cast<std::size_t>(v);
+    }
+    const auto count = static_cast<std::size_t>(e.at("count").integer());
+    const auto offset = static_cast<std::size_t>(e.at("offset").integer());
+    if (count != product) e.at("count").fail("does not match the shape " + shape_text(tensor.shape));
+    if (offset % 4 != 0 || offset > data_bytes || count > (data_bytes - offset) / 4)
+      e.at("offset").fail("the tensor runs past the data");
+    tensor.values.resize(count);
+    std::memcpy(tensor.values.data(), data + offset, count * 4);  // little-endian host (x86-64, arm64)
+    if (!f.tensors.emplace(name, std::move(tensor)).second) e.at("name").fail("appears twice");
+  }
+  return f;
+}
+
+}  // namespace miner::heuristic

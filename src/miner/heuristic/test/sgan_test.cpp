@@ -1,0 +1,129 @@
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <unistd.h>
+
+#include "miner/core/error.hpp"
+#include "miner/core/rng.hpp"
+#include "miner/heuristic/sgan.hpp"
+#include "miner/heuristic/tensor_file.hpp"
+
+using Catch::Matchers::Contains;
+namespace heuristic = miner::heuristic;
+
+namespace {
+
+const std::string kFixtures = std::string(MINER_SOURCE_DIR) + "/fixtures/sgan/";
+
+std::string read_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::string temp_file(const std::string& name, const std::string& bytes) {
+  const auto p = std::filesystem::temp_directory_path() / ("miner_sgan_test_" + std::to_string(::getpid()) + "_" + name);
+  std::ofstream(p, std::ios::binary) << bytes;
+  return p.string();
+}
+
+/// A miner-tensors-v1 blob, written the way tensors.py does (header JSON, float32 data,
+/// FNV-1a-64 of the data), so the reader's checks can be exercised one by one.
+std::string tensor_blob(miner::Json header, const std::vector<float>& data) {
+  std::string bytes(reinterpret_cast<const char*>(data.data()), data.size() * 4);
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx",
+                static_cast<unsigned long long>(
+                    heuristic::fnv1a64(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size())));
+  header["format"] = "miner-tensors-v1";
+  header["data_bytes"] = bytes.size();
+  if (!header.contains("data_fnv1a64")) header["data_fnv1a64"] = hex;
+  const std::string text = header.dump();
+  std::string out = "MINERTS1";
+  const auto n = static_cast<std::uint32_t>(text.size());
+  for (int i = 0; i < 4; ++i) out.push_back(static_cast<char>((n >> (8 * i)) & 0xff));
+  return out + text + bytes;
+}
+
+}  // namespace
+
+TEST_CASE("The shipped generator agrees with the PyTorch reference tensors to 1e-4", "[REQ-HEUR-005]") {
+  const heuristic::Sgan g = heuristic::Sgan::builtin();
+  const std::vector<double> errors = heuristic::reference_errors(g, kFixtures + "reference.bin");
+  REQUIRE(errors.size() >= 1);
+  for (std::size_t k = 0; k < errors.size(); ++k) {
+    INFO("sample " << k << ": max |C++ - PyTorch| = " << errors[k]);
+    CHECK(errors[k] <= heuristic::kReferenceTolerance);
+  }
+  // The builtin copy is the fixture file, byte for byte.
+  const heuristic::Sgan from_file = heuristic::Sgan::load(kFixtures + "sgan.bin");
+  CHECK(from_file.meta() == g.meta());
+  // The reference file is checked as carefully as the weights.
+  CHECK_THROWS_WITH(heuristic::reference_errors(g, kFixtures + "sgan.bin"), Contains("sgan-reference"));
+}
+
+TEST_CASE("The same inputs and seed give the same region bytes", "[REQ-HEUR-005]") {
+  const heuristic::Sgan g = heuristic::Sgan::builtin();
+  const auto n = static_cast<std::size_t>(g.architecture().dims.prod());
+  std::vector<std::uint8_t> e(n, 0), s(n, 0);
+  for (std::size_t i = 0; i < n; i += 7) e[i] = static_cast<std::uint8_t>(i % 3);
+  s[5] = s[n - 9] = 1;
+  miner::Rng r1(3, 1), r2(3, 1), r3(4, 1);
+  const auto a = g.predict(e, s, r1), b = g.predict(e, s, r2), c = g.predict(e, s, r3);
+  CHECK(a == b);
+  CHECK(a != c);  // the noise enters the network
+  for (float v : a) REQUIRE((v >= 0.0f && v <= 1.0f));
+  CHECK_THROWS_WITH(g.predict(std::vector<std::uint8_t>(10, 0), s, r1), Contains("cells"));
+}
+
+TEST_CASE("A missing, truncated, altered or mismatched weights file is refused naming the fault", "[REQ-HEUR-006]") {
+  const std::string good = read_bytes(kFixtures + "sgan.bin");
+  REQUIRE(good.size() > 1000);
+  CHECK_THROWS_WITH(heuristic::Sgan::load("/nonexistent/sgan.bin"), Contains("/nonexistent/sgan.bin") && Contains("cannot open"));
+  CHECK_THROWS_WITH(heuristic::Sgan::load(temp_file("short.bin", good.substr(0, good.size() - 100))),
+                    Contains("truncated"));
+  CHECK_THROWS_WITH(heuristic::Sgan::load(temp_file("head.bin", good.substr(0, 40))), Contains("truncated"));
+  std::string altered = good;
+  altered[altered.size() - 5] = static_cast<char>(altered[altered.size() - 5] ^ 0x10);
+  CHECK_THROWS_WITH(heuristic::Sgan::load(temp_file("altered.bin", altered)), Contains("checksum"));
+  CHECK_THROWS_WITH(heuristic::Sgan::load(temp_file("text.bin", "{\"format\": \"miner-map-v1\"}")), Contains("magic"));
+  CHECK_THROWS_WITH(heuristic::Sgan::load(kFixtures + "reference.bin"), Contains("sgan-weights"));
+
+  // A well-formed file for another width: the first layer's shape is named.
+  const miner::Json arch = {{"name", "sgan-unet4"}, {"width", 4}, {"dims", {32, 32, 32}},
+                            {"environment_scale", 0.5}, {"threshold", 0.5}};
+  miner::Json tensors = miner::Json::array();
+  tensors.push_back({{"name", "enc1.weight"}, {"shape", {8, 3, 3, 3, 3}}, {"offset", 0}, {"count", 648}});
+  const std::string wrong = tensor_blob({{"kind", "sgan-weights"}, {"meta", {{"architecture", arch}}}, {"tensors", tensors}},
+                                        std::vector<float>(648, 0.1f));
+  CHECK_THROWS_WITH(heuristic::Sgan::from_bytes(wrong, "wrong.bin"),
+                    Contains("wrong.bin") && Contains("enc1.weight") && Contains("[8, 3, 3, 3, 3]") && Contains("[4, 3, 3, 3, 3]"));
+  // A tensor that runs past the data, and a count that disagrees with the shape.
+  tensors[0]["count"] = 700;
+  CHECK_THROWS_WITH(heuristic::parse_tensor_file(tensor_blob({{"kind", "k"}, {"tensors", tensors}}, std::vector<float>(648)),
+                                                 "x.bin", "k"),
+                    Contains("count"));
+  tensors[0]["shape"] = {700};
+  CHECK_THROWS_WITH(heuristic::parse_tensor_file(tensor_blob({{"kind", "k"}, {"tensors", tensors}}, std::vector<float>(648)),
+                                                 "x.bin", "k"),
+                    Contains("past the data"));
+  // Non-finite weights are refused before anything runs.
+  miner::Json nan_arch = arch;
+  nan_arch["width"] = 1;
+  miner::Json one = miner::Json::array();
+  one.push_back({{"name", "enc1.weight"}, {"shape", {1, 3, 3, 3, 3}}, {"offset", 0}, {"count", 81}});
+  one.push_back({{"name", "enc1.bias"}, {"shape", {1}}, {"offset", 324}, {"count", 1}});
+  std::vector<float> values(82, 0.0f);
+  values[3] = std::nanf("");
+  CHECK_THROWS_WITH(heuristic::Sgan::from_bytes(tensor_blob({{"kind", "sgan-weights"}, {"meta", {{"architecture", nan_arch}}},
+                                                             {"tensors", one}},
+                                                            values),
+                                                "nan.bin"),
+                    Contains("non-finite"));
+}

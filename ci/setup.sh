@@ -27,6 +27,9 @@ PACKAGES=(
   librapidcheck-dev    # property tests
   gcovr                # coverage reports and thresholds
   python3              # traceability checker
+  # learned heuristic
+  libdnnl-dev          # oneDNN: the sGAN's 3D convolutions in C++ (~20x LibTorch's default CPU path)
+  python3-torch python3-numpy   # sGAN training (src/python/sgan) and its deterministic-training test
 )
 
 SUDO=""

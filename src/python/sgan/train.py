@@ -34,9 +34,18 @@ import model as sgan  # noqa: E402
 import quality  # noqa: E402
 import tensors  # noqa: E402
 
+# Defaults and why:
+#   alpha1 0.05  the adversarial terms shape the region; BCE (alpha2 1) carries the signal early
+#   alpha3 0.5   continuity: jumps over delta = 0.5 between neighbours (a region's edge is one jump)
+#   alpha4 50    safety is a mean over all n^3 cells, so its per-cell gradient needs ~50x to
+#                outweigh BCE's on the solid cells the network sees in E
+#   pos_weight 5 the target is ~1.4 % of the grid; weighting it keeps the thresholded region
+#                from breaking up (connectivity)
+#   kappa 1      safety and connectivity discriminators equally important (Eq. generator_loss)
+#   thresholds   candidates for the raw region's threshold, chosen on the validation split
 DEFAULTS = dict(epochs=4, batch=8, lr_g=2e-3, lr_d=2e-4, kappa=1.0, alpha1=0.05, alpha2=1.0, alpha3=0.5,
-                alpha4=1.0, delta=0.5, pos_weight=3.0, width=8, threshold=0.5, seed=1, threads=2,
-                max_train=0, references=2)
+                alpha4=50.0, delta=0.5, pos_weight=5.0, width=8, threshold=0.5, seed=1, threads=2,
+                max_train=0, references=2, thresholds="0.5")
 
 
 def load_split(data, split):
@@ -81,8 +90,12 @@ def main(argv=None):
     a = ap.parse_args(argv)
     if a.epochs < 1 or a.batch < 1 or a.width < 1 or a.threads < 1:
         raise SystemExit("train: --epochs, --batch, --width and --threads must be >= 1")
-    if not 0.0 < a.threshold < 1.0:
-        raise SystemExit("train: --threshold must be in (0, 1)")
+    try:
+        candidates = sorted({float(t) for t in a.thresholds.split(",")} | {a.threshold})
+    except ValueError:
+        raise SystemExit("train: --thresholds must be numbers separated by commas")
+    if not all(0.0 < t < 1.0 for t in candidates):
+        raise SystemExit("train: --threshold and --thresholds must be in (0, 1)")
 
     torch.set_num_threads(a.threads)
     torch.use_deterministic_algorithms(True)
@@ -141,6 +154,18 @@ def main(argv=None):
         log.append(entry)  # the files hold no wall-clock time: same seed, same bytes
         print(json.dumps({**entry, "seconds": round(time.time() - t0, 1)}), flush=True)
 
+    # The raw region's threshold: the candidate with the best connectivity + safety on the
+    # validation split (ties: the one nearest 0.5).
+    if len(candidates) > 1:
+        scores = []
+        for t in candidates:
+            q = evaluate(G, val, a, dev, t)
+            scores.append((q["val_connectivity_rate_raw"] + q["val_safety_rate_raw"], -abs(t - 0.5), t, q))
+        best = max(scores)
+        a.threshold = best[2]
+        log[-1]["threshold_scan"] = [{"threshold": t, **q} for _, _, t, q in scores]
+        log[-1].update(best[3])
+        print(json.dumps({"threshold": a.threshold, **best[3]}), flush=True)
     os.makedirs(a.out, exist_ok=True)
     args = list(argv if argv is not None else sys.argv[1:])
     # The recorded command leaves out where the files went, so the same training gives
@@ -155,7 +180,7 @@ def main(argv=None):
     export(G, a, meta, val, log, dev, args)
 
 
-def evaluate(G, val, a, dev):
+def evaluate(G, val, a, dev, threshold=None):
     """Raw connectivity and safety rates on the validation split (quality.py, REQ-HEUR-004)."""
     G.eval()
     conn = safe = 0
@@ -167,7 +192,7 @@ def evaluate(G, val, a, dev):
             noise = torch.randn(env.shape, generator=gen)
             p = G(env.to(dev), state.to(dev), noise.to(dev)).cpu().numpy()[:, 0]
             for k in range(len(b)):
-                region = p[k] >= a.threshold
+                region = p[k] >= (a.threshold if threshold is None else threshold)
                 c, s = quality.connected_and_safe(region, b[k, 0], b[k, 1])
                 conn += c
                 safe += s

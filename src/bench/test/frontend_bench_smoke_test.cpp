@@ -81,8 +81,9 @@ TEST_CASE("bench frontend runs every planner and prints the documented JSON fiel
   }
   CHECK(names == miner::bench::default_frontend_planners());
   if (miner::bench::ompl_available()) {
-    CHECK(names.size() == 10);
-    CHECK(names[4] == "ompl:RRTstar");
+    CHECK(names.size() == 11);
+    CHECK(names[4] == "miner-sgan");
+    CHECK(names[5] == "ompl:RRTstar");
   }
   CHECK(doc["throughput"]["rrtstar_iterations_per_s"].get<double>() > 0);
 }

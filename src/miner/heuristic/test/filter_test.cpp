@@ -59,7 +59,7 @@ TEST_CASE("The filter drops solid cells and islands, and bridges start to goal t
   CHECK(heuristic::solid_cells_in(f.mask, g.env) == 0);
 }
 
-TEST_CASE("An empty raw region is bridged; a walled-off goal stays unconnected and nothing unsafe is added",
+TEST_CASE("An empty raw region is bridged, a walled-off goal stays unconnected and nothing unsafe is added",
           "[REQ-HEUR-007]") {
   Grid g;
   const auto f = heuristic::filter_region(g.p, g.env, kDims, {0, 0, 0}, {7, 3, 3}, 0.5);

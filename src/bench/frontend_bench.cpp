@@ -164,7 +164,7 @@ FrontendBenchResult run_frontend_bench(const world::Map& map, const std::string&
     const plan::PlannerKind kind =
         ompl ? plan::PlannerKind::kRrtStar : sgan_planner ? plan::PlannerKind::kMiner : plan::planner_from_name(name);
     if (sgan_planner && !sgan) {
-      sgan.emplace(options.weights_file.empty() ? heuristic::Sgan::builtin() : heuristic::Sgan::load(options.weights_file));
+      sgan.emplace(heuristic::Sgan::load_or_builtin(options.weights_file));
       // Warm-up query: the first oneDNN execution pays one-time page faults, as it would
       // once at start-up on board.
       heuristic::query_region(*sgan, map, start, goal, robot_radius, options.seed);
@@ -187,9 +187,7 @@ FrontendBenchResult run_frontend_bench(const world::Map& map, const std::string&
               heuristic::query_region(*sgan, map, start, goal, robot_radius, options.seed + static_cast<std::uint64_t>(run));
           const double region_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
           record.result = plan::plan(problem, po, &q.region);
-          record.result.time_ms += region_ms;
-          if (record.result.first) record.result.first->time_ms += region_ms;
-          if (record.result.target) record.result.target->time_ms += region_ms;
+          plan::add_setup_time(record.result, region_ms);
         } else {
           record.result = plan::plan(problem, po, kind == plan::PlannerKind::kMiner ? &region : nullptr);
         }

@@ -62,7 +62,7 @@ HeuristicBenchResult run_heuristic_bench(const HeuristicBenchOptions& o, std::os
   std::vector<heuristic::Sample> split = heuristic::read_split(o.data, o.split);
   if (o.samples > 0 && static_cast<std::size_t>(o.samples) < split.size()) split.resize(static_cast<std::size_t>(o.samples));
   if (split.empty()) throw Error(o.data + ": split '" + o.split + "' has no samples");
-  const heuristic::Sgan sgan = o.weights.empty() ? heuristic::Sgan::builtin() : heuristic::Sgan::load(o.weights);
+  const heuristic::Sgan sgan = heuristic::Sgan::load_or_builtin(o.weights);
   const Eigen::Vector3i dims(meta["dims"][0].get<int>(), meta["dims"][1].get<int>(), meta["dims"][2].get<int>());
   if (dims != sgan.architecture().dims)
     throw Error(o.data + ": the dataset's grid differs from the weights' grid (" + sgan.path() + ")");
@@ -94,9 +94,7 @@ HeuristicBenchResult run_heuristic_bench(const HeuristicBenchOptions& o, std::os
       po.stream = k;  // common random numbers for the two planners
       po.planner = plan::PlannerKind::kMiner;
       rec.miner = plan::plan(problem, po, &q.region);
-      rec.miner.time_ms += rec.region_ms;
-      if (rec.miner.first) rec.miner.first->time_ms += rec.region_ms;
-      if (rec.miner.target) rec.miner.target->time_ms += rec.region_ms;
+      plan::add_setup_time(rec.miner, rec.region_ms);
       po.planner = plan::PlannerKind::kRrtStar;
       rec.rrtstar = plan::plan(problem, po);
     }

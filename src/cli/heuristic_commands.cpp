@@ -42,7 +42,7 @@ Json report_json(const heuristic::FilterReport& r) {
 void run_heuristic(const HeuristicCliOptions& o, std::ostream& out) {
   const ResolvedQuery q = resolve_query(o.query);
   plan::PlanningProblem::make(q.map, q.start, q.goal, q.radius);  // start/goal checks, named errors
-  const heuristic::Sgan sgan = o.weights.empty() ? heuristic::Sgan::builtin() : heuristic::Sgan::load(o.weights);
+  const heuristic::Sgan sgan = heuristic::Sgan::load_or_builtin(o.weights);
   const heuristic::HeuristicQuery h = heuristic::query_region(sgan, q.map, q.start, q.goal, q.radius, o.seed, !o.raw);
   h.region.save(o.region_out);
   Json doc = {{"region", o.region_out},
@@ -115,7 +115,7 @@ void add_heuristic_commands(CLI::App& app, std::ostream& out) {
   chk->add_option("--reference", k->reference, "reference.bin written by train.py")->required();
   chk->add_flag("--json", k->json, "print the result as JSON");
   chk->callback([k, &out] {
-    const heuristic::Sgan sgan = k->weights.empty() ? heuristic::Sgan::builtin() : heuristic::Sgan::load(k->weights);
+    const heuristic::Sgan sgan = heuristic::Sgan::load_or_builtin(k->weights);
     const std::vector<double> errors = heuristic::reference_errors(sgan, k->reference);
     const double worst = *std::max_element(errors.begin(), errors.end());
     const bool ok = worst <= heuristic::kReferenceTolerance;

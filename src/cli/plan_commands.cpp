@@ -72,7 +72,7 @@ void run_plan(PlanCliOptions o, std::ostream& out) {
   std::optional<heuristic::HeuristicQuery> sgan_query;
   if (o.planner_options.planner == plan::PlannerKind::kMiner) {
     if (o.region == "sgan") {
-      const heuristic::Sgan sgan = o.weights.empty() ? heuristic::Sgan::builtin() : heuristic::Sgan::load(o.weights);
+      const heuristic::Sgan sgan = heuristic::Sgan::load_or_builtin(o.weights);
       sgan_query = heuristic::query_region(sgan, q.map, q.start, q.goal, q.radius, o.planner_options.seed);
       region = sgan_query->region;
     } else if (o.region == "astar") {

@@ -12,13 +12,15 @@
 
 namespace miner {
 
-Json read_json_file(const std::string& path) {
+std::string read_file_bytes(const std::string& path, const std::string& what) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path + ": cannot open file");
+  if (!in) throw Error(path + ": cannot open " + what);
   std::ostringstream ss;
   ss << in.rdbuf();
-  return parse_json(ss.str(), path);
+  return ss.str();
 }
+
+Json read_json_file(const std::string& path) { return parse_json(read_file_bytes(path), path); }
 
 Json parse_json(const std::string& text, const std::string& origin) {
   try {

@@ -18,6 +18,9 @@ using Json = nlohmann::json;
 /// Parses `path` as JSON. Throws Error naming the file on a missing file or a
 /// syntax error (with the byte offset nlohmann reports).
 Json read_json_file(const std::string& path);
+/// The whole file as bytes; throws miner::Error "<path>: cannot open <what>" when it cannot
+/// be opened.
+std::string read_file_bytes(const std::string& path, const std::string& what = "file");
 
 /// Parses JSON text; `origin` names it in messages (a path, or "<stdin>").
 Json parse_json(const std::string& text, const std::string& origin);

@@ -9,7 +9,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 
 #include "miner/core/error.hpp"
@@ -186,8 +185,7 @@ std::vector<Sample> read_split(const std::string& dir, const std::string& split)
     const JsonField shard = sp.at("shards").at(i);
     const std::string path = dir + "/" + shard.at("file").string();
     const auto n = static_cast<std::size_t>(shard.at("count").integer());
-    std::ifstream in(path, std::ios::binary);
-    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string bytes = read_file_bytes(path, "the dataset shard");
     if (bytes.size() != n * 3 * cells)
       throw Error(path + ": expected " + std::to_string(n * 3 * cells) + " bytes (" + std::to_string(n) +
                   " samples of 3 x " + std::to_string(cells) + "), found " + std::to_string(bytes.size()));

@@ -65,8 +65,10 @@ FilteredRegion filter_region(const std::vector<float>& p, const std::vector<std:
       mask[i] = 0;
       ++r.island_dropped;
     }
+  // Connected now iff start and goal share a component; the bridge below joins them.
+  bool joined = mask[is] && mask[ig] && label[is] == label[ig];
   // 4. bridge: Dijkstra over non-solid cells from the start's component to the goal's.
-  if (mask[is] && mask[ig] && label[is] != label[ig]) {
+  if (mask[is] && mask[ig] && !joined) {
     const double inf = std::numeric_limits<double>::infinity();
     std::vector<double> dist(n, inf);
     std::vector<std::size_t> parent(n, n);
@@ -97,6 +99,7 @@ FilteredRegion filter_region(const std::vector<float>& p, const std::vector<std:
       });
     }
     if (reached != n) {
+      joined = true;
       std::vector<std::size_t> chain;
       for (std::size_t c = reached; c != n; c = parent[c])
         if (!mask[c]) chain.push_back(c);
@@ -115,7 +118,7 @@ FilteredRegion filter_region(const std::vector<float>& p, const std::vector<std:
     }
   }
   r.cells = static_cast<std::size_t>(std::count(mask.begin(), mask.end(), 1));
-  r.connected = connects(mask, dims, start_cell, goal_cell);
+  r.connected = joined;  // equals connects(mask, ...): the filter tests check both
   r.safe = solid_cells_in(mask, env) == 0;
   out.mask = std::move(mask);
   return out;

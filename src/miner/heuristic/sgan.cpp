@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <fstream>
-#include <iterator>
 #include <utility>
 
 #include <omp.h>
@@ -258,12 +256,9 @@ Sgan Sgan::from_bytes(const std::string& blob, const std::string& origin) {
   return Sgan(std::move(impl));
 }
 
-Sgan Sgan::load(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path + ": cannot open the sGAN weights file");
-  const std::string blob((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  return from_bytes(blob, path);
-}
+Sgan Sgan::load(const std::string& path) { return from_bytes(read_file_bytes(path, "the sGAN weights file"), path); }
+
+Sgan Sgan::load_or_builtin(const std::string& path) { return path.empty() ? builtin() : load(path); }
 
 Sgan Sgan::builtin() {
   return from_bytes(std::string(reinterpret_cast<const char*>(kBuiltinSganWeights), kBuiltinSganWeightsSize),

@@ -47,6 +47,8 @@ class Sgan {
   /// The weights shipped in fixtures/sgan/sgan.bin, compiled into the library (nothing is
   /// read or downloaded at run time).
   static Sgan builtin();
+  /// load(path), or builtin() when path is empty (the CLI's and benchmarks' --weights).
+  static Sgan load_or_builtin(const std::string& path);
   ~Sgan();
   Sgan(Sgan&&) noexcept;
   Sgan& operator=(Sgan&&) noexcept;

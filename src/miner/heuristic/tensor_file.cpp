@@ -2,8 +2,6 @@
 
 #include <cstdio>
 #include <cstring>
-#include <fstream>
-#include <iterator>
 #include <sstream>
 
 #include "miner/core/error.hpp"
@@ -43,10 +41,7 @@ const Tensor& TensorFile::at(const std::string& name, const std::vector<int>& sh
 }
 
 TensorFile read_tensor_file(const std::string& path, const std::string& kind) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path + ": cannot open the " + kind + " file");
-  const std::string blob((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  return parse_tensor_file(blob, path, kind);
+  return parse_tensor_file(read_file_bytes(path, "the " + kind + " file"), path, kind);
 }
 
 TensorFile parse_tensor_file(const std::string& blob, const std::string& path, const std::string& kind) {

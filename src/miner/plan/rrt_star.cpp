@@ -381,4 +381,10 @@ PlanResult plan(const PlanningProblem& problem, const PlannerOptions& options, c
   return planner.run();
 }
 
+void add_setup_time(PlanResult& result, double ms) {
+  result.time_ms += ms;
+  if (result.first) result.first->time_ms += ms;
+  if (result.target) result.target->time_ms += ms;
+}
+
 }  // namespace miner::plan

@@ -131,4 +131,9 @@ struct PlanResult {
 PlanResult plan(const PlanningProblem& problem, const PlannerOptions& options,
                 const HeuristicRegion* region = nullptr);
 
+/// Counts `ms` of work done before plan() for this query (e.g. computing the heuristic
+/// region) in the result's total time and in its first-solution and target stages, so
+/// they read as end-to-end times. The improvements list keeps plan()'s own clock.
+void add_setup_time(PlanResult& result, double ms);
+
 }  // namespace miner::plan

@@ -35,6 +35,7 @@ TEST_CASE("The filter keeps a connected safe raw region as it is", "[REQ-HEUR-00
   CHECK(f.report.cells == 8);
   CHECK(f.report.bridge_cells == 0);
   CHECK(f.report.connected);
+  CHECK(heuristic::connects(f.mask, kDims, {0, 1, 1}, {7, 1, 1}));
   CHECK(f.report.safe);
 }
 
@@ -66,11 +67,13 @@ TEST_CASE("An empty raw region is bridged, a walled-off goal stays unconnected a
   CHECK(f.report.raw_cells == 0);
   CHECK_FALSE(f.report.raw_connected);
   CHECK(f.report.connected);
+  CHECK(heuristic::connects(f.mask, kDims, {0, 0, 0}, {7, 3, 3}));
   Grid wall;
   for (int j = 0; j < 4; ++j)
     for (int k = 0; k < 4; ++k) wall.solid(4, j, k);
   const auto w = heuristic::filter_region(wall.p, wall.env, kDims, {0, 0, 0}, {7, 3, 3}, 0.5);
   CHECK_FALSE(w.report.connected);
+  CHECK_FALSE(heuristic::connects(w.mask, kDims, {0, 0, 0}, {7, 3, 3}));
   CHECK(w.report.safe);
   CHECK(w.report.bridge_cells == 0);
   CHECK(w.report.cells == 2);  // start and goal cells only

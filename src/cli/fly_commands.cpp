@@ -1,4 +1,5 @@
 // `miner fly` (REQ-FLIGHT-009) and `miner bench sim` (REQ-FLIGHT-010).
+#include <chrono>
 #include <iomanip>
 #include <memory>
 #include <ostream>
@@ -10,6 +11,7 @@
 #include "cli/cli.hpp"
 #include "miner/core/error.hpp"
 #include "miner/flight/closed_loop.hpp"
+#include "miner/report/flight_report.hpp"
 #include "miner/traj/problem_io.hpp"
 
 namespace miner::cli {
@@ -44,28 +46,60 @@ void run_fly(const FlyCliOptions& o, std::ostream& out) {
   const flight::ReferencePlan reference = flight::build_reference(s);
   flight::FlyOptions options;
   options.use_ground_truth = o.ground_truth;
+  const auto t0 = std::chrono::steady_clock::now();
   const flight::FlightResult r = flight::fly(s, reference, options);
+  auto stage_ms = reference.stage_ms;
+  stage_ms.emplace_back("flight", std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
 
   const std::string dir = o.out.empty() ? "runs/" + s.name + "-seed" + std::to_string(s.seed) : o.out;
   Json summary = r.summary;
   summary["run_folder"] = dir;
-  Json path = Json::array();
-  for (Eigen::Index i = 0; i < reference.path.rows(); ++i) path.push_back(vec3_json(reference.path.row(i).transpose()));
-  write_folder_atomic(dir, {{"summary.json", dump_json(r.summary)},
-                            {"trajectory.json", dump_json(traj::answer_to_json(reference.trajectory))},
-                            {"path.json", dump_json(Json{{"source", reference.source}, {"points", path}})},
-                            {"flight_log.csv", flight::flight_log_csv(r)}});
+  summary["report"] = dir + "/report.html";
+  Json stages = Json::object();
+  for (const auto& [name, ms] : stage_ms) stages[name] = ms;
+  summary["stage_ms"] = stages;
+
+  auto points = [](const Eigen::MatrixX3d& m) {
+    Json p = Json::array();
+    for (Eigen::Index i = 0; i < m.rows(); ++i) p.push_back(vec3_json(m.row(i).transpose()));
+    return p;
+  };
+  Json path{{"source", reference.source}, {"points", points(reference.path)}};
+  std::vector<std::pair<std::string, std::string>> files{
+      {"scenario.json", o.scenario.scenario.empty() ? std::string(flight::default_scenario_text())
+                                                    : read_file_bytes(o.scenario.scenario, "scenario")},
+      {"map.json", dump_json(s.map->to_json())}};
+  if (reference.region) {
+    files.emplace_back("region.json", reference.region->to_json().dump() + "\n");
+    path["planned"] = points(reference.planned_path);
+    Json vertices = Json::array();
+    for (const auto& v : reference.tree_vertices) vertices.push_back(vec3_json(v));
+    files.emplace_back("tree.json", dump_json(Json{{"vertices", vertices}, {"parents", reference.tree_parents}}));
+  }
+  files.emplace_back("path.json", dump_json(path));
+  files.emplace_back("trajectory.json", dump_json(traj::answer_to_json(reference.trajectory)));
+  files.emplace_back("flight_log.csv", flight::flight_log_csv(r));
+  files.emplace_back("report.html", report::render_flight_report({s, reference, r, stage_ms}));
+  files.emplace_back("summary.json", dump_json(summary));
+  write_folder_atomic(dir, files);
+
   if (o.json) {
     out << dump_json(summary);
   } else {
     out << "flew " << s.name << " (seed " << s.seed << ", controller on the "
         << (o.ground_truth ? "GROUND TRUTH (diagnostic)" : "EKF estimate") << "): reference from "
-        << reference.source << ", " << reference.trajectory.segments() << " segments, " << std::fixed
-        << std::setprecision(2) << reference.trajectory.total_duration() << " s\n"
+        << reference.source;
+    if (reference.region) out << " (MINER RRT* on the " << reference.region->source() << " region)";
+    out << ", " << reference.trajectory.segments() << " segments, " << std::fixed << std::setprecision(2)
+        << reference.trajectory.total_duration() << " s\n"
         << flight::tracking_table(s.name, r) << std::setprecision(3) << "max position error " << r.max_position_error
         << " m, estimate RMSE " << r.estimation_rmse << " m, collisions " << r.collisions << ", goal "
         << (r.goal_reached ? "reached" : "NOT reached") << " (" << r.final_position_error << " m off)\n"
-        << "wrote " << dir << "/{summary.json,trajectory.json,path.json,flight_log.csv}\n";
+        << "stages (ms):";
+    for (const auto& [name, ms] : stage_ms) out << " " << name << " " << std::setprecision(1) << ms;
+    out << "\nwrote " << dir << "/ (";
+    for (std::size_t i = 0; i < files.size(); ++i) out << (i ? ", " : "") << files[i].first;
+    out << ")\nreport: " << dir << "/report.html\n";
   }
   if (!r.goal_reached)
     throw NoSolution("the flight did not reach the goal (final error " + std::to_string(r.final_position_error) +

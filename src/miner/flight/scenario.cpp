@@ -1,11 +1,14 @@
 #include "miner/flight/scenario.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 
 #include "miner/core/error.hpp"
 #include "miner/flight/flatness.hpp"
+#include "miner/heuristic/region_filter.hpp"
+#include "miner/heuristic/sgan.hpp"
 #include "miner/plan/reference.hpp"
 #include "miner/plan/rrt_star.hpp"
 #include "miner/traj/collision_repair.hpp"
@@ -87,6 +90,19 @@ Scenario scenario_from_json(const Json& doc, const std::string& origin, const st
     }
     if (t.has("v_max")) s.limits.v_max = t.at("v_max").positive_number();
     if (t.has("a_max")) s.limits.a_max = t.at("a_max").positive_number();
+  }
+  if (root.has("planner")) {
+    const JsonField p = root.at("planner");
+    if (p.has("region")) {
+      s.region = p.at("region").string();
+      if (s.region != "sgan" && s.region != "astar") p.at("region").fail("must be \"sgan\" or \"astar\"");
+    }
+    if (p.has("weights")) s.weights = resolve(base_dir, p.at("weights").string());
+    if (p.has("iterations")) {
+      const long long n = p.at("iterations").integer();
+      if (n < 1) p.at("iterations").fail("must be >= 1");
+      s.planner_iterations = static_cast<std::size_t>(n);
+    }
   }
   if (root.has("seed")) {
     const JsonField f = root.at("seed");
@@ -226,18 +242,37 @@ ReferencePlan build_reference(const Scenario& s) {
       path.row(path.rows() - 1) = s.goal.transpose();
     } else {
       r.source = "planner";
+      using Clock = std::chrono::steady_clock;
+      const auto ms_since = [](Clock::time_point t0) {
+        return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+      };
       const auto problem = plan::PlanningProblem::make(*s.map, s.start, s.goal, radius);
-      const auto reference = plan::astar_reference(problem);
-      const auto region = plan::astar_dilated_region(problem, reference, Eigen::Vector3i(32, 32, 32), 1);
+      auto t0 = Clock::now();
+      if (s.region == "astar") {
+        const auto reference = plan::astar_reference(problem);
+        r.region = plan::astar_dilated_region(problem, reference, Eigen::Vector3i(32, 32, 32), 1);
+      } else {
+        const auto sgan = heuristic::Sgan::load_or_builtin(s.weights);
+        r.region = heuristic::query_region(sgan, *s.map, s.start, s.goal, radius, s.seed).region;
+      }
+      r.stage_ms.emplace_back("region", ms_since(t0));
       plan::PlannerOptions options;
+      options.planner = plan::PlannerKind::kMiner;
       options.seed = s.seed;
-      options.max_iterations = 5000;
-      const auto result = plan::plan(problem, options, &region);
+      options.max_iterations = s.planner_iterations;
+      options.record_tree = true;
+      t0 = Clock::now();
+      auto result = plan::plan(problem, options, &*r.region);
+      r.stage_ms.emplace_back("plan", ms_since(t0));
       if (!result.solved) throw NoSolution(s.origin + ": MINER RRT* found no path: " + result.reason);
       path.resize(static_cast<Eigen::Index>(result.path.size()), 3);
       for (std::size_t i = 0; i < result.path.size(); ++i) path.row(static_cast<Eigen::Index>(i)) = result.path[i].transpose();
       r.planner_iterations = result.iterations;
+      r.tree_vertices = std::move(result.tree_vertices);
+      r.tree_parents = std::move(result.tree_parents);
+      r.planned_path = path;
     }
+    const auto t_traj = std::chrono::steady_clock::now();
     traj::RepairOptions options;
     options.order = s.order;
     options.limits = s.limits;
@@ -251,6 +286,8 @@ ReferencePlan build_reference(const Scenario& s) {
       r.time_scale = k * (1.0 + kLimitSlack);
       scale_time(r.trajectory, r.time_scale);
     }
+    r.stage_ms.emplace_back(
+        "trajectory", std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_traj).count());
   }
   const double T = r.trajectory.total_duration();
   if ((r.trajectory.evaluate(0.0) - s.start).norm() > kEndpointTolerance ||

@@ -22,6 +22,7 @@
 #include <optional>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -31,6 +32,7 @@
 #include "miner/flight/n3.hpp"
 #include "miner/flight/sensors.hpp"
 #include "miner/flight/vehicle.hpp"
+#include "miner/plan/heuristic_region.hpp"
 #include "miner/traj/polynomial_trajectory.hpp"
 #include "miner/traj/trapezoidal_allocation.hpp"
 #include "miner/world/map.hpp"
@@ -62,6 +64,12 @@ struct Scenario {
   ControllerParams controller;
   EkfParams ekf;                            ///< imu and pose are copied from the above
   std::optional<std::pair<double, double>> command_dropout;
+  /// How the path is found when the scenario gives neither waypoints nor a trajectory
+  /// file: MINER RRT* (Alg. 1) sampling the sGAN's filtered region ("sgan", the paper's
+  /// system) or the A*-dilated oracle region ("astar").
+  std::string region = "sgan";
+  std::string weights;                      ///< sGAN weights file; empty: the built-in ones
+  std::size_t planner_iterations = 5000;
 };
 
 /// Parses and validates a scenario; relative paths resolve against `base_dir`. Checks
@@ -89,6 +97,14 @@ struct ReferencePlan {
   double time_scale = 1.0;      ///< durations were stretched by this to meet the limits
   double max_speed = 0.0, max_acceleration = 0.0;  ///< of the final trajectory
   std::size_t planner_iterations = 0;
+  /// With source "planner": the heuristic region the planner sampled, its final tree
+  /// (vertices, parent indices, -1 for the root) and the path it returned (before repair).
+  std::optional<plan::HeuristicRegion> region;
+  std::vector<Eigen::Vector3d> tree_vertices;
+  std::vector<long> tree_parents;
+  Eigen::MatrixX3d planned_path;
+  /// Wall-clock time of each stage (ms, not deterministic): "region", "plan", "trajectory".
+  std::vector<std::pair<std::string, double>> stage_ms;
 };
 
 /// Builds the reference: the file as is, or MINCO through start-waypoints-goal (or a

@@ -1,0 +1,45 @@
+#pragma once
+/// \file
+/// The self-contained HTML report of one `miner fly` run (REQ-REPORT-002): an
+/// interactive 3D view (three.js, embedded) of the map, the heuristic region, the RRT*
+/// tree, the path, the MINCO trajectory and the flown path; SVG plots of tracking error,
+/// speed and thrust over time; the stage timings and the paper's tracking table. The file
+/// opens offline: every script and datum is inside it.
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "miner/core/json_io.hpp"
+#include "miner/flight/closed_loop.hpp"
+#include "miner/flight/scenario.hpp"
+
+namespace miner::report {
+
+struct FlightReportInput {
+  const flight::Scenario& scenario;
+  const flight::ReferencePlan& reference;
+  const flight::FlightResult& flight;
+  /// Wall-clock time of each stage in order (ms): region, plan, trajectory, flight.
+  std::vector<std::pair<std::string, double>> stage_ms;
+};
+
+/// What the 3D view draws, in the map's metres: bounds, obstacles [min, max], start,
+/// goal, region cells (centres, with the cell size), tree edges, the path (planned and
+/// repaired), the trajectory sampled every `kTrajectoryStep` s and the flown path
+/// (truth) from the log every `kFlownStep` s. Coordinates rounded to 1 mm.
+Json scene_json(const FlightReportInput& in);
+
+std::string render_flight_report(const FlightReportInput& in);
+
+/// Sampling of the drawn curves: fine enough that a 1 m/s trajectory is drawn within a few
+/// centimetres, coarse enough that a minute of flight stays a few hundred kilobytes.
+inline constexpr double kTrajectoryStep = 0.05;  // s
+inline constexpr double kFlownStep = 0.05;       // s
+
+/// The three.js build and orbit controls embedded in every report (Debian libjs-three).
+std::string three_js_source();
+/// The report's own viewer script (src/miner/report/viewer.js).
+std::string viewer_js_source();
+
+}  // namespace miner::report

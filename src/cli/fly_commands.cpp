@@ -1,5 +1,6 @@
 // `miner fly` (REQ-FLIGHT-009) and `miner bench sim` (REQ-FLIGHT-010).
 #include <chrono>
+#include <filesystem>
 #include <iomanip>
 #include <memory>
 #include <ostream>
@@ -66,8 +67,11 @@ void run_fly(const FlyCliOptions& o, std::ostream& out) {
   };
   Json path{{"source", reference.source}, {"points", points(reference.path)}};
   std::vector<std::pair<std::string, std::string>> files{
-      {"scenario.json", o.scenario.scenario.empty() ? std::string(flight::default_scenario_text())
-                                                    : read_file_bytes(o.scenario.scenario, "scenario")},
+      {"scenario.json",
+       dump_json(o.scenario.scenario.empty()
+                     ? flight::default_scenario_document()
+                     : flight::self_contained_scenario(read_json_file(o.scenario.scenario),
+                                                       std::filesystem::path(o.scenario.scenario).parent_path().string()))},
       {"map.json", dump_json(s.map->to_json())}};
   if (reference.region) {
     files.emplace_back("region.json", reference.region->to_json().dump() + "\n");

@@ -9,6 +9,7 @@
 
 #include "cli/cli.hpp"
 #include "miner/core/json_io.hpp"
+#include "miner/flight/scenario.hpp"
 #include "miner/plan/heuristic_region.hpp"
 
 using Catch::Matchers::Contains;
@@ -323,11 +324,72 @@ TEST_CASE("miner fly with no argument flies the default scenario and writes the 
   // Human output: the paper's table and where the files went.
   const Run human = miner_cli({"fly", "--out", run});
   CHECK(human.code == 0);
-  CHECK_THAT(human.out, Contains("Pos. Err. x") && Contains("wrote " + run));
+  CHECK_THAT(human.out, Contains("Pos. Err. x") && Contains("wrote " + run) && Contains("report: " + run + "/report.html"));
   // Same seed, same bytes.
   const std::string first = read(run + "/flight_log.csv");
   REQUIRE(miner_cli({"fly", "--out", run, "--seed", "1"}).code == 0);
   CHECK(read(run + "/flight_log.csv") == first);
+}
+
+TEST_CASE("miner fly runs sGAN region, MINER RRT*, MINCO and flight and keeps every product", "[REQ-REPORT-001]") {
+  const std::string run = dir() + "/pipeline-run";
+  const Run r = miner_cli({"fly", "--out", run, "--json"});
+  INFO(r.err);
+  REQUIRE(r.code == 0);
+  const miner::Json summary = miner::parse_json(r.out, "stdout");
+  CHECK(summary["report"] == run + "/report.html");
+  for (const char* stage : {"region", "plan", "trajectory", "flight"}) CHECK(summary["stage_ms"][stage].get<double>() > 0.0);
+  for (const char* f : {"scenario.json", "map.json", "region.json", "tree.json", "path.json", "trajectory.json",
+                        "flight_log.csv", "report.html", "summary.json"})
+    CHECK(std::filesystem::exists(run + "/" + f));
+  // The inputs, self-contained: flying the stored scenario again gives the same bytes.
+  const Run again = miner_cli({"fly", "--scenario", run + "/scenario.json", "--out", dir() + "/again"});
+  INFO(again.err);
+  CHECK(again.code == 0);
+  CHECK(read(dir() + "/again/flight_log.csv") == read(run + "/flight_log.csv"));
+  CHECK(miner::world::Map::load(run + "/map.json").obstacles().size() ==
+        miner::flight::default_scenario().map->obstacles().size());
+  const auto region = miner::plan::HeuristicRegion::load(run + "/region.json");
+  CHECK(region.source() == "sgan-filtered");
+  const miner::Json tree = miner::read_json_file(run + "/tree.json");
+  CHECK(tree["vertices"].size() == tree["parents"].size());
+  CHECK(tree["vertices"].size() > 10);
+  const miner::Json path = miner::read_json_file(run + "/path.json");
+  CHECK(path["source"] == "planner");
+  CHECK(path["planned"].size() >= 2);
+  CHECK(path["points"].size() >= path["planned"].size());  // repair only adds waypoints
+  // Minimum snap by default: 2s = 8 coefficients per segment.
+  const miner::Json trajectory = miner::read_json_file(run + "/trajectory.json");
+  CHECK(trajectory["coefficients"][0].size() == 8);
+  CHECK(trajectory["coefficients"].size() + 1 == path["points"].size());
+
+  // "order": 3 selects minimum jerk; "planner" picks the oracle region.
+  miner::Json doc = miner::read_json_file(run + "/scenario.json");
+  doc["trajectory"]["order"] = 3;
+  doc["planner"]["region"] = "astar";
+  const std::string jerk = write("jerk-scenario.json", doc.dump());
+  const std::string jerk_run = dir() + "/jerk-run";
+  const Run j = miner_cli({"fly", "--scenario", jerk, "--out", jerk_run, "--json"});
+  INFO(j.err);
+  REQUIRE(j.code == 0);
+  CHECK(miner::read_json_file(jerk_run + "/trajectory.json")["coefficients"][0].size() == 6);
+  CHECK(miner::plan::HeuristicRegion::load(jerk_run + "/region.json").source() == "astar-dilated");
+
+  // A bad planner block is refused before anything is written.
+  doc["planner"]["region"] = "oracle";
+  const Run bad = miner_cli({"fly", "--scenario", write("bad-region.json", doc.dump()), "--out", dir() + "/never"});
+  CHECK(bad.code == 1);
+  CHECK_THAT(bad.err, Contains("planner.region") && Contains("\"sgan\" or \"astar\""));
+  doc["planner"]["region"] = "sgan";
+  doc["planner"]["iterations"] = 0;
+  CHECK(miner_cli({"fly", "--scenario", write("bad-iter.json", doc.dump()), "--out", dir() + "/never"}).code == 1);
+  CHECK_FALSE(std::filesystem::exists(dir() + "/never"));
+
+  // A failing run leaves the earlier folder whole.
+  const std::string before = read(jerk_run + "/summary.json");
+  doc["planner"]["iterations"] = 1;
+  CHECK(miner_cli({"fly", "--scenario", write("one-iter.json", doc.dump()), "--out", jerk_run}).code == 3);
+  CHECK(read(jerk_run + "/summary.json") == before);
 }
 
 TEST_CASE("miner fly refuses a bad scenario before flying", "[REQ-FLIGHT-007]") {

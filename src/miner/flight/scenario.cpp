@@ -152,6 +152,25 @@ Scenario scenario_from_json(const Json& doc, const std::string& origin, const st
   return s;
 }
 
+Json self_contained_scenario(Json doc, const std::string& base_dir) {
+  const auto absolute = [&](const std::string& path) {
+    return std::filesystem::absolute(resolve(base_dir, path)).lexically_normal().string();
+  };
+  if (!doc.is_object()) return doc;  // scenario_from_json names the fault
+  if (doc.contains("map") && doc["map"].is_string()) {
+    const std::string map = resolve(base_dir, doc["map"].get<std::string>());
+    doc["map"] = std::filesystem::path(map).extension() == ".json" ? read_json_file(map) : Json(absolute(map));
+  }
+  if (doc.contains("vehicle") && doc["vehicle"].is_string())
+    doc["vehicle"] = read_json_file(resolve(base_dir, doc["vehicle"].get<std::string>()));
+  for (const char* block : {"trajectory", "planner"}) {
+    const char* key = std::string(block) == "trajectory" ? "file" : "weights";
+    if (doc.contains(block) && doc[block].is_object() && doc[block].contains(key) && doc[block][key].is_string())
+      doc[block][key] = absolute(doc[block][key].get<std::string>());
+  }
+  return doc;
+}
+
 Scenario load_scenario(const std::string& path) {
   return scenario_from_json(read_json_file(path), path, std::filesystem::path(path).parent_path().string());
 }

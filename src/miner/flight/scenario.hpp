@@ -85,6 +85,13 @@ Scenario default_scenario();
 /// Its text, as shipped.
 const char* default_scenario_text();
 
+/// A scenario document that runs from any folder: the map (JSON) and the vehicle inlined,
+/// other file references (an OctoMap map, a trajectory file, sGAN weights) made absolute
+/// against `base_dir`. What `miner fly` stores as its run folder's scenario.json.
+Json self_contained_scenario(Json doc, const std::string& base_dir);
+/// The default scenario as such a document.
+Json default_scenario_document();
+
 /// The share of the vehicle's tilt limit and thrust that a reference trajectory may use;
 /// the rest is left to the feedback loop.
 inline constexpr double kEnvelopeMargin = 0.8;

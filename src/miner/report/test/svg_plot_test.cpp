@@ -1,0 +1,65 @@
+#include <cmath>
+#include <string>
+
+#include <catch2/catch.hpp>
+
+#include "miner/report/svg_plot.hpp"
+
+using Catch::Matchers::Contains;
+using namespace miner::report;
+
+namespace {
+std::size_t count(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (std::size_t p = text.find(what); p != std::string::npos; p = text.find(what, p + 1)) ++n;
+  return n;
+}
+}  // namespace
+
+TEST_CASE("nice ticks are 1-2-5 steps that cover the range", "[REQ-REPORT-004]") {
+  const auto t = nice_ticks(0.013, 0.87);
+  REQUIRE(t.size() >= 2);
+  CHECK(t.front() <= 0.013);
+  CHECK(t.back() >= 0.87);
+  const double step = t[1] - t[0];
+  const double mantissa = step / std::pow(10.0, std::floor(std::log10(step)));
+  CHECK((std::abs(mantissa - 1) < 1e-9 || std::abs(mantissa - 2) < 1e-9 || std::abs(mantissa - 5) < 1e-9));
+  for (std::size_t i = 1; i < t.size(); ++i) CHECK(t[i] - t[i - 1] == Approx(step));
+  CHECK(nice_ticks(-3, 3, 6) == std::vector<double>{-3, -2, -1, 0, 1, 2, 3});
+  CHECK_THROWS(nice_ticks(1, 1));
+  CHECK_THROWS(nice_ticks(0, NAN));
+}
+
+TEST_CASE("line plots draw every series, break at NaN, escape text and are deterministic", "[REQ-REPORT-004]") {
+  const Series a{"a <b>", "#123456", {0, 1, 2, 3}, {0, 1, NAN, 3}};
+  const Series b{"b", "red", {0, 3}, {3, 0}};
+  const std::string svg = svg_line_plot({"T & U", "x", "y"}, {a, b});
+  CHECK_THAT(svg, Contains("<svg") && Contains("</svg>") && Contains("T &amp; U") && Contains("a &lt;b&gt;"));
+  CHECK(count(svg, "<path d=\"") == 2);
+  // The NaN splits series a into two pieces: two move-to commands.
+  const auto first_path = svg.substr(svg.find("<path d=\""), svg.find("\" fill", svg.find("<path d=\"")) - svg.find("<path d=\""));
+  CHECK(count(first_path, "M") == 2);
+  CHECK(svg == svg_line_plot({"T & U", "x", "y"}, {a, b}));
+  CHECK_THROWS_WITH(svg_line_plot({"P", "x", "y"}, {Series{"bad", "red", {0, 1}, {0}}}),
+                    Contains("\"P\"") && Contains("\"bad\"") && Contains("2 x values and 1 y values"));
+  // Degenerate data still make a drawable plot.
+  CHECK_THAT(svg_line_plot({"flat", "x", "y"}, {Series{"c", "red", {1, 1}, {2, 2}}}), Contains("</svg>"));
+  CHECK_THAT(svg_line_plot({"empty", "x", "y"}, {}), Contains("</svg>"));
+}
+
+TEST_CASE("box plots draw median, quartiles, whiskers and outliers", "[REQ-REPORT-004]") {
+  // 1..9 and an outlier at 100: type-7 quartiles of {1..9, 100} are 3.25 and 7.75,
+  // IQR 4.5, upper fence 14.5: the whisker ends at 9 and 100 is an outlier.
+  BoxGroup g{"g", {1, 2, 3, 4, 5, 6, 7, 8, 9, 100}};
+  const std::string svg = svg_box_plot({"box", "", "value"}, {g, BoxGroup{"none", {}}});
+  CHECK(count(svg, "<circle") == 1);
+  CHECK(count(svg, "<rect x=") >= 2);  // frame + box
+  CHECK_THAT(svg, Contains(">n/a<") && Contains(">none<"));
+  CHECK(svg == svg_box_plot({"box", "", "value"}, {g, BoxGroup{"none", {}}}));
+  const std::string log_svg = svg_box_plot({"log", "", "ms"}, {BoxGroup{"x", {0.1, 1, 10, 100}}}, true);
+  CHECK_THAT(log_svg, Contains(">100<") && Contains(">0.1<"));
+}
+
+TEST_CASE("html_escape escapes the five special characters", "[REQ-REPORT-004]") {
+  CHECK(html_escape("<a href=\"x\">'&'</a>") == "&lt;a href=&quot;x&quot;&gt;&#39;&amp;&#39;&lt;/a&gt;");
+}

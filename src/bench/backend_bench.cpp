@@ -58,9 +58,51 @@ std::pair<double, double> time_solves(const std::function<void()>& solve, const 
   return {us[us.size() / 2], us.front()};
 }
 
+/// Times every method of `o` on `p` (MINCO through a reused MincoSolver) and appends one
+/// record per method; the O(M^3) baselines are skipped above o.max_dense_segments.
+void time_methods(const traj::MincoProblem& p, const BackendBenchOptions& o, std::vector<BackendRecord>& records) {
+  const int s = p.order;
+  const int M = static_cast<int>(p.durations.size());
+  traj::MincoSolver solver;
+  traj::PolynomialTrajectory out;
+  solver.solve(p, out);
+  const Eigen::MatrixX3d reference = out.coefficients();
+  double minco_us = 0.0;
+  for (const auto& method : o.methods) {
+    BackendRecord r;
+    r.method = method;
+    r.order = s;
+    r.segments = M;
+    if (method != "minco" && M > o.max_dense_segments) {
+      r.skipped = true;
+      records.push_back(r);
+      continue;
+    }
+    Eigen::MatrixX3d c;
+    std::function<void()> solve;
+    if (method == "minco") {
+      solve = [&] { solver.solve(p, out); };
+    } else {
+      const Baseline baseline = baselines().at(method);
+      solve = [&, baseline] { c = baseline(p); };
+    }
+    const auto [median, fastest] = time_solves(solve, o, r.samples, r.reps_per_sample);
+    r.us_per_solve = median;
+    r.min_us = fastest;
+    if (method == "minco") {
+      minco_us = median;
+      c = out.coefficients();
+    }
+    r.max_rel_diff = (c - reference).norm() / reference.norm();
+    r.ratio_to_minco = minco_us > 0.0 ? median / minco_us : 0.0;
+    records.push_back(r);
+  }
+}
+
 }  // namespace
 
-std::vector<BackendRecord> run_backend_bench(const BackendBenchOptions& o) {
+namespace {
+void validate(const BackendBenchOptions& o) {
   for (const auto& m : o.methods) {
     if (m != "minco" && baselines().count(m) == 0) {
       throw Error("--methods: unknown method \"" + m + "\" (known: minco, dense-lu, closed-form, kkt-qp)");
@@ -73,46 +115,25 @@ std::vector<BackendRecord> run_backend_bench(const BackendBenchOptions& o) {
     if (m < 1) throw Error("--segments: must be at least 1, got " + std::to_string(m));
   }
   if (!(o.budget_s > 0.0) || o.samples < 1) throw Error("--budget and --samples: must be positive");
+}
+}  // namespace
+
+std::vector<BackendRecord> run_backend_bench(const BackendBenchOptions& o) {
+  validate(o);
 
   std::vector<BackendRecord> records;
   for (int s : o.orders)
-    for (int M : o.segments) {
-      const traj::MincoProblem p = bench_problem(s, M, o.seed);
-      traj::MincoSolver solver;
-      traj::PolynomialTrajectory out;
-      solver.solve(p, out);
-      const Eigen::MatrixX3d reference = out.coefficients();
-      double minco_us = 0.0;
-      for (const auto& method : o.methods) {
-        BackendRecord r;
-        r.method = method;
-        r.order = s;
-        r.segments = M;
-        if (method != "minco" && M > o.max_dense_segments) {
-          r.skipped = true;
-          records.push_back(r);
-          continue;
-        }
-        Eigen::MatrixX3d c;
-        std::function<void()> solve;
-        if (method == "minco") {
-          solve = [&] { solver.solve(p, out); };
-        } else {
-          const Baseline baseline = baselines().at(method);
-          solve = [&, baseline] { c = baseline(p); };
-        }
-        const auto [median, fastest] = time_solves(solve, o, r.samples, r.reps_per_sample);
-        r.us_per_solve = median;
-        r.min_us = fastest;
-        if (method == "minco") {
-          minco_us = median;
-          c = out.coefficients();
-        }
-        r.max_rel_diff = (c - reference).norm() / reference.norm();
-        r.ratio_to_minco = minco_us > 0.0 ? median / minco_us : 0.0;
-        records.push_back(r);
-      }
-    }
+    for (int M : o.segments) time_methods(bench_problem(s, M, o.seed), o, records);
+  return records;
+}
+
+std::vector<BackendRecord> run_backend_on_path(const Eigen::MatrixX3d& points, const traj::Limits& limits,
+                                               const BackendBenchOptions& o) {
+  validate(o);
+  if (points.rows() < 2) throw Error("bench backend: a path needs at least 2 points");
+  std::vector<BackendRecord> records;
+  for (int s : o.orders)
+    time_methods(traj::rest_to_rest(s, points, traj::trapezoidal_allocation(points, limits)), o, records);
   return records;
 }
 

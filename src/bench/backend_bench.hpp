@@ -8,7 +8,10 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
 #include <nlohmann/json.hpp>
+
+#include "miner/traj/trapezoidal_allocation.hpp"
 
 namespace miner::bench {
 
@@ -36,6 +39,10 @@ struct BackendRecord {
 };
 
 std::vector<BackendRecord> run_backend_bench(const BackendBenchOptions& options);
+/// The same methods on one path (a front end's waypoints), durations by trapezoidal
+/// allocation under `limits`, for each of options.orders (options.segments is unused).
+std::vector<BackendRecord> run_backend_on_path(const Eigen::MatrixX3d& points, const traj::Limits& limits,
+                                               const BackendBenchOptions& options);
 nlohmann::json to_json(const std::vector<BackendRecord>& records);
 /// A table like the paper's Table II: one row per (order, segments), one column per method.
 void print_table(const std::vector<BackendRecord>& records, std::ostream& out);

@@ -4,12 +4,14 @@
 
 #include <CLI/CLI.hpp>
 
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 
 #include "bench/backend_bench.hpp"
 #include "bench/frontend_bench.hpp"
 #include "bench/heuristic_bench.hpp"
+#include "bench/paper_bench.hpp"
 #include "miner/core/progress.hpp"
 #include "cli/cli.hpp"
 #include "miner/core/json_io.hpp"
@@ -125,6 +127,70 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   hc->callback([h, &out] {
     const bench::HeuristicBenchResult r = bench::run_heuristic_bench(h->bench, terminal_stream());
     emit(h->output, bench::to_json(r), bench::to_text(r), out);
+  });
+
+  struct PaperOptions {
+    bench::PaperBenchOptions bench;
+    std::string results = "docs/results.md";
+    std::string figures;  // empty: <results folder>/results
+    bool json = false;
+    bool quiet = false;
+  };
+  auto p = std::make_shared<PaperOptions>();
+  CLI::App* pc = bench_cmd->add_subcommand(
+      "paper", "the paper's Table I, heuristic quality, Table II and tracking MSE side by side -> docs/results.md");
+  pc->add_option("--maps", p->bench.maps, "front-end and back-end maps (with stored queries)")
+      ->delimiter(',')->capture_default_str();
+  pc->add_option("--planners", p->bench.planners, "front-end planners")->delimiter(',')->capture_default_str();
+  pc->add_option("--runs", p->bench.runs, "front-end runs per planner and map")->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  pc->add_option("--seed", p->bench.seed, "seed of every campaign")->capture_default_str();
+  pc->add_option("--time-limit", p->bench.time_limit_s, "seconds per front-end run")->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  pc->add_option("--iterations", p->bench.max_iterations, "front-end iteration budget")->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  pc->add_option("--weights", p->bench.weights, "sGAN weights (default: the shipped ones)");
+  pc->add_option("--heuristic-data", p->bench.heuristic_data, "a `miner dataset` folder (default: generate unseen maps)");
+  pc->add_option("--heuristic-samples", p->bench.heuristic_samples, "unseen maps for the heuristic table")
+      ->capture_default_str()->check(CLI::PositiveNumber);
+  pc->add_option("--heuristic-iterations", p->bench.heuristic_iterations, "MINER vs RRT* budget per heuristic query")
+      ->capture_default_str()->check(CLI::PositiveNumber);
+  pc->add_option("--scenarios", p->bench.scenarios, "tracking scenarios (default: indoor-1 and indoor-2)")->delimiter(',');
+  pc->add_option("--tracking-maps", p->bench.tracking_maps, "maps flown with the default scenario besides indoor-1")
+      ->delimiter(',')->capture_default_str();
+  pc->add_option("--backend-budget", p->bench.backend_budget_s, "seconds per back-end method and order")
+      ->capture_default_str()->check(CLI::PositiveNumber);
+  pc->add_option("--jobs", p->bench.jobs, "threads for generating the heuristic test set")->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  pc->add_option("--results", p->results, "the Markdown file to write")->capture_default_str();
+  pc->add_option("--figures", p->figures, "folder for the box plots (default: <results folder>/results)");
+  pc->add_flag("--json", p->json, "print every figure as JSON");
+  pc->add_flag("--quiet", p->quiet, "no progress on stderr");
+  pc->callback([p, &out] {
+    std::ostringstream command;
+    command << "miner bench paper --runs " << p->bench.runs << " --seed " << p->bench.seed << " --time-limit "
+            << p->bench.time_limit_s << " --heuristic-samples " << p->bench.heuristic_samples;
+    if (!p->bench.heuristic_data.empty()) command << " --heuristic-data " << p->bench.heuristic_data;
+    if (!p->bench.weights.empty()) command << " --weights " << p->bench.weights;
+    if (p->bench.maps != bench::PaperBenchOptions{}.maps) {
+      command << " --maps ";
+      for (std::size_t i = 0; i < p->bench.maps.size(); ++i) command << (i ? "," : "") << p->bench.maps[i];
+    }
+    if (p->bench.planners != bench::PaperBenchOptions{}.planners) {
+      command << " --planners ";
+      for (std::size_t i = 0; i < p->bench.planners.size(); ++i) command << (i ? "," : "") << p->bench.planners[i];
+    }
+    namespace fs = std::filesystem;
+    const fs::path results(p->results);
+    const fs::path figures = p->figures.empty() ? results.parent_path() / "results" : fs::path(p->figures);
+    const auto r = bench::run_paper_bench(p->bench, command.str(), p->quiet ? nullptr : terminal_stream());
+    const std::string link = fs::relative(fs::absolute(figures), fs::absolute(results).parent_path()).generic_string();
+    std::vector<std::pair<std::string, std::string>> files;
+    for (const auto& [name, svg] : bench::results_figures(r)) files.emplace_back(name, svg);
+    write_folder_atomic(figures.string(), files);
+    write_file_atomic(results.string(), bench::results_markdown(r, link));
+    if (p->json) out << dump_json(bench::to_json(r));
+    else out << "wrote " << results.string() << " and " << files.size() << " box plots in " << figures.string() << "\n";
   });
 }
 

@@ -392,6 +392,36 @@ TEST_CASE("miner fly runs sGAN region, MINER RRT*, MINCO and flight and keeps ev
   CHECK(read(jerk_run + "/summary.json") == before);
 }
 
+TEST_CASE("miner bench paper writes the four tables beside the paper's numbers, with box plots", "[REQ-REPORT-005]") {
+  const std::string src = std::getenv("MINER_SOURCE_DIR") ? std::getenv("MINER_SOURCE_DIR") : ".";
+  const std::string results = dir() + "/paper/results.md";
+  const Run r = miner_cli({"bench", "paper", "--maps", src + "/fixtures/maps/sim-1.json", "--planners",
+                           "rrtstar,miner-sgan,ompl:RRTConnect", "--runs", "2", "--time-limit", "0.2",
+                           "--heuristic-samples", "2", "--heuristic-iterations", "300", "--backend-budget", "0.005",
+                           "--tracking-maps", src + "/fixtures/maps/indoor-2.json", "--results", results, "--quiet"});
+  INFO(r.err);
+  REQUIRE(r.code == 0);
+  const std::string md = read(results);
+  // Every table, the paper's numbers next to ours and OMPL's, the command and the commit.
+  for (const char* heading : {"## Table I", "## Heuristic quality", "## Table II", "## Tracking error"})
+    CHECK_THAT(md, Contains(heading));
+  CHECK_THAT(md, Contains("| RRT* | paper | — | 737.0 | 590.4 | 99.4 | 2.1 | 34007.9 | 30579.4 | 491.1 |"));
+  CHECK_THAT(md, Contains("| RRT* | MINER `rrtstar` |") && Contains("| Ours | MINER `miner-sgan` |") &&
+                     Contains("OMPL `ompl:RRTConnect`"));
+  CHECK_THAT(md, Contains("| Ours (paper) | 96.3 % | 97.1 % |") && Contains("| MINER sGAN, filtered | 100.0 % | 100.0 % |"));
+  CHECK_THAT(md, Contains("0.0023/0.0043") && Contains("| Map1 | paper (real flight) | 0.0513 |"));
+  CHECK_THAT(md, Contains("| indoor-1 | MINER (simulation) |") && Contains("| indoor-2 | MINER (simulation) |"));
+  CHECK_THAT(md, Contains("`miner bench paper --runs 2 --seed 1") && Contains("at commit `"));
+  CHECK_THAT(md, Contains("](results/sim-1-first.svg)") && Contains("](results/sim-1-target.svg)"));
+  const std::string box = read(dir() + "/paper/results/sim-1-first.svg");
+  CHECK_THAT(box, Contains("<svg") && Contains(">rrtstar<") && Contains(">miner-sgan<"));
+  // A bad map is refused before any campaign, and nothing is written.
+  const Run bad = miner_cli({"bench", "paper", "--maps", "/nonexistent.json", "--results", dir() + "/bad/r.md", "--quiet"});
+  CHECK(bad.code == 1);
+  CHECK_THAT(bad.err, Contains("/nonexistent.json"));
+  CHECK_FALSE(std::filesystem::exists(dir() + "/bad"));
+}
+
 TEST_CASE("miner fly refuses a bad scenario before flying", "[REQ-FLIGHT-007]") {
   const std::string path = write("bad-scenario.json", R"({"format": "miner-scenario-v1",
     "map": {"format": "miner-map-v1", "bounds": {"min": [0,0,0], "max": [10,10,10]}, "resolution": 1.0,

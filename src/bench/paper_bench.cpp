@@ -1,0 +1,392 @@
+#include "bench/paper_bench.hpp"
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <iomanip>
+#include <ostream>
+#include <sstream>
+#include <thread>
+
+#include <unistd.h>
+
+#include "bench/campaign_stats.hpp"
+#include "bench/ompl_planners.hpp"
+#include "miner/core/error.hpp"
+#include "miner/core/json_io.hpp"
+#include "miner/flight/closed_loop.hpp"
+#include "miner/flight/scenario.hpp"
+#include "miner/heuristic/dataset.hpp"
+#include "miner/report/svg_plot.hpp"
+#include "miner/world/map.hpp"
+
+namespace miner::bench {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+/// The paper's Table I (sim maps 1-3): initial iteration, nodes, cost, time (ms),
+/// optimal iteration, nodes, time (ms).
+struct PaperFrontRow {
+  const char* method;
+  double v[7];
+};
+const PaperFrontRow kPaperTable1[3][4] = {
+    {{"RRT*", {737.0, 590.4, 99.4, 2.1, 34007.9, 30579.4, 491.1}},
+     {"I-RRT*", {899.1, 746.2, 100.5, 2.5, 4118.1, 3592.4, 31.9}},
+     {"G-RRT*", {842.2, 685.9, 102.9, 2.8, 14276.4, 12995.9, 102.4}},
+     {"Ours", {156.9, 146.9, 82.4, 1.2, 437.9, 415.4, 5.3}}},
+    {{"RRT*", {1729.1, 1438.1, 101.4, 7.3, 17095.8, 15549.6, 135.0}},
+     {"I-RRT*", {1536.8, 1286.1, 102.6, 6.2, 3816.5, 3274.0, 27.1}},
+     {"G-RRT*", {1503.5, 1251.5, 102.0, 5.0, 6160.9, 5673.8, 45.4}},
+     {"Ours", {122.4, 113.5, 84.7, 1.2, 221.7, 210.4, 3.1}}},
+    {{"RRT*", {1379.0, 1174.0, 99.6, 7.0, 11480.1, 10499.2, 88.3}},
+     {"I-RRT*", {2192.7, 1882.3, 99.3, 10.2, 3930.5, 3519.0, 26.5}},
+     {"G-RRT*", {1937.9, 1706.8, 98.0, 9.9, 5680.8, 5294.3, 44.3}},
+     {"Ours", {209.7, 198.5, 81.9, 2.0, 380.7, 314.2, 4.6}}}};
+/// The paper's planner names for the project's planners.
+const char* paper_name(const std::string& planner) {
+  if (planner == "rrtstar") return "RRT*";
+  if (planner == "informed") return "I-RRT*";
+  if (planner == "guided") return "G-RRT*";
+  if (planner == "miner-sgan") return "Ours";
+  return nullptr;
+}
+/// Table II: initial time (ms) of RRT* and of MINER per map, then min-jerk / min-snap time
+/// (ms) per back-end method.
+const double kPaperInitial[3][2] = {{2.10, 1.29}, {7.31, 1.20}, {7.01, 2.08}};
+struct PaperBackRow {
+  const char* method;
+  const char* label;
+  double jerk_snap[3][2];
+};
+const PaperBackRow kPaperTable2[] = {
+    {"kkt-qp", "QP (Mellinger)", {{0.550, 1.445}, {0.375, 0.597}, {0.464, 1.023}}},
+    {"closed-form", "Closed form (Bry, Oleynikova)", {{2.618, 4.390}, {1.809, 2.821}, {2.575, 4.839}}},
+    {"minco", "Optimal condition (Wang; ours)", {{0.0023, 0.0043}, {0.0022, 0.0040}, {0.0024, 0.0045}}},
+};
+const double kPaperConnectivity = 0.963, kPaperSafety = 0.971;
+/// The paper's tracking MSE (real flights, Map1 and Map2).
+const double kPaperMse[2][6] = {{0.0513, 0.0919, 0.0003, 0.0222, 0.0285, 0.0006},
+                                {0.0716, 0.1089, 0.0004, 0.0237, 0.0115, 0.0008}};
+
+std::string f(double v, int digits) {
+  if (!std::isfinite(v)) return "—";
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
+  return buf;
+}
+
+std::string pct(double v) { return std::isfinite(v) ? f(100.0 * v, 1) + " %" : "—"; }
+
+std::string git_commit() {
+  std::string out;
+  if (FILE* p = ::popen("git describe --always --dirty 2>/dev/null", "r")) {
+    char buf[128];
+    while (std::fgets(buf, sizeof buf, p)) out += buf;
+    ::pclose(p);
+  }
+  while (!out.empty() && (out.back() == '\n' || out.back() == '\r')) out.pop_back();
+  return out.empty() ? "unknown" : out;
+}
+
+std::string map_label(const std::string& path) { return std::filesystem::path(path).stem().string(); }
+
+const PlannerSummary* find_summary(const FrontendBenchResult& r, const std::string& planner) {
+  for (const auto& s : r.summaries)
+    if (s.planner == planner) return &s;
+  return nullptr;
+}
+
+const BackendRecord* find_record(const std::vector<BackendRecord>& records, const std::string& method, int order) {
+  for (const auto& r : records)
+    if (r.method == method && r.order == order && !r.skipped) return &r;
+  return nullptr;
+}
+
+}  // namespace
+
+PaperBenchResult run_paper_bench(const PaperBenchOptions& o, const std::string& command, std::ostream* progress) {
+  if (o.maps.empty()) throw Error("bench paper: --maps needs at least one map");
+  if (o.runs < 1) throw Error("bench paper: --runs must be >= 1");
+  if (o.heuristic_samples < 1) throw Error("bench paper: --heuristic-samples must be >= 1");
+  const auto t0 = Clock::now();
+  PaperBenchResult out;
+  out.options = o;
+  out.command = command;
+  out.commit = git_commit();
+  // Load everything first: a bad map or scenario fails before minutes of benchmarking.
+  std::vector<world::Map> maps;
+  for (const auto& path : o.maps) {
+    maps.push_back(world::Map::load(path));
+    if (!maps.back().query()) throw Error(path + ": the map stores no query (start, goal, robot radius)");
+  }
+  std::vector<flight::Scenario> scenarios;
+  if (o.scenarios.empty()) {
+    scenarios.push_back(flight::default_scenario());
+    for (const auto& m : o.tracking_maps) {
+      Json doc = flight::default_scenario_document();
+      doc["map"] = read_json_file(m);
+      doc["name"] = map_label(m);
+      scenarios.push_back(flight::scenario_from_json(doc, m, ""));
+    }
+  } else {
+    for (const auto& s : o.scenarios) scenarios.push_back(flight::load_scenario(s));
+  }
+  if (!o.weights.empty())
+    for (auto& s : scenarios) s.weights = o.weights;
+
+  // Table I and the box plots.
+  for (std::size_t i = 0; i < maps.size(); ++i) {
+    if (progress) *progress << "front end on " << o.maps[i] << "\n";
+    FrontendBenchOptions fo;
+    fo.planners = o.planners;
+    fo.runs = o.runs;
+    fo.seed = o.seed;
+    fo.time_limit_s = o.time_limit_s;
+    fo.max_iterations = o.max_iterations;
+    fo.weights_file = o.weights;
+    fo.throughput_iterations = 0;
+    const auto& q = *maps[i].query();
+    out.frontend.push_back(
+        run_frontend_bench(maps[i], map_label(o.maps[i]), q.start, q.goal, q.robot_radius, fo, progress));
+  }
+  // Table II: the back end on the path MINER (sGAN) found in run 0, else RRT*'s.
+  BackendBenchOptions bo;
+  bo.budget_s = o.backend_budget_s;
+  bo.methods = {"minco", "closed-form", "kkt-qp", "dense-lu"};
+  for (const auto& fr : out.frontend) {
+    const plan::PlanResult* path = nullptr;
+    for (const char* who : {"miner-sgan", "rrtstar"})
+      for (const auto& run : fr.runs)
+        if (!path && run.planner == who && run.result.solved) path = &run.result;
+    if (!path) {
+      out.backend.emplace_back();
+      out.backend_segments.push_back(0);
+      continue;
+    }
+    Eigen::MatrixX3d points(static_cast<Eigen::Index>(path->path.size()), 3);
+    for (std::size_t k = 0; k < path->path.size(); ++k) points.row(static_cast<Eigen::Index>(k)) = path->path[k].transpose();
+    out.backend.push_back(run_backend_on_path(points, traj::Limits{2.0, 1.0}, bo));
+    out.backend_segments.push_back(path->path.size() - 1);
+  }
+  // Heuristic quality.
+  HeuristicBenchOptions ho;
+  ho.samples = o.heuristic_samples;
+  ho.weights = o.weights;
+  ho.seed = o.seed;
+  ho.max_iterations = o.heuristic_iterations;
+  std::string generated;
+  if (o.heuristic_data.empty()) {
+    generated = (std::filesystem::temp_directory_path() / ("miner-paper-data-" + std::to_string(::getpid()))).string();
+    heuristic::DatasetOptions d;
+    d.count = 1;  // the test split alone is used: map seeds after the first `count`
+    d.test_count = o.heuristic_samples;
+    d.seed = o.seed;
+    d.jobs = std::max(1, o.jobs);
+    if (progress) *progress << "generating " << o.heuristic_samples << " unseen heuristic test samples\n";
+    heuristic::write_dataset(d, generated, progress);
+    ho.data = generated;
+  } else {
+    ho.data = o.heuristic_data;
+  }
+  try {
+    out.heuristic = run_heuristic_bench(ho, progress);
+  } catch (...) {
+    if (!generated.empty()) std::filesystem::remove_all(generated);
+    throw;
+  }
+  if (!generated.empty()) {
+    std::filesystem::remove_all(generated);
+    out.heuristic.options.data = "(generated: miner dataset --count 1 --test-count " +
+                                 std::to_string(o.heuristic_samples) + " --seed " + std::to_string(o.seed) + ")";
+  }
+  // Tracking.
+  for (const auto& s : scenarios) {
+    if (progress) *progress << "flying " << s.name << "\n";
+    const auto reference = flight::build_reference(s);
+    const auto r = flight::fly(s, reference);
+    out.tracking.push_back({s.name, r.position_mse, r.velocity_mse, r.max_position_error, r.collisions, r.goal_reached});
+  }
+  out.total_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  return out;
+}
+
+std::map<std::string, std::string> results_figures(const PaperBenchResult& r) {
+  std::map<std::string, std::string> figures;
+  for (const auto& fr : r.frontend) {
+    std::vector<report::BoxGroup> first, target;
+    for (const auto& planner : r.options.planners) {
+      report::BoxGroup a{planner, {}}, b{planner, {}};
+      for (const auto& run : fr.runs) {
+        if (run.planner != planner) continue;
+        if (run.result.first) a.values.push_back(run.result.first->time_ms);
+        if (run.result.target) b.values.push_back(run.result.target->time_ms);
+      }
+      first.push_back(a);
+      target.push_back(b);
+    }
+    const int width = 110 * static_cast<int>(std::max<std::size_t>(r.options.planners.size(), 4));
+    figures[fr.map + "-first.svg"] = report::svg_box_plot(
+        {fr.map + ": time to the first solution", "", "ms (log)", width, 300}, first, true);
+    figures[fr.map + "-target.svg"] = report::svg_box_plot(
+        {fr.map + ": time to the target cost (A* cost x " + f(r.options.runs > 0 ? fr.target_cost / fr.reference_cost : 1.0, 2) + ")",
+         "", "ms (log)", width, 300},
+        target, true);
+  }
+  return figures;
+}
+
+std::string results_markdown(const PaperBenchResult& r, const std::string& figure_dir) {
+  std::ostringstream md;
+  md << "# Results: the paper's tables reproduced\n\n"
+     << "Generated by `" << r.command << "` at commit `" << r.commit << "` (" << f(r.total_s, 0)
+     << " s). The paper's numbers come from its own hardware (and, for tracking, real flights); ours from this "
+        "machine, single-threaded. Times are wall clock and vary between runs and machines; iterations, nodes "
+        "and costs are deterministic for the seed. Method: docs/report.md.\n\n";
+
+  md << "## Table I: front end (medians over " << r.options.runs << " runs per planner)\n\n"
+     << "Columns as in the paper: initial = first solution, optimal = first time the cost is at or below the "
+        "target (the A* path's length on the 0.5 m grid; the paper's \"asymptotic optimal cost\" is not "
+        "given). \"Ours\" is MINER RRT* sampling the sGAN's filtered region with the region's time "
+        "(encoding, inference, filter) included. A dash: no value (fewer than half the runs got there, "
+        "or OMPL does not report it). OMPL's planners run under a " << f(r.options.time_limit_s, 1)
+     << " s limit per run.\n\n";
+  for (std::size_t i = 0; i < r.frontend.size(); ++i) {
+    const auto& fr = r.frontend[i];
+    md << "### Map " << (i + 1) << " (" << fr.map << ", A* cost " << f(fr.reference_cost, 1) << " m)\n\n"
+       << "| method | source | success | initial iteration | initial nodes | initial cost (m) | initial time (ms) "
+          "| optimal iteration | optimal nodes | optimal time (ms) |\n|---|---|---|---|---|---|---|---|---|---|\n";
+    for (const auto& planner : r.options.planners) {
+      const PlannerSummary* s = find_summary(fr, planner);
+      if (!s) continue;
+      const char* pn = paper_name(planner);
+      if (pn && i < 3)
+        for (const auto& row : kPaperTable1[i])
+          if (std::string(row.method) == pn)
+            md << "| " << pn << " | paper | — | " << f(row.v[0], 1) << " | " << f(row.v[1], 1) << " | "
+               << f(row.v[2], 1) << " | " << f(row.v[3], 1) << " | " << f(row.v[4], 1) << " | " << f(row.v[5], 1)
+               << " | " << f(row.v[6], 1) << " |\n";
+      const bool ompl = is_ompl_planner(planner);
+      md << "| " << (pn ? pn : planner.c_str()) << " | " << (ompl ? "OMPL " : "MINER ") << "`" << planner << "` | "
+         << pct(s->success_rate) << " | " << f(s->first_iterations, 1) << " | " << f(s->first_nodes, 1) << " | "
+         << f(s->first_cost, 1) << " | " << f(s->first_time_ms, 2) << " | " << f(s->target_iterations, 1) << " | "
+         << f(s->target_nodes, 1) << " | " << f(s->target_time_ms, 2) << " |\n";
+    }
+    md << "\n![" << fr.map << " first](" << figure_dir << "/" << fr.map << "-first.svg) ![" << fr.map << " target]("
+       << figure_dir << "/" << fr.map << "-target.svg)\n\n";
+  }
+
+  const auto h = to_json(r.heuristic);
+  md << "## Heuristic quality (" << r.heuristic.samples.size() << " unseen maps)\n\n"
+     << "Data: " << r.heuristic.options.data << ". Exact definitions of connected and safe: spec/heuristic.md "
+        "REQ-HEUR-004. Raw = the network's thresholded output; filtered = after Alg. 1 line 3's filter.\n\n"
+     << "| method | connectivity rate | safety rate |\n|---|---|---|\n"
+     << "| Li et al. (paper) | 91.53 % | 91.90 % |\n| Ma et al. (paper) | 91.80 % | 92.40 % |\n"
+     << "| Ours (paper) | " << pct(kPaperConnectivity) << " | " << pct(kPaperSafety) << " |\n"
+     << "| MINER sGAN, raw | " << pct(h["connectivity_rate_raw"].get<double>()) << " | "
+     << pct(h["safety_rate_raw"].get<double>()) << " |\n"
+     << "| MINER sGAN, filtered | " << pct(h["connectivity_rate_filtered"].get<double>()) << " | "
+     << pct(h["safety_rate_filtered"].get<double>()) << " |\n\n";
+  const auto ms = [&](const char* k) { return h[k].is_number() ? f(h[k].get<double>(), 2) : std::string("—"); };
+  md << "Inference median " << ms("inference_ms") << " ms, whole region query " << ms("region_ms") << " ms.";
+  if (h.contains("miner") && h.contains("rrtstar")) {
+    const auto stage = [&](const char* who, const char* k) {
+      return h[who][k].is_number() ? f(h[who][k].get<double>(), 1) : std::string("—");
+    };
+    md << " On the same queries (budget " << r.options.heuristic_iterations
+       << " iterations), median iterations to the target: MINER " << stage("miner", "target_iterations")
+       << ", RRT* " << stage("rrtstar", "target_iterations") << "; time to the target: MINER "
+       << stage("miner", "target_time_ms") << " ms, RRT* " << stage("rrtstar", "target_time_ms") << " ms.";
+  }
+  md << "\n\n";
+
+  md << "## Table II: front end + back end (ms)\n\n"
+     << "Initial time: median time to the first solution (Table I). Back end: minimum jerk / minimum snap solve "
+        "on the waypoints of MINER's run-0 path on the same map, durations by trapezoidal allocation (v_max 2, "
+        "a_max 1), median of timed batches. The paper's MINCO row is Wang et al.'s code; ours is this "
+        "project's O(M) solver.\n\n"
+     << "| method | source |";
+  for (const auto& fr : r.frontend) md << " " << fr.map << " |";
+  md << "\n|---|---|";
+  for (std::size_t i = 0; i < r.frontend.size(); ++i) md << "---|";
+  md << "\n";
+  const auto backend_ms = [&](std::size_t i, const char* method, int order) {
+    const BackendRecord* b = find_record(r.backend[i], method, order);
+    return b ? f(b->us_per_solve / 1000.0, 4) : std::string("—");
+  };
+  for (const auto& row : kPaperTable2) {
+    const bool ours = std::string(row.method) == "minco";
+    md << "| " << (ours ? "RRT* + " : "RRT* + ") << row.label << " | paper |";
+    for (std::size_t i = 0; i < r.frontend.size(); ++i)
+      md << " " << (i < 3 ? f(kPaperInitial[i][0], 2) + " + " + f(row.jerk_snap[i][0], 4) + "/" + f(row.jerk_snap[i][1], 4)
+                          : std::string("—"))
+         << " |";
+    md << "\n| RRT* + " << row.label << " | MINER |";
+    for (std::size_t i = 0; i < r.frontend.size(); ++i) {
+      const PlannerSummary* s = find_summary(r.frontend[i], "rrtstar");
+      md << " " << (s ? f(s->first_time_ms, 2) : std::string("—")) << " + " << backend_ms(i, row.method, 3) << "/"
+         << backend_ms(i, row.method, 4) << " |";
+    }
+    md << "\n";
+  }
+  md << "| MINER-RRT* (ours) | paper |";
+  for (std::size_t i = 0; i < r.frontend.size(); ++i)
+    md << " " << (i < 3 ? f(kPaperInitial[i][1], 2) + " + " + f(kPaperTable2[2].jerk_snap[i][0], 4) + "/" +
+                              f(kPaperTable2[2].jerk_snap[i][1], 4)
+                        : std::string("—"))
+       << " |";
+  md << "\n| MINER-RRT* (ours) | MINER (`miner-sgan`) |";
+  for (std::size_t i = 0; i < r.frontend.size(); ++i) {
+    const PlannerSummary* s = find_summary(r.frontend[i], "miner-sgan");
+    md << " " << (s ? f(s->first_time_ms, 2) : std::string("—")) << " + " << backend_ms(i, "minco", 3) << "/"
+       << backend_ms(i, "minco", 4) << " |";
+  }
+  md << "\n| dense LU (extra baseline) | MINER |";
+  for (std::size_t i = 0; i < r.frontend.size(); ++i)
+    md << " " << backend_ms(i, "dense-lu", 3) << "/" << backend_ms(i, "dense-lu", 4) << " |";
+  md << "\n\nPath segments per map:";
+  for (std::size_t i = 0; i < r.frontend.size(); ++i) md << " " << r.frontend[i].map << " " << r.backend_segments[i] << ";";
+  md << " OMPL has no trajectory back end, so it has no row here.\n\n";
+
+  md << "## Tracking error (MSE)\n\n"
+     << "The paper flew a real quadrotor (Map1, Map2); ours are closed-loop simulations (CVODE dynamics, emulated "
+        "N3, EKF on noisy IMU and pose, SE(3) PID) of the indoor scenarios, sGAN + MINER + min-snap reference. "
+        "m^2 and (m/s)^2.\n\n"
+     << "| env. | source | pos. x | pos. y | pos. z | vel. x | vel. y | vel. z | max error (m) | collisions |\n"
+     << "|---|---|---|---|---|---|---|---|---|---|\n";
+  for (int k = 0; k < 2; ++k) {
+    md << "| Map" << (k + 1) << " | paper (real flight) |";
+    for (double v : kPaperMse[k]) md << " " << f(v, 4) << " |";
+    md << " — | — |\n";
+  }
+  for (const auto& t : r.tracking) {
+    md << "| " << t.env << " | MINER (simulation) |";
+    for (int a = 0; a < 3; ++a) md << " " << f(t.position_mse[a], 4) << " |";
+    for (int a = 0; a < 3; ++a) md << " " << f(t.velocity_mse[a], 4) << " |";
+    md << " " << f(t.max_position_error, 3) << " | " << t.collisions << (t.goal_reached ? "" : " (goal NOT reached)")
+       << " |\n";
+  }
+  return md.str();
+}
+
+nlohmann::json to_json(const PaperBenchResult& r) {
+  nlohmann::json j{{"commit", r.commit}, {"command", r.command}, {"total_s", r.total_s}};
+  j["frontend"] = nlohmann::json::array();
+  for (const auto& fr : r.frontend) j["frontend"].push_back(to_json(fr));
+  j["backend"] = nlohmann::json::array();
+  for (const auto& b : r.backend) j["backend"].push_back(to_json(b));
+  j["heuristic"] = to_json(r.heuristic);
+  j["tracking"] = nlohmann::json::array();
+  for (const auto& t : r.tracking)
+    j["tracking"].push_back({{"env", t.env},
+                             {"position_mse", {t.position_mse.x(), t.position_mse.y(), t.position_mse.z()}},
+                             {"velocity_mse", {t.velocity_mse.x(), t.velocity_mse.y(), t.velocity_mse.z()}},
+                             {"max_position_error", t.max_position_error},
+                             {"collisions", t.collisions},
+                             {"goal_reached", t.goal_reached}});
+  return j;
+}
+
+}  // namespace miner::bench

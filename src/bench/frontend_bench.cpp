@@ -13,6 +13,7 @@
 
 #include "bench/ompl_planners.hpp"
 #include "miner/core/error.hpp"
+#include "miner/core/progress.hpp"
 #include "miner/core/json_io.hpp"
 #include "bench/campaign_stats.hpp"
 #include "miner/heuristic/region_filter.hpp"
@@ -99,6 +100,8 @@ FrontendBenchResult run_frontend_bench(const world::Map& map, const std::string&
                                        double robot_radius, const FrontendBenchOptions& options,
                                        std::ostream* progress) {
   if (options.runs < 1) throw Error("--runs: must be >= 1, got " + std::to_string(options.runs));
+  if (options.shard_count < 1 || options.shard_index < 0 || options.shard_index >= options.shard_count)
+    throw Error("--shard: needs 0 <= i < N");
   if (!(options.target_factor > 0.0)) throw Error("--target-factor: must be > 0");
   const Clock::time_point campaign_start = Clock::now();
   const plan::PlanningProblem problem = plan::PlanningProblem::make(map, start, goal, robot_radius);
@@ -151,6 +154,9 @@ FrontendBenchResult run_frontend_bench(const world::Map& map, const std::string&
     return o;
   };
 
+  ProgressBar bar(progress, "frontend " + map_name,
+                  out.options.planners.size() * static_cast<std::size_t>(options.runs));
+  std::size_t done = 0;
   for (const std::string& name : out.options.planners) {
     const bool ompl = is_ompl_planner(name);
     if (ompl) {
@@ -170,6 +176,7 @@ FrontendBenchResult run_frontend_bench(const world::Map& map, const std::string&
       heuristic::query_region(*sgan, map, start, goal, robot_radius, options.seed);
     }
     for (int run = 0; run < options.runs; ++run) {
+      if (run % options.shard_count != options.shard_index) continue;
       RunRecord record;
       record.planner = name;
       record.run = run;
@@ -193,17 +200,13 @@ FrontendBenchResult run_frontend_bench(const world::Map& map, const std::string&
         }
       }
       out.runs.push_back(std::move(record));
+      bar.update(++done);
     }
     out.summaries.push_back(summarise(name, out.runs));
-    if (progress) {
-      const PlannerSummary& s = out.summaries.back();
-      *progress << "  " << std::left << std::setw(22) << name << std::right << " success " << std::setw(5)
-                << 100.0 * s.success_rate << " %, target " << std::setw(5) << 100.0 * s.target_rate
-                << " %, median time to target " << s.target_time_ms << " ms\n";
-    }
   }
+  bar.finish();
 
-  if (options.throughput_iterations > 0) {
+  if (options.throughput_iterations > 0 && options.shard_index == 0) {
     std::vector<double> mine, theirs;
     const bool with_ompl = ompl_available();
     for (int run = 0; run < std::min(options.runs, 5); ++run) {
@@ -230,29 +233,71 @@ FrontendBenchResult run_frontend_bench(const world::Map& map, const std::string&
   return out;
 }
 
+namespace {
+
+nlohmann::json summary_json(const PlannerSummary& s) {
+  return {{"planner", s.planner},
+          {"runs", s.runs},
+          {"success_rate", s.success_rate},
+          {"target_rate", s.target_rate},
+          {"first_iterations", num(s.first_iterations)},
+          {"first_nodes", num(s.first_nodes)},
+          {"first_cost", num(s.first_cost)},
+          {"first_time_ms", num(s.first_time_ms)},
+          {"first_iterations_mean", num(s.first_iterations_mean)},
+          {"first_nodes_mean", num(s.first_nodes_mean)},
+          {"first_cost_mean", num(s.first_cost_mean)},
+          {"first_time_ms_mean", num(s.first_time_ms_mean)},
+          {"target_iterations", num(s.target_iterations)},
+          {"target_nodes", num(s.target_nodes)},
+          {"target_time_ms", num(s.target_time_ms)},
+          {"target_iterations_mean", num(s.target_iterations_mean)},
+          {"target_nodes_mean", num(s.target_nodes_mean)},
+          {"target_time_ms_mean", num(s.target_time_ms_mean)},
+          {"final_cost", num(s.final_cost)}};
+}
+
+nlohmann::json count_json(std::size_t c) { return c == kUnknownCount ? nlohmann::json(nullptr) : nlohmann::json(c); }
+std::size_t count_from(const nlohmann::json& j) { return j.is_null() ? kUnknownCount : j.get<std::size_t>(); }
+
+nlohmann::json stage_json(const std::optional<plan::StageRecord>& s) {
+  if (!s) return nullptr;
+  return {{"iteration", count_json(s->iteration)}, {"nodes", count_json(s->nodes)}, {"cost", s->cost},
+          {"time_ms", s->time_ms}};
+}
+std::optional<plan::StageRecord> stage_from(const nlohmann::json& j) {
+  if (j.is_null()) return std::nullopt;
+  return plan::StageRecord{count_from(j.at("iteration")), count_from(j.at("nodes")), j.at("cost").get<double>(),
+                           j.at("time_ms").get<double>()};
+}
+
+/// What summarise() and a merge need of one run.
+nlohmann::json run_json(const RunRecord& r) {
+  return {{"planner", r.planner},     {"run", r.run},
+          {"solved", r.result.solved}, {"cost", r.result.solved ? nlohmann::json(r.result.cost) : nlohmann::json(nullptr)},
+          {"iterations", count_json(r.result.iterations)},
+          {"first", stage_json(r.result.first)},
+          {"target", stage_json(r.result.target)}};
+}
+RunRecord run_from(const nlohmann::json& j) {
+  RunRecord r;
+  r.planner = j.at("planner").get<std::string>();
+  r.run = j.at("run").get<int>();
+  r.result.solved = j.at("solved").get<bool>();
+  if (r.result.solved) r.result.cost = j.at("cost").get<double>();
+  r.result.iterations = count_from(j.at("iterations"));
+  r.result.first = stage_from(j.at("first"));
+  r.result.target = stage_from(j.at("target"));
+  return r;
+}
+
+}  // namespace
+
 nlohmann::json to_json(const FrontendBenchResult& r) {
   nlohmann::json planners = nlohmann::json::array();
-  for (const PlannerSummary& s : r.summaries) {
-    planners.push_back({{"planner", s.planner},
-                        {"runs", s.runs},
-                        {"success_rate", s.success_rate},
-                        {"target_rate", s.target_rate},
-                        {"first_iterations", num(s.first_iterations)},
-                        {"first_nodes", num(s.first_nodes)},
-                        {"first_cost", num(s.first_cost)},
-                        {"first_time_ms", num(s.first_time_ms)},
-                        {"first_iterations_mean", num(s.first_iterations_mean)},
-                        {"first_nodes_mean", num(s.first_nodes_mean)},
-                        {"first_cost_mean", num(s.first_cost_mean)},
-                        {"first_time_ms_mean", num(s.first_time_ms_mean)},
-                        {"target_iterations", num(s.target_iterations)},
-                        {"target_nodes", num(s.target_nodes)},
-                        {"target_time_ms", num(s.target_time_ms)},
-                        {"target_iterations_mean", num(s.target_iterations_mean)},
-                        {"target_nodes_mean", num(s.target_nodes_mean)},
-                        {"target_time_ms_mean", num(s.target_time_ms_mean)},
-                        {"final_cost", num(s.final_cost)}});
-  }
+  for (const PlannerSummary& s : r.summaries) planners.push_back(summary_json(s));
+  nlohmann::json runs = nlohmann::json::array();
+  for (const RunRecord& run : r.runs) runs.push_back(run_json(run));
   return {{"map", r.map},
           {"start", vec3_json(r.start)},
           {"goal", vec3_json(r.goal)},
@@ -273,7 +318,60 @@ nlohmann::json to_json(const FrontendBenchResult& r) {
             {"rrtstar_iterations_per_s", num(r.rrtstar_iterations_per_s)},
             {"ompl_rrtstar_iterations_per_s", num(r.ompl_rrtstar_iterations_per_s)}}},
           {"total_s", r.total_s},
-          {"planners", planners}};
+          {"shard", {{"index", r.options.shard_index}, {"count", r.options.shard_count}}},
+          {"planners", planners},
+          {"run_records", runs}};
+}
+
+nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts) {
+  if (parts.empty()) throw Error("merge: no shard files");
+  // Everything but the per-shard fields must agree.
+  const auto settings = [](nlohmann::json j) {
+    for (const char* k : {"planners", "run_records", "shard", "total_s", "throughput", "region"}) j.erase(k);
+    return j;
+  };
+  const nlohmann::json common = settings(parts.front());
+  const int n = parts.front().at("shard").at("count").get<int>();
+  if (static_cast<int>(parts.size()) != n)
+    throw Error("merge: the campaign has " + std::to_string(n) + " shards, got " + std::to_string(parts.size()) + " files");
+  std::vector<int> seen(static_cast<std::size_t>(n), -1);
+  std::vector<RunRecord> runs;
+  double total_s = 0.0;
+  nlohmann::json merged = parts.front();
+  for (std::size_t p = 0; p < parts.size(); ++p) {
+    const auto& part = parts[p];
+    if (settings(part) != common)
+      throw Error("merge: shard file " + std::to_string(p + 1) + " is from a different campaign (map, query, seed, "
+                  "runs or settings differ)");
+    if (part.at("shard").at("count").get<int>() != n)
+      throw Error("merge: shard file " + std::to_string(p + 1) + " splits the campaign differently");
+    const int index = part.at("shard").at("index").get<int>();
+    if (index < 0 || index >= n) throw Error("merge: shard index " + std::to_string(index) + " out of range");
+    if (seen[static_cast<std::size_t>(index)] >= 0)
+      throw Error("merge: shard " + std::to_string(index) + "/" + std::to_string(n) + " appears twice");
+    seen[static_cast<std::size_t>(index)] = static_cast<int>(p);
+    for (const auto& r : part.at("run_records")) runs.push_back(run_from(r));
+    total_s += part.at("total_s").get<double>();
+    if (index == 0) {
+      merged["throughput"] = part.at("throughput");
+      merged["region"] = part.at("region");
+    }
+  }
+  std::vector<std::string> order;
+  for (const auto& s : parts.front().at("planners")) order.push_back(s.at("planner").get<std::string>());
+  const auto rank = [&](const std::string& planner) {
+    return std::find(order.begin(), order.end(), planner) - order.begin();
+  };
+  std::stable_sort(runs.begin(), runs.end(), [&](const RunRecord& a, const RunRecord& b) {
+    return rank(a.planner) != rank(b.planner) ? rank(a.planner) < rank(b.planner) : a.run < b.run;
+  });
+  merged["planners"] = nlohmann::json::array();
+  for (const auto& planner : order) merged["planners"].push_back(summary_json(summarise(planner, runs)));
+  merged["run_records"] = nlohmann::json::array();
+  for (const auto& r : runs) merged["run_records"].push_back(run_json(r));
+  merged["shard"] = {{"index", 0}, {"count", 1}};
+  merged["total_s"] = total_s;
+  return merged;
 }
 
 void print_table(const FrontendBenchResult& r, std::ostream& out) {

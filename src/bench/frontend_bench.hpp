@@ -41,6 +41,11 @@ struct FrontendBenchOptions {
   /// Throughput check: the project's RRT* and OMPL's RRTstar both run this many
   /// iterations with no target, and iterations per second are compared. 0: skip.
   std::size_t throughput_iterations = 20000;
+  /// Distributed campaigns (REQ-REPORT-006): this process runs only the runs r with
+  /// r % shard_count == shard_index (and the throughput check only in shard 0);
+  /// merge_frontend_shards() joins the parts into the unsharded campaign's result.
+  int shard_index = 0;
+  int shard_count = 1;
 };
 
 /// MINER with the filtered sGAN region computed per run, its time included in every
@@ -106,6 +111,12 @@ PlannerSummary summarise(const std::string& planner, const std::vector<RunRecord
 /// One record per planner: planner, runs, success_rate, first_* and target_* (medians,
 /// null where undefined), *_mean, final_cost; plus the campaign's settings.
 nlohmann::json to_json(const FrontendBenchResult& result);
+
+/// Joins the `to_json` outputs of shards 0..N-1 of one campaign (same map, query, seed,
+/// runs, planners and settings; every shard exactly once) into the JSON the unsharded
+/// campaign writes: run records in planner-then-run order, summaries recomputed from
+/// them, total_s summed. Throws miner::Error naming the mismatch or the missing shard.
+nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts);
 /// A table like the paper's Table I.
 void print_table(const FrontendBenchResult& result, std::ostream& out);
 /// OMPL's benchmark log format (ompl::tools::Benchmark::saveResultsToStream), readable by

@@ -1,6 +1,7 @@
 // `miner bench backend` (REQ-TRAJ-009).
 #include <ostream>
 #include <sstream>
+#include <tuple>
 
 #include <CLI/CLI.hpp>
 
@@ -29,6 +30,7 @@ struct FrontendOptions {
   bench::FrontendBenchOptions bench;
   std::vector<int> region_dims = {32, 32, 32};
   std::string ompl_log;
+  std::string shard;
   bool quiet = false;
   OutputOptions output;
 };
@@ -37,9 +39,10 @@ void run_frontend(const FrontendOptions& o, std::ostream& out) {
   const ResolvedQuery q = resolve_query(o.query);
   bench::FrontendBenchOptions options = o.bench;
   options.region_dims = Eigen::Vector3i(o.region_dims[0], o.region_dims[1], o.region_dims[2]);
-  // Progress goes to stderr so --json output stays clean.
+  if (!o.shard.empty()) std::tie(options.shard_index, options.shard_count) = parse_shard(o.shard);
+  // A progress bar on stderr when it is a terminal (--json output stays clean).
   const auto result = bench::run_frontend_bench(q.map, o.query.map, q.start, q.goal, q.radius, options,
-                                                o.quiet ? nullptr : &std::cerr);
+                                                o.quiet ? nullptr : terminal_stream());
   if (!o.ompl_log.empty()) {
     std::ostringstream log;
     bench::write_ompl_log(result, log);
@@ -101,7 +104,8 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
                  "iterations of the rrtstar vs ompl:RRTstar throughput check (0: skip)")
       ->capture_default_str();
   fc->add_option("--ompl-log", f->ompl_log, "also write OMPL's benchmark log format to this file");
-  fc->add_flag("--quiet", f->quiet, "no progress lines on stderr");
+  fc->add_option("--shard", f->shard, "i/N: run only runs r with r % N == i (join the parts with `miner bench merge`)");
+  fc->add_flag("--quiet", f->quiet, "no progress bar on stderr");
   add_output_options(fc, f->output);
   fc->callback([f, &out] { run_frontend(*f, out); });
 
@@ -127,6 +131,27 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   hc->callback([h, &out] {
     const bench::HeuristicBenchResult r = bench::run_heuristic_bench(h->bench, terminal_stream());
     emit(h->output, bench::to_json(r), bench::to_text(r), out);
+  });
+
+  struct MergeOptions {
+    std::vector<std::string> parts;
+    OutputOptions output;
+  };
+  auto mo = std::make_shared<MergeOptions>();
+  CLI::App* mc = bench_cmd->add_subcommand("merge", "join the --json outputs of `bench frontend --shard i/N` runs");
+  mc->add_option("parts", mo->parts, "the N shard files (any order)")->required();
+  add_output_options(mc, mo->output);
+  mc->callback([mo, &out] {
+    std::vector<Json> parts;
+    for (const auto& f : mo->parts) parts.push_back(read_json_file(f));
+    const Json merged = bench::merge_frontend_shards(parts);
+    std::ostringstream text;
+    text << "merged " << parts.size() << " shards of " << merged["map"].get<std::string>() << ": "
+         << merged["run_records"].size() << " runs\n";
+    for (const auto& s : merged["planners"])
+      text << "  " << s["planner"].get<std::string>() << ": success " << 100.0 * s["success_rate"].get<double>()
+           << " %, target " << 100.0 * s["target_rate"].get<double>() << " %\n";
+    emit(mo->output, merged, text.str(), out);
   });
 
   struct PaperOptions {

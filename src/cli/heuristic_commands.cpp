@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <iomanip>
 #include <memory>
+#include <tuple>
 #include <ostream>
 #include <sstream>
 
@@ -22,6 +23,8 @@ struct DatasetCliOptions {
   heuristic::DatasetOptions dataset;
   std::vector<int> dims = {32, 32, 32};
   std::string out;
+  std::string shard;
+  std::vector<std::string> merge;
 };
 
 struct HeuristicCliOptions {
@@ -82,9 +85,18 @@ void add_heuristic_commands(CLI::App& app, std::ostream& out) {
   d->add_option("--dilation", o->dataset.dilation, "cells around start, goal and path cells (1: 3x3x3)")->capture_default_str();
   d->add_option("--shard-size", o->dataset.shard_size, "samples per shard file")->capture_default_str();
   d->add_option("--jobs", o->dataset.jobs, "worker threads (the output does not depend on it)")->capture_default_str();
+  d->add_option("--shard", o->shard, "i/N: write only part i of N (shard files j with j % N == i); join with --merge");
+  d->add_option("--merge", o->merge, "join these part folders (made with --shard) into --out instead of generating");
   d->add_option("--out", o->out, "output folder (written as a whole)")->required();
   d->callback([o, &out] {
+    if (!o->merge.empty()) {
+      const Json doc = heuristic::merge_dataset_parts(o->merge, o->out);
+      out << "merged " << o->merge.size() << " parts into " << o->out << ": " << doc["splits"]["train"]["count"]
+          << " train, " << doc["splits"]["val"]["count"] << " val, " << doc["splits"]["test"]["count"] << " test samples\n";
+      return;
+    }
     heuristic::DatasetOptions options = o->dataset;
+    if (!o->shard.empty()) std::tie(options.shard_index, options.shard_count) = parse_shard(o->shard);
     options.dims = Eigen::Vector3i(o->dims[0], o->dims[1], o->dims[2]);
     const Json doc = heuristic::write_dataset(options, o->out, terminal_stream());
     const Json& s = doc["splits"];

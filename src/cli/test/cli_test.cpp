@@ -422,6 +422,88 @@ TEST_CASE("miner bench paper writes the four tables beside the paper's numbers, 
   CHECK_FALSE(std::filesystem::exists(dir() + "/bad"));
 }
 
+namespace {
+/// A campaign's JSON without its wall-clock figures (which no two runs share).
+miner::Json without_clock(const miner::Json& j) {
+  if (j.is_object()) {
+    miner::Json out = miner::Json::object();
+    for (const auto& [k, v] : j.items())
+      if (k.find("time") == std::string::npos && k != "total_s" && k != "region") out[k] = without_clock(v);
+    return out;
+  }
+  if (j.is_array()) {
+    miner::Json out = miner::Json::array();
+    for (const auto& v : j) out.push_back(without_clock(v));
+    return out;
+  }
+  return j;
+}
+}  // namespace
+
+TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[REQ-REPORT-006]") {
+  const std::string src = std::getenv("MINER_SOURCE_DIR") ? std::getenv("MINER_SOURCE_DIR") : ".";
+  const std::vector<std::string> campaign{"bench", "frontend", "--map", src + "/fixtures/maps/sim-2.json", "--runs", "5",
+                                          "--planners", "rrtstar,informed,miner", "--throughput-iterations", "0",
+                                          "--max-iterations", "3000", "--quiet", "--json"};
+  const auto with = [&](std::vector<std::string> extra) {
+    std::vector<std::string> a = campaign;
+    a.insert(a.end(), extra.begin(), extra.end());
+    return a;
+  };
+  const Run full = miner_cli(campaign);
+  REQUIRE(full.code == 0);
+  std::vector<std::string> parts;
+  for (const char* shard : {"2/3", "0/3", "1/3"}) {
+    const std::string path = dir() + "/shard-" + std::string(1, shard[0]) + ".json";
+    REQUIRE(miner_cli(with({"--shard", shard, "--out", path})).code == 0);
+    parts.push_back(path);
+  }
+  std::vector<std::string> merge{"bench", "merge"};
+  merge.insert(merge.end(), parts.begin(), parts.end());
+  merge.push_back("--json");
+  const Run merged = miner_cli(merge);
+  INFO(merged.err);
+  REQUIRE(merged.code == 0);
+  const miner::Json a = miner::parse_json(full.out, "full"), b = miner::parse_json(merged.out, "merged");
+  CHECK(b["run_records"].size() == 15);
+  CHECK(without_clock(a) == without_clock(b));
+  // Missing, repeated and foreign parts, and malformed shards, are refused.
+  CHECK(miner_cli({"bench", "merge", parts[0], parts[1]}).code == 1);
+  const Run twice = miner_cli({"bench", "merge", parts[0], parts[0], parts[1]});
+  CHECK(twice.code == 1);
+  CHECK_THAT(twice.err, Contains("appears twice"));
+  const std::string other = dir() + "/other-seed.json";
+  REQUIRE(miner_cli(with({"--shard", "1/3", "--seed", "9", "--out", other})).code == 0);
+  CHECK_THAT(miner_cli({"bench", "merge", parts[0], parts[1], other}).err, Contains("different campaign"));
+  for (const char* bad : {"3/3", "-1/2", "1", "a/b", "1/2x"}) CHECK(miner_cli(with({"--shard", bad})).code == 1);
+
+  // Datasets: the merged parts are byte-identical to the unsharded folder.
+  const std::vector<std::string> gen{"dataset", "--count", "7", "--test-count", "4", "--shard-size", "2", "--seed", "5"};
+  const auto dataset = [&](std::vector<std::string> extra) {
+    std::vector<std::string> a = gen;
+    a.insert(a.end(), extra.begin(), extra.end());
+    return miner_cli(a);
+  };
+  REQUIRE(dataset({"--out", dir() + "/ds-full"}).code == 0);
+  REQUIRE(dataset({"--shard", "1/2", "--out", dir() + "/ds-1"}).code == 0);
+  REQUIRE(dataset({"--shard", "0/2", "--out", dir() + "/ds-0"}).code == 0);
+  REQUIRE(miner_cli({"dataset", "--merge", dir() + "/ds-1", dir() + "/ds-0", "--out", dir() + "/ds-merged"}).code == 0);
+  std::size_t compared = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir() + "/ds-full")) {
+    const std::string name = e.path().filename().string();
+    CHECK(read(dir() + "/ds-merged/" + name) == read(e.path().string()));
+    ++compared;
+  }
+  CHECK(compared == static_cast<std::size_t>(std::distance(std::filesystem::directory_iterator(dir() + "/ds-merged"),
+                                                           std::filesystem::directory_iterator{})));
+  CHECK(compared >= 8);  // dataset.json, 3 indexes, 4 + 1 + 2 shard files
+  const Run half = miner_cli({"dataset", "--merge", dir() + "/ds-1", "--out", dir() + "/ds-half"});
+  CHECK(half.code == 1);
+  CHECK_THAT(half.err, Contains("2 parts, got 1"));
+  CHECK(miner_cli({"dataset", "--merge", dir() + "/ds-full", "--out", dir() + "/ds-x"}).code == 1);
+  CHECK_FALSE(std::filesystem::exists(dir() + "/ds-half"));
+}
+
 TEST_CASE("miner fly refuses a bad scenario before flying", "[REQ-FLIGHT-007]") {
   const std::string path = write("bad-scenario.json", R"({"format": "miner-scenario-v1",
     "map": {"format": "miner-map-v1", "bounds": {"min": [0,0,0], "max": [10,10,10]}, "resolution": 1.0,

@@ -46,6 +46,8 @@ void validate(const DatasetOptions& o) {
   if (o.dilation < 0 || o.dilation > 4) throw Error("dataset: --dilation must be in [0, 4]");
   if (o.shard_size < 1) throw Error("dataset: --shard-size must be >= 1");
   if (o.jobs < 1 || o.jobs > 256) throw Error("dataset: --jobs must be in [1, 256]");
+  if (o.shard_count < 1 || o.shard_index < 0 || o.shard_index >= o.shard_count)
+    throw Error("dataset: --shard needs 0 <= i < N");
   if (!(o.min_separation >= 0.0 && o.min_separation < 1.0)) throw Error("dataset: min_separation must be in [0, 1)");
 }
 
@@ -104,9 +106,10 @@ Json write_dataset(const DatasetOptions& o, const std::string& dir, std::ostream
     Json index = Json::array();
     std::string shard;
     int in_shard = 0;
+    int file_number = 0;
     auto flush = [&] {
       if (in_shard == 0) return;
-      const std::string name = shard_name(kSplits[sp], shards.size());
+      const std::string name = shard_name(kSplits[sp], static_cast<std::size_t>(file_number));
       shards.push_back({{"file", name}, {"count", in_shard}});
       files.emplace_back(name, std::move(shard));
       shard.clear();
@@ -116,6 +119,12 @@ Json write_dataset(const DatasetOptions& o, const std::string& dir, std::ostream
     // do not depend on the number of threads.
     for (int i0 = 0; i0 < counts[sp]; i0 += o.shard_size) {
       const int n = std::min(o.shard_size, counts[sp] - i0);
+      file_number = i0 / o.shard_size;
+      if (file_number % o.shard_count != o.shard_index) {  // another part's file
+        done += static_cast<std::size_t>(n);
+        bar.update(done);
+        continue;
+      }
       std::vector<Sample> batch(static_cast<std::size_t>(n));
       std::atomic<int> next{0};
       std::exception_ptr failure;
@@ -166,6 +175,68 @@ Json write_dataset(const DatasetOptions& o, const std::string& dir, std::ostream
               {"min_separation", o.min_separation},
               {"map_seed_rule", "splitmix64(seed ^ k); train and val: k < count, test: k >= count"},
               {"splits", splits}};
+  if (o.shard_count > 1) doc["part"] = {{"index", o.shard_index}, {"count", o.shard_count}};
+  files.emplace_back("dataset.json", dump_json(doc));
+  write_folder_atomic(dir, files);
+  return doc;
+}
+
+Json merge_dataset_parts(const std::vector<std::string>& parts, const std::string& dir) {
+  if (parts.empty()) throw Error("dataset merge: no part folders");
+  std::vector<Json> docs;
+  for (const auto& p : parts) {
+    docs.push_back(read_json_file(p + "/dataset.json"));
+    if (docs.back().value("format", "") != kDatasetFormat) throw Error(p + ": not a miner-dataset-v1 folder");
+    if (!docs.back().contains("part")) throw Error(p + ": not a part folder (made without --shard)");
+  }
+  const auto common = [](Json d) {
+    d.erase("part");
+    for (auto& [name, split] : d["splits"].items()) split.erase("shards");
+    return d;
+  };
+  const Json base = common(docs.front());
+  const int n = docs.front()["part"]["count"].get<int>();
+  if (static_cast<int>(parts.size()) != n)
+    throw Error("dataset merge: the dataset has " + std::to_string(n) + " parts, got " + std::to_string(parts.size()));
+  std::vector<bool> seen(static_cast<std::size_t>(n), false);
+  for (std::size_t p = 0; p < parts.size(); ++p) {
+    if (common(docs[p]) != base) throw Error(parts[p] + ": a part of a different dataset (options differ)");
+    const int index = docs[p]["part"]["index"].get<int>();
+    if (docs[p]["part"]["count"].get<int>() != n || index < 0 || index >= n)
+      throw Error(parts[p] + ": splits the dataset differently");
+    if (seen[static_cast<std::size_t>(index)])
+      throw Error(parts[p] + ": part " + std::to_string(index) + "/" + std::to_string(n) + " appears twice");
+    seen[static_cast<std::size_t>(index)] = true;
+  }
+  Json doc = docs.front();
+  doc.erase("part");
+  std::vector<std::pair<std::string, std::string>> files;
+  for (const char* split : kSplits) {
+    std::vector<std::pair<std::string, Json>> shards;  // file name -> shard record, from every part
+    std::vector<Json> index;
+    for (std::size_t p = 0; p < parts.size(); ++p) {
+      const Json& sp = docs[p]["splits"][split];
+      for (const auto& shard : sp["shards"]) {
+        const std::string name = shard["file"].get<std::string>();
+        shards.emplace_back(name, shard);
+        files.emplace_back(name, read_file_bytes(parts[p] + "/" + name, "dataset shard"));
+      }
+      for (const auto& e : read_json_file(parts[p] + "/" + sp["index"].get<std::string>())) index.push_back(e);
+    }
+    std::sort(shards.begin(), shards.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    std::sort(index.begin(), index.end(),
+              [](const Json& a, const Json& b) { return a["k"].get<std::uint64_t>() < b["k"].get<std::uint64_t>(); });
+    Json list = Json::array();
+    for (const auto& s : shards) list.push_back(s.second);
+    doc["splits"][split]["shards"] = list;
+    std::uint64_t samples = 0;
+    for (const auto& s : shards) samples += s.second["count"].get<std::uint64_t>();
+    if (samples != doc["splits"][split]["count"].get<std::uint64_t>() || index.size() != samples)
+      throw Error("dataset merge: split " + std::string(split) + " has " + std::to_string(samples) + " samples, expected " +
+                  std::to_string(doc["splits"][split]["count"].get<std::uint64_t>()));
+    files.emplace_back(std::string(split) + "-index.json", dump_json(Json(index)));
+  }
+  // Shard files in the unsharded run's order (split by split), then dataset.json.
   files.emplace_back("dataset.json", dump_json(doc));
   write_folder_atomic(dir, files);
   return doc;

@@ -53,6 +53,11 @@ struct DatasetOptions {
   /// Start and goal at least this fraction of the bounds' diagonal apart, so the path
   /// crosses the clutter (the paper's queries span the map).
   double min_separation = 0.5;
+  /// Distributed generation (REQ-REPORT-006): this process writes only the shard files j
+  /// (numbered per split) with j % shard_count == shard_index, into a part folder that
+  /// merge_dataset_parts() joins with the others.
+  int shard_index = 0;
+  int shard_count = 1;
 };
 
 /// Throws miner::Error naming the option unless the options are usable.
@@ -74,6 +79,11 @@ Sample make_sample(const DatasetOptions& o, std::uint64_t k);
 /// Generates the whole dataset into `dir` (written as a whole: REQ-CORE-004). Progress
 /// goes to `progress` when it is not null.
 Json write_dataset(const DatasetOptions& o, const std::string& dir, std::ostream* progress);
+
+/// Joins the part folders of one dataset (same options, every part 0..N-1 exactly once)
+/// into `dir`, byte for byte the folder an unsharded run writes. Throws miner::Error
+/// naming the mismatch or the missing part; `dir` is written as a whole.
+Json merge_dataset_parts(const std::vector<std::string>& parts, const std::string& dir);
 
 /// Reads split `split` back: one Sample per record (metadata from the index).
 std::vector<Sample> read_split(const std::string& dir, const std::string& split);

@@ -35,7 +35,7 @@
 
     var camera = new THREE.PerspectiveCamera(45, width / height, diag / 1000, diag * 10);
     camera.up.set(0, 0, 1);  // ENU: z is up
-    camera.position.copy(centre).add(new THREE.Vector3(-0.6 * diag, -0.9 * diag, 0.7 * diag));
+    camera.position.copy(centre).add(new THREE.Vector3(-0.45 * diag, -0.7 * diag, 0.55 * diag));
     var controls = new THREE.OrbitControls(camera, renderer.domElement);
     controls.target.copy(centre);
     controls.update();
@@ -81,6 +81,8 @@
                           scene_data.region.centres[3 * i + 2]);
         cells.setMatrixAt(i, m);
       }
+      // r111 culls an InstancedMesh by its one cube's bounds at the origin: never cull it.
+      cells.frustumCulled = false;
       layer('region').add(cells);
     }
 
@@ -88,8 +90,10 @@
       if (!flat || flat.length < 6) return;
       var g = new THREE.BufferGeometry();
       g.setAttribute('position', new THREE.Float32BufferAttribute(flat, 3));
-      // Drawn over the translucent map and region, so the curves are never hidden.
-      var line = new THREE.Line(g, new THREE.LineBasicMaterial({color: color, depthTest: false}));
+      // Drawn last and over everything (transparent pass, highest render order, no depth
+      // test), so the translucent map, region and tree never hide the curves.
+      var line = new THREE.Line(g, new THREE.LineBasicMaterial({color: color, depthTest: false, transparent: true,
+                                                                opacity: 1.0}));
       line.renderOrder = 10;
       layer(name).add(line);
     }
@@ -107,7 +111,8 @@
     var marker = new THREE.SphereBufferGeometry(Math.max(scene_data.radius, diag / 200), 16, 12);
     var ends = layer('start / goal');
     [[scene_data.start, 0x2ca02c], [scene_data.goal, 0xd62728]].forEach(function (p) {
-      var s = new THREE.Mesh(marker, new THREE.MeshLambertMaterial({color: p[1], depthTest: false}));
+      var s = new THREE.Mesh(marker, new THREE.MeshLambertMaterial({color: p[1], depthTest: false, transparent: true,
+                                                                    opacity: 1.0}));
       s.renderOrder = 11;
       s.position.fromArray(p[0]);
       ends.add(s);

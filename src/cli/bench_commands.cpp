@@ -143,7 +143,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   add_output_options(mc, mo->output);
   mc->callback([mo, &out] {
     std::vector<Json> parts;
-    for (const auto& f : mo->parts) parts.push_back(read_json_file(f));
+    for (const auto& file : mo->parts) parts.push_back(read_json_file(file));
     const Json merged = bench::merge_frontend_shards(parts);
     std::ostringstream text;
     text << "merged " << parts.size() << " shards of " << merged["map"].get<std::string>() << ": "

@@ -480,9 +480,9 @@ TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[RE
   // Datasets: the merged parts are byte-identical to the unsharded folder.
   const std::vector<std::string> gen{"dataset", "--count", "7", "--test-count", "4", "--shard-size", "2", "--seed", "5"};
   const auto dataset = [&](std::vector<std::string> extra) {
-    std::vector<std::string> a = gen;
-    a.insert(a.end(), extra.begin(), extra.end());
-    return miner_cli(a);
+    std::vector<std::string> args = gen;
+    args.insert(args.end(), extra.begin(), extra.end());
+    return miner_cli(args);
   };
   REQUIRE(dataset({"--out", dir() + "/ds-full"}).code == 0);
   REQUIRE(dataset({"--shard", "1/2", "--out", dir() + "/ds-1"}).code == 0);

@@ -14,6 +14,8 @@
 #include "bench/ompl_planners.hpp"
 #include "miner/core/error.hpp"
 #include "miner/core/progress.hpp"
+#include "miner/core/shard.hpp"
+#include "miner/core/stopwatch.hpp"
 #include "miner/core/json_io.hpp"
 #include "bench/campaign_stats.hpp"
 #include "miner/heuristic/region_filter.hpp"
@@ -100,8 +102,7 @@ FrontendBenchResult run_frontend_bench(const world::Map& map, const std::string&
                                        double robot_radius, const FrontendBenchOptions& options,
                                        std::ostream* progress) {
   if (options.runs < 1) throw Error("--runs: must be >= 1, got " + std::to_string(options.runs));
-  if (options.shard_count < 1 || options.shard_index < 0 || options.shard_index >= options.shard_count)
-    throw Error("--shard: needs 0 <= i < N");
+  require_shard(options.shard_index, options.shard_count);
   if (!(options.target_factor > 0.0)) throw Error("--target-factor: must be > 0");
   const Clock::time_point campaign_start = Clock::now();
   const plan::PlanningProblem problem = plan::PlanningProblem::make(map, start, goal, robot_radius);
@@ -134,7 +135,7 @@ FrontendBenchResult run_frontend_bench(const world::Map& map, const std::string&
       options.region_file.empty()
           ? plan::astar_dilated_region(problem, reference, options.region_dims, options.region_dilation)
           : plan::HeuristicRegion::load(options.region_file);
-  out.region_ms = std::chrono::duration<double, std::milli>(Clock::now() - region_start).count();
+  out.region_ms = elapsed_ms(region_start);
   region.require_matches(map, "bench frontend");
   out.region_source = options.region_file.empty() ? region.source() : options.region_file;
   out.region_cells = region.cells().size();
@@ -192,7 +193,7 @@ FrontendBenchResult run_frontend_bench(const world::Map& map, const std::string&
           const Clock::time_point t0 = Clock::now();
           const heuristic::HeuristicQuery q =
               heuristic::query_region(*sgan, map, start, goal, robot_radius, options.seed + static_cast<std::uint64_t>(run));
-          const double region_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+          const double region_ms = elapsed_ms(t0);
           record.result = plan::plan(problem, po, &q.region);
           plan::add_setup_time(record.result, region_ms);
         } else {
@@ -331,28 +332,23 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts) {
     return j;
   };
   const nlohmann::json common = settings(parts.front());
-  const int n = parts.front().at("shard").at("count").get<int>();
-  if (static_cast<int>(parts.size()) != n)
-    throw Error("merge: the campaign has " + std::to_string(n) + " shards, got " + std::to_string(parts.size()) + " files");
-  std::vector<int> seen(static_cast<std::size_t>(n), -1);
+  std::vector<nlohmann::json> tags;
+  std::vector<std::string> names;
+  for (std::size_t p = 0; p < parts.size(); ++p) {
+    names.push_back("shard file " + std::to_string(p + 1));
+    if (settings(parts[p]) != common)
+      throw Error("merge: " + names.back() + " is from a different campaign (map, query, seed, runs or settings differ)");
+    tags.push_back(parts[p].at("shard"));
+  }
+  require_complete_parts(tags, names, "merge: the campaign");
   std::vector<RunRecord> runs;
   double total_s = 0.0;
   nlohmann::json merged = parts.front();
   for (std::size_t p = 0; p < parts.size(); ++p) {
     const auto& part = parts[p];
-    if (settings(part) != common)
-      throw Error("merge: shard file " + std::to_string(p + 1) + " is from a different campaign (map, query, seed, "
-                  "runs or settings differ)");
-    if (part.at("shard").at("count").get<int>() != n)
-      throw Error("merge: shard file " + std::to_string(p + 1) + " splits the campaign differently");
-    const int index = part.at("shard").at("index").get<int>();
-    if (index < 0 || index >= n) throw Error("merge: shard index " + std::to_string(index) + " out of range");
-    if (seen[static_cast<std::size_t>(index)] >= 0)
-      throw Error("merge: shard " + std::to_string(index) + "/" + std::to_string(n) + " appears twice");
-    seen[static_cast<std::size_t>(index)] = static_cast<int>(p);
     for (const auto& r : part.at("run_records")) runs.push_back(run_from(r));
     total_s += part.at("total_s").get<double>();
-    if (index == 0) {
+    if (part.at("shard").at("index").get<int>() == 0) {
       merged["throughput"] = part.at("throughput");
       merged["region"] = part.at("region");
     }

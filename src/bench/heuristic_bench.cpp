@@ -9,6 +9,7 @@
 #include "miner/core/error.hpp"
 #include "miner/core/json_io.hpp"
 #include "miner/core/progress.hpp"
+#include "miner/core/stopwatch.hpp"
 #include "miner/heuristic/dataset.hpp"
 #include "miner/heuristic/region_filter.hpp"
 #include "miner/heuristic/sgan.hpp"
@@ -76,7 +77,7 @@ HeuristicBenchResult run_heuristic_bench(const HeuristicBenchOptions& o, std::os
     const Clock::time_point t0 = Clock::now();
     const heuristic::HeuristicQuery q =
         heuristic::query_region(sgan, map, s.start, s.goal, preset.robot_radius, o.seed + k);
-    rec.region_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    rec.region_ms = elapsed_ms(t0);
     rec.inference_ms = q.inference_ms;
     rec.raw_connected = q.report.raw_connected;
     rec.raw_safe = q.report.raw_safe;

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "miner/core/error.hpp"
+#include "miner/core/stopwatch.hpp"
 #include "miner/world/map.hpp"
 
 #if MINER_WITH_OMPL
@@ -190,7 +191,7 @@ plan::PlanResult run_ompl(const plan::PlanningProblem& problem, const OmplRunOpt
     return n > 0 ? static_cast<std::size_t>(n - 1) : kUnknownCount;
   };
   Clock::time_point t0;
-  const auto now_ms = [&t0] { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); };
+  const auto now_ms = [&t0] { return elapsed_ms(t0); };
   double best = std::numeric_limits<double>::infinity();
   const auto record = [&](double cost) {
     if (!(cost < best)) return;

@@ -15,6 +15,7 @@
 #include "bench/paper_bench.hpp"
 #include "miner/core/progress.hpp"
 #include "cli/cli.hpp"
+#include "miner/core/shard.hpp"
 #include "miner/core/json_io.hpp"
 
 namespace miner::cli {

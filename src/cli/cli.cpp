@@ -109,18 +109,4 @@ int run_cli(const std::vector<std::string>& args, std::ostream& out, std::ostrea
   return 0;
 }
 
-std::pair<int, int> parse_shard(const std::string& text) {
-  const auto slash = text.find('/');
-  try {
-    if (slash != std::string::npos) {
-      std::size_t a = 0, b = 0;
-      const int i = std::stoi(text.substr(0, slash), &a);
-      const int n = std::stoi(text.substr(slash + 1), &b);
-      if (a == slash && b == text.size() - slash - 1 && n >= 1 && i >= 0 && i < n) return {i, n};
-    }
-  } catch (const std::exception&) {
-  }
-  throw Error("--shard: expected i/N with 0 <= i < N (e.g. 0/4), got \"" + text + "\"");
-}
-
 }  // namespace miner::cli

@@ -33,9 +33,6 @@ void add_output_options(CLI::App* cmd, OutputOptions& o);
 /// Writes `doc` to o.out if set, then prints `doc` (with --json) or `human`.
 void emit(const OutputOptions& o, const Json& doc, const std::string& human, std::ostream& out);
 
-/// --shard "i/N" with 0 <= i < N -> (i, N); throws miner::Error otherwise.
-std::pair<int, int> parse_shard(const std::string& text);
-
 /// CLI11 validators: a finite number; a finite number >= 0.
 extern const CLI::Validator kFinite;
 extern const CLI::Validator kFiniteNonNegative;

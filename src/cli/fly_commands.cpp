@@ -11,6 +11,7 @@
 #include "bench/sim_bench.hpp"
 #include "cli/cli.hpp"
 #include "miner/core/error.hpp"
+#include "miner/core/stopwatch.hpp"
 #include "miner/flight/closed_loop.hpp"
 #include "miner/report/flight_report.hpp"
 #include "miner/traj/problem_io.hpp"
@@ -50,7 +51,7 @@ void run_fly(const FlyCliOptions& o, std::ostream& out) {
   const auto t0 = std::chrono::steady_clock::now();
   const flight::FlightResult r = flight::fly(s, reference, options);
   auto stage_ms = reference.stage_ms;
-  stage_ms.emplace_back("flight", std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  stage_ms.emplace_back("flight", elapsed_ms(t0));
 
   const std::string dir = o.out.empty() ? "runs/" + s.name + "-seed" + std::to_string(s.seed) : o.out;
   Json summary = r.summary;

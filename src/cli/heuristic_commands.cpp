@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/cli.hpp"
+#include "miner/core/shard.hpp"
 #include "miner/core/error.hpp"
 #include "miner/core/progress.hpp"
 #include "miner/heuristic/dataset.hpp"

@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "miner/core/error.hpp"
+#include "miner/core/stopwatch.hpp"
 #include "miner/flight/flatness.hpp"
 #include "miner/heuristic/region_filter.hpp"
 #include "miner/heuristic/sgan.hpp"
@@ -163,8 +164,7 @@ Json self_contained_scenario(Json doc, const std::string& base_dir) {
   }
   if (doc.contains("vehicle") && doc["vehicle"].is_string())
     doc["vehicle"] = read_json_file(resolve(base_dir, doc["vehicle"].get<std::string>()));
-  for (const char* block : {"trajectory", "planner"}) {
-    const char* key = std::string(block) == "trajectory" ? "file" : "weights";
+  for (const auto& [block, key] : {std::pair{"trajectory", "file"}, std::pair{"planner", "weights"}}) {
     if (doc.contains(block) && doc[block].is_object() && doc[block].contains(key) && doc[block][key].is_string())
       doc[block][key] = absolute(doc[block][key].get<std::string>());
   }
@@ -261,12 +261,8 @@ ReferencePlan build_reference(const Scenario& s) {
       path.row(path.rows() - 1) = s.goal.transpose();
     } else {
       r.source = "planner";
-      using Clock = std::chrono::steady_clock;
-      const auto ms_since = [](Clock::time_point t0) {
-        return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-      };
       const auto problem = plan::PlanningProblem::make(*s.map, s.start, s.goal, radius);
-      auto t0 = Clock::now();
+      auto t0 = std::chrono::steady_clock::now();
       if (s.region == "astar") {
         const auto reference = plan::astar_reference(problem);
         r.region = plan::astar_dilated_region(problem, reference, Eigen::Vector3i(32, 32, 32), 1);
@@ -274,15 +270,15 @@ ReferencePlan build_reference(const Scenario& s) {
         const auto sgan = heuristic::Sgan::load_or_builtin(s.weights);
         r.region = heuristic::query_region(sgan, *s.map, s.start, s.goal, radius, s.seed).region;
       }
-      r.stage_ms.emplace_back("region", ms_since(t0));
+      r.stage_ms.emplace_back("region", elapsed_ms(t0));
       plan::PlannerOptions options;
       options.planner = plan::PlannerKind::kMiner;
       options.seed = s.seed;
       options.max_iterations = s.planner_iterations;
       options.record_tree = true;
-      t0 = Clock::now();
+      t0 = std::chrono::steady_clock::now();
       auto result = plan::plan(problem, options, &*r.region);
-      r.stage_ms.emplace_back("plan", ms_since(t0));
+      r.stage_ms.emplace_back("plan", elapsed_ms(t0));
       if (!result.solved) throw NoSolution(s.origin + ": MINER RRT* found no path: " + result.reason);
       path.resize(static_cast<Eigen::Index>(result.path.size()), 3);
       for (std::size_t i = 0; i < result.path.size(); ++i) path.row(static_cast<Eigen::Index>(i)) = result.path[i].transpose();
@@ -305,8 +301,7 @@ ReferencePlan build_reference(const Scenario& s) {
       r.time_scale = k * (1.0 + kLimitSlack);
       scale_time(r.trajectory, r.time_scale);
     }
-    r.stage_ms.emplace_back(
-        "trajectory", std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_traj).count());
+    r.stage_ms.emplace_back("trajectory", elapsed_ms(t_traj));
   }
   const double T = r.trajectory.total_duration();
   if ((r.trajectory.evaluate(0.0) - s.start).norm() > kEndpointTolerance ||

@@ -14,6 +14,7 @@
 #include "miner/core/error.hpp"
 #include "miner/core/progress.hpp"
 #include "miner/core/rng.hpp"
+#include "miner/core/shard.hpp"
 #include "miner/heuristic/grid.hpp"
 #include "miner/plan/heuristic_region.hpp"
 #include "miner/world/astar.hpp"
@@ -46,8 +47,7 @@ void validate(const DatasetOptions& o) {
   if (o.dilation < 0 || o.dilation > 4) throw Error("dataset: --dilation must be in [0, 4]");
   if (o.shard_size < 1) throw Error("dataset: --shard-size must be >= 1");
   if (o.jobs < 1 || o.jobs > 256) throw Error("dataset: --jobs must be in [1, 256]");
-  if (o.shard_count < 1 || o.shard_index < 0 || o.shard_index >= o.shard_count)
-    throw Error("dataset: --shard needs 0 <= i < N");
+  require_shard(o.shard_index, o.shard_count);
   if (!(o.min_separation >= 0.0 && o.min_separation < 1.0)) throw Error("dataset: min_separation must be in [0, 1)");
 }
 
@@ -195,19 +195,12 @@ Json merge_dataset_parts(const std::vector<std::string>& parts, const std::strin
     return d;
   };
   const Json base = common(docs.front());
-  const int n = docs.front()["part"]["count"].get<int>();
-  if (static_cast<int>(parts.size()) != n)
-    throw Error("dataset merge: the dataset has " + std::to_string(n) + " parts, got " + std::to_string(parts.size()));
-  std::vector<bool> seen(static_cast<std::size_t>(n), false);
+  std::vector<Json> tags;
   for (std::size_t p = 0; p < parts.size(); ++p) {
     if (common(docs[p]) != base) throw Error(parts[p] + ": a part of a different dataset (options differ)");
-    const int index = docs[p]["part"]["index"].get<int>();
-    if (docs[p]["part"]["count"].get<int>() != n || index < 0 || index >= n)
-      throw Error(parts[p] + ": splits the dataset differently");
-    if (seen[static_cast<std::size_t>(index)])
-      throw Error(parts[p] + ": part " + std::to_string(index) + "/" + std::to_string(n) + " appears twice");
-    seen[static_cast<std::size_t>(index)] = true;
+    tags.push_back(docs[p]["part"]);
   }
+  require_complete_parts(tags, parts, "dataset merge: the dataset");
   Json doc = docs.front();
   doc.erase("part");
   std::vector<std::pair<std::string, std::string>> files;

@@ -7,6 +7,7 @@
 
 #include "miner/core/error.hpp"
 #include "miner/core/rng.hpp"
+#include "miner/core/stopwatch.hpp"
 #include "miner/heuristic/grid.hpp"
 #include "miner/heuristic/sgan.hpp"
 #include "miner/world/map.hpp"
@@ -28,10 +29,6 @@ void for_neighbours(const Eigen::Vector3i& dims, const Eigen::Vector3i& c, F&& f
         if ((n.array() < 0).any() || (n.array() >= dims.array()).any()) continue;
         f(n, cell_index(dims, n.x(), n.y(), n.z()));
       }
-}
-
-double ms_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
 }  // namespace
@@ -133,11 +130,11 @@ HeuristicQuery query_region(const Sgan& sgan, const world::Map& map, const Eigen
   std::vector<std::uint8_t> env = encode_environment(map, dims, robot_radius);
   // The network was trained with the dataset's 3x3x3 state cubes (dilation 1).
   const std::vector<std::uint8_t> state = encode_state(b, dims, start, goal, 1);
-  const double encode_ms = ms_since(t0);
+  const double encode_ms = elapsed_ms(t0);
   t0 = std::chrono::steady_clock::now();
   Rng rng(seed, kNoiseStream);
   std::vector<float> prob = sgan.predict(env, state, rng);
-  const double inference_ms = ms_since(t0);
+  const double inference_ms = elapsed_ms(t0);
   t0 = std::chrono::steady_clock::now();
   FilteredRegion f = filter_region(prob, env, dims, cell_of(b, dims, start), cell_of(b, dims, goal), arch.threshold);
   std::vector<double> probabilities(prob.size(), 0.0);
@@ -146,7 +143,7 @@ HeuristicQuery query_region(const Sgan& sgan, const world::Map& map, const Eigen
   } else {
     for (std::size_t i = 0; i < prob.size(); ++i) probabilities[i] = static_cast<double>(prob[i]);
   }
-  const double filter_ms = ms_since(t0);
+  const double filter_ms = elapsed_ms(t0);
   plan::HeuristicRegion region(b, dims, std::move(probabilities), filter ? 0.5 : arch.threshold,
                                filter ? "sgan-filtered" : "sgan-raw");
   return {std::move(region), std::move(prob), std::move(env), f.report, encode_ms, inference_ms, filter_ms};

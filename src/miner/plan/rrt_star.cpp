@@ -8,6 +8,7 @@
 
 #include "miner/core/error.hpp"
 #include "miner/core/rng.hpp"
+#include "miner/core/stopwatch.hpp"
 #include "miner/plan/heuristic_region.hpp"
 #include "miner/plan/informed_set.hpp"
 #include "miner/plan/kd_tree.hpp"
@@ -29,10 +30,6 @@ constexpr double kRewireRelativeMargin = 1e-12;
 constexpr int kMaxRejectionTries = 64;
 
 using Clock = std::chrono::steady_clock;
-
-double elapsed_ms(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 void require_probability(double p, const std::string& name, bool below_one) {
   if (!(p >= 0.0 && (below_one ? p < 1.0 : p <= 1.0))) {

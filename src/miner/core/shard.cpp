@@ -1,0 +1,45 @@
+#include "miner/core/shard.hpp"
+
+#include <exception>
+
+#include "miner/core/error.hpp"
+
+namespace miner {
+
+std::pair<int, int> parse_shard(const std::string& text) {
+  const auto slash = text.find('/');
+  try {
+    if (slash != std::string::npos) {
+      std::size_t a = 0, b = 0;
+      const int i = std::stoi(text.substr(0, slash), &a);
+      const int n = std::stoi(text.substr(slash + 1), &b);
+      if (a == slash && b == text.size() - slash - 1 && n >= 1 && i >= 0 && i < n) return {i, n};
+    }
+  } catch (const std::exception&) {
+  }
+  throw Error("--shard: expected i/N with 0 <= i < N (e.g. 0/4), got \"" + text + "\"");
+}
+
+void require_shard(int index, int count) {
+  if (count < 1 || index < 0 || index >= count) throw Error("--shard: needs 0 <= i < N");
+}
+
+void require_complete_parts(const std::vector<Json>& tags, const std::vector<std::string>& names,
+                            const std::string& job) {
+  if (tags.empty()) throw Error(job + ": no parts given");
+  const int n = tags.front().at("count").get<int>();
+  if (static_cast<int>(tags.size()) != n)
+    throw Error(job + " has " + std::to_string(n) + " parts, got " + std::to_string(tags.size()));
+  std::vector<bool> seen(static_cast<std::size_t>(n), false);
+  for (std::size_t p = 0; p < tags.size(); ++p) {
+    const int index = tags[p].at("index").get<int>();
+    if (tags[p].at("count").get<int>() != n || index < 0 || index >= n)
+      throw Error(names[p] + ": splits " + job + " differently (part " + std::to_string(index) + " of " +
+                  std::to_string(tags[p].at("count").get<int>()) + ", expected N = " + std::to_string(n) + ")");
+    if (seen[static_cast<std::size_t>(index)])
+      throw Error(names[p] + ": part " + std::to_string(index) + "/" + std::to_string(n) + " appears twice");
+    seen[static_cast<std::size_t>(index)] = true;
+  }
+}
+
+}  // namespace miner

@@ -29,7 +29,7 @@ PACKAGES=(
   python3              # traceability checker
   # learned heuristic
   libdnnl-dev          # oneDNN: the sGAN's 3D convolutions in C++ (~20x LibTorch's default CPU path)
-  python3-torch python3-numpy   # sGAN training (src/python/sgan) and its deterministic-training test
+  python3-torch python3-numpy python3-scipy   # sGAN training (src/python/sgan; scipy: connected components) and its test
   # reports
   libjs-three          # three.js r111, embedded in every flight report's 3D view
   chromium             # headless browser: the report's screenshot test

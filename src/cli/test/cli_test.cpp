@@ -630,6 +630,27 @@ TEST_CASE("Training is deterministic for a seed and exports weights C++ loads an
   const miner::Json metrics = miner::read_json_file(dir() + "/train-a/metrics.json");
   CHECK(metrics["training"]["data_seed"] == 21);
   CHECK_THAT(metrics["training"]["command"].get<std::string>(), Contains("train.py"));
+  // Stopped after epoch 1 and resumed: the same bytes as the run straight through.
+  const std::string ckpt = " --checkpoint " + dir() + "/train-e.ckpt";
+  REQUIRE(std::system((train + ckpt + " --stop-after 1 --epochs 2 --out " + dir() + "/train-e > /dev/null").c_str()) == 0);
+  CHECK_FALSE(std::filesystem::exists(dir() + "/train-e/sgan.bin"));
+  REQUIRE(std::system((train + ckpt + " --resume " + dir() + "/train-e.ckpt --epochs 2 --out " + dir() +
+                       "/train-e > /dev/null")
+                          .c_str()) == 0);
+  REQUIRE(std::system((train + " --epochs 2 --out " + dir() + "/train-f > /dev/null").c_str()) == 0);
+  for (const char* f : {"/sgan.bin", "/metrics.json"}) {
+    std::ifstream a(dir() + "/train-e" + f, std::ios::binary), b(dir() + "/train-f" + f, std::ios::binary);
+    std::stringstream sa, sb;
+    sa << a.rdbuf();
+    sb << b.rdbuf();
+    INFO(f);
+    CHECK(sa.str().size() > 10);
+    CHECK(sa.str() == sb.str());
+  }
+  // A checkpoint from other options, and a CUDA device PyTorch does not see, are refused.
+  CHECK(std::system((train + " --resume " + dir() + "/train-e.ckpt --alpha4 7 --out " + dir() + "/train-g 2> /dev/null")
+                        .c_str()) != 0);
+  CHECK(std::system((train + " --device cuda:7 --out " + dir() + "/train-h 2> /dev/null").c_str()) != 0);
   CHECK(std::system((train + " --epochs 0 --out " + dir() + "/train-c 2> /dev/null").c_str()) != 0);
   CHECK(std::system((std::string(MINER_TORCH_PYTHON) + " " + MINER_SOURCE_DIR + "/src/python/sgan/train.py --data " +
                      dir() + "/nope --out " + dir() + "/train-d 2> /dev/null")

@@ -2,9 +2,8 @@
 is src/miner/heuristic/grid.hpp): safe = no solid cell (E == 2) in the region; connected =
 the start and goal cells are in the region and joined by a 26-connected chain of its cells.
 The start and goal cells are the centres of the two 3x3x3 cubes of S."""
-from collections import deque
-
 import numpy as np
+from scipy import ndimage
 
 
 def endpoints(state):
@@ -28,26 +27,16 @@ def _full_cube(state, c):
     return bool(state[lo[0]:hi[0], lo[1]:hi[1], lo[2]:hi[2]].all())
 
 
+# 26-connectivity: cells sharing a face, an edge or a corner.
+NEIGHBOURS_26 = np.ones((3, 3, 3), dtype=bool)
+
+
 def connected(region, a, b):
+    """True when cells a and b are in the region and one 26-connected component holds both."""
     if not region[a] or not region[b]:
         return False
-    seen = np.zeros(region.shape, bool)
-    seen[a] = True
-    q = deque([a])
-    shape = region.shape
-    while q:
-        c = q.popleft()
-        if c == b:
-            return True
-        for dz in (-1, 0, 1):
-            for dy in (-1, 0, 1):
-                for dx in (-1, 0, 1):
-                    n = (c[0] + dz, c[1] + dy, c[2] + dx)
-                    if 0 <= n[0] < shape[0] and 0 <= n[1] < shape[1] and 0 <= n[2] < shape[2] \
-                            and region[n] and not seen[n]:
-                        seen[n] = True
-                        q.append(n)
-    return False
+    labels, _ = ndimage.label(region, structure=NEIGHBOURS_26)
+    return bool(labels[a] == labels[b])
 
 
 def connected_and_safe(region, env, state):

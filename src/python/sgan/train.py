@@ -21,6 +21,7 @@ the first validation samples, for the C++ agreement test) and OUT/metrics.json.
 """
 import argparse
 import json
+import math
 import os
 import sys
 import time
@@ -34,18 +35,34 @@ import model as sgan  # noqa: E402
 import quality  # noqa: E402
 import tensors  # noqa: E402
 
-# Defaults and why:
-#   alpha1 0.05  the adversarial terms shape the region; BCE (alpha2 1) carries the signal early
+# Defaults and why (the shipped fixtures/sgan weights were trained with them; docs/heuristic.md
+# has the sweep that chose them):
+#   alpha1 0.002 the adversarial terms: the discriminators soon tell the generated region from the
+#                A* tube (loss_D -> 0.005); with a larger weight (0.05, 0.01, 0.005 tried) their
+#                gradient dragged BCE back up every epoch and the raw region stayed 55-75 % connected
+#   alpha2 1     BCE against the target carries the signal
 #   alpha3 0.5   continuity: jumps over delta = 0.5 between neighbours (a region's edge is one jump)
-#   alpha4 50    safety is a mean over all n^3 cells, so its per-cell gradient needs ~50x to
+#   alpha4 100   safety is a mean over all n^3 cells, so its per-cell gradient needs ~100x to
 #                outweigh BCE's on the solid cells the network sees in E
-#   pos_weight 5 the target is ~1.4 % of the grid; weighting it keeps the thresholded region
-#                from breaking up (connectivity)
+#   pos_weight 8 the target is ~1.4 % of the grid; weighting it keeps the thresholded region
+#                from breaking up (connectivity). alpha1, alpha4 and pos_weight changed together
+#                in the sweep (docs/heuristic.md); their separate effects were not measured
 #   kappa 1      safety and connectivity discriminators equally important (Eq. generator_loss)
+#   batch 32     keeps a GPU busy (an epoch of 21 600 samples: 14 s on one H100)
 #   thresholds   candidates for the raw region's threshold, chosen on the validation split
-DEFAULTS = dict(epochs=4, batch=8, lr_g=2e-3, lr_d=2e-4, kappa=1.0, alpha1=0.05, alpha2=1.0, alpha3=0.5,
-                alpha4=50.0, delta=0.5, pos_weight=5.0, width=8, threshold=0.5, seed=1, threads=2,
-                max_train=0, references=2, thresholds="0.5")
+#   augment 1    each sample is drawn through a random symmetry of the map's horizontal square
+#                (x and y mirrors, and the x <-> y swap when the grid and the bounds are square):
+#                it maps a query and its A* path to a query of the same map family and a path of
+#                the same length, so it is 8x data for free; gravity (z) is never flipped
+#   schedule     "cosine": both learning rates decay as (1 + cos(pi t)) / 2 over the run, t the
+#                share of steps done, so the last epochs settle instead of oscillating
+#   select       "best": export the epoch (and threshold) with the best validation
+#                connectivity + safety (GAN training oscillates); "last": the last epoch
+#   val_samples  validation samples scored after each epoch (0: all of them)
+DEFAULTS = dict(epochs=10, batch=32, lr_g=2e-3, lr_d=2e-4, kappa=1.0, alpha1=0.002, alpha2=1.0, alpha3=0.5,
+                alpha4=100.0, delta=0.5, pos_weight=8.0, width=8, threshold=0.5, seed=1, threads=2,
+                max_train=0, references=2, thresholds="0.3,0.4,0.5,0.6,0.7,0.8", augment=1, schedule="cosine",
+                select="best", val_samples=400)
 
 
 def load_split(data, split):
@@ -70,35 +87,83 @@ def load_split(data, split):
 
 
 def to_inputs(batch):
-    """uint8 [B, 3, n, n, n] -> (E/2, S, T, solid) float tensors [B, 1, n, n, n]."""
-    t = torch.from_numpy(batch.astype(np.float32))
+    """uint8 [B, 3, n, n, n] (numpy or torch) -> (E/2, S, T, solid) float tensors [B, 1, n, n, n]."""
+    t = (torch.from_numpy(batch) if isinstance(batch, np.ndarray) else batch).float()
     env, state, target = t[:, 0:1], t[:, 1:2], t[:, 2:3]
     return env * 0.5, state, target, (env == 2).float()
+
+
+def square_plan(meta):
+    """True when the x <-> y swap maps the map family onto itself: same cell count and extent."""
+    nx, ny, _ = meta["dims"]
+    lo, hi = meta["bounds"]["min"], meta["bounds"]["max"]
+    return nx == ny and abs((hi[0] - lo[0]) - (hi[1] - lo[1])) < 1e-9
+
+
+def augment(batch, code, swap_xy):
+    """Applies per sample the symmetry code (bit 0: mirror x, bit 1: mirror y, bit 2: swap x
+    and y) to uint8 [B, 3, nz, ny, nx]; code is an int tensor [B] on the batch's device."""
+    def where(bit, changed):
+        mask = ((code >> bit) & 1).bool().view(-1, 1, 1, 1, 1)
+        return torch.where(mask, changed, batch)
+    batch = where(0, batch.flip(4))
+    batch = where(1, batch.flip(3))
+    if swap_xy:
+        batch = where(2, batch.transpose(3, 4))
+    return batch
 
 
 def bce(p, label):
     return F.binary_cross_entropy(p, torch.full_like(p, label))
 
 
-def main(argv=None):
+def parse_args(argv):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--data", required=True, help="miner dataset folder")
     ap.add_argument("--out", required=True, help="output folder (created)")
     for k, v in DEFAULTS.items():
         ap.add_argument("--" + k.replace("_", "-"), type=type(v), default=v)
-    ap.add_argument("--device", default="cpu", help="cpu or cuda")
+    ap.add_argument("--device", default="cpu", help="cpu or cuda (same options, same bytes on one device kind)")
+    ap.add_argument("--checkpoint", default="", help="write the whole training state here after every epoch")
+    ap.add_argument("--resume", default="", help="continue from a --checkpoint file (same options)")
+    ap.add_argument("--stop-after", type=int, default=0,
+                    help="stop after this many epochs in all, leaving the --checkpoint to resume from (no export)")
     a = ap.parse_args(argv)
     if a.epochs < 1 or a.batch < 1 or a.width < 1 or a.threads < 1:
         raise SystemExit("train: --epochs, --batch, --width and --threads must be >= 1")
+    if a.schedule not in ("constant", "cosine"):
+        raise SystemExit("train: --schedule must be constant or cosine")
+    if a.select not in ("best", "last"):
+        raise SystemExit("train: --select must be best or last")
+    if a.augment not in (0, 1) or a.val_samples < 0:
+        raise SystemExit("train: --augment must be 0 or 1 and --val-samples >= 0")
     try:
-        candidates = sorted({float(t) for t in a.thresholds.split(",")} | {a.threshold})
+        a.candidates = sorted({float(t) for t in a.thresholds.split(",")} | {a.threshold})
     except ValueError:
         raise SystemExit("train: --thresholds must be numbers separated by commas")
-    if not all(0.0 < t < 1.0 for t in candidates):
+    if not all(0.0 < t < 1.0 for t in a.candidates):
         raise SystemExit("train: --threshold and --thresholds must be in (0, 1)")
+    if a.device.startswith("cuda"):
+        index = int(a.device.partition(":")[2] or 0) if a.device.partition(":")[2].isdigit() or a.device == "cuda" else -1
+        if index < 0:
+            raise SystemExit("train: --device must be cpu or cuda[:N]")
+        if index >= torch.cuda.device_count():
+            raise SystemExit(f"train: --device {a.device} asked for, but PyTorch sees "
+                             f"{torch.cuda.device_count()} CUDA device(s)")
+        # cuBLAS is deterministic only with a fixed workspace (PyTorch's reproducibility notes).
+        os.environ.setdefault("CUBLAS_WORKSPACE_CONFIG", ":4096:8")
+    elif a.device != "cpu":
+        raise SystemExit("train: --device must be cpu or cuda[:N]")
+    if a.stop_after and not a.checkpoint:
+        raise SystemExit("train: --stop-after needs --checkpoint (else the work is lost)")
+    return a
 
+
+def main(argv=None):
+    a = parse_args(argv)
     torch.set_num_threads(a.threads)
     torch.use_deterministic_algorithms(True)
+    torch.backends.cudnn.benchmark = False
     torch.manual_seed(a.seed)
     dev = torch.device(a.device)
     meta, train = load_split(a.data, "train")
@@ -109,23 +174,49 @@ def main(argv=None):
         raise SystemExit("train: the dataset needs train and val samples")
     if any(d % 8 for d in meta["dims"]):
         raise SystemExit("train: the grid dims must be divisible by 8")
+    train = torch.from_numpy(train).to(dev)  # uint8 on the device: 96 KiB a sample
+    swap_xy = square_plan(meta)
+    val_endpoints = [quality.endpoints(val[k, 1]) for k in range(len(val))]
 
-    gen = torch.Generator().manual_seed(a.seed)
+    gen = torch.Generator().manual_seed(a.seed)  # shuffles and symmetries (CPU)
+    noise_gen = torch.Generator(device=dev).manual_seed(a.seed + 3)  # noise, drawn on the device
     G = sgan.Generator(a.width).to(dev)
     Dc, Ds = sgan.Discriminator().to(dev), sgan.Discriminator().to(dev)
     opt_g = torch.optim.Adam(G.parameters(), lr=a.lr_g, betas=(0.5, 0.99))
     opt_d = torch.optim.Adam(list(Dc.parameters()) + list(Ds.parameters()), lr=a.lr_d, betas=(0.5, 0.99))
     pos_weight = torch.tensor(a.pos_weight, device=dev)
+    log, best, first_epoch = [], None, 0
+    if a.resume:
+        state = torch.load(a.resume, map_location=dev)
+        if state.get("options") != options_key(a):
+            raise SystemExit(f"train: {a.resume} was written with other options; resume with the same ones")
+        for m, k in ((G, "G"), (Dc, "Dc"), (Ds, "Ds"), (opt_g, "opt_g"), (opt_d, "opt_d")):
+            m.load_state_dict(state[k])
+        gen.set_state(state["gen"])
+        noise_gen.set_state(state["noise_gen"].to(noise_gen.get_state().device))
+        log, best, first_epoch = state["log"], state["best"], state["epoch"]
 
-    log, t0 = [], time.time()
+    t0 = time.time()
     steps_per_epoch = (len(train) + a.batch - 1) // a.batch
-    for epoch in range(a.epochs):
-        order = torch.randperm(len(train), generator=gen).numpy()
-        sums = np.zeros(6)
+    total_steps = steps_per_epoch * a.epochs
+    if first_epoch > a.epochs:
+        raise SystemExit(f"train: {a.resume} has {first_epoch} epochs done, more than --epochs {a.epochs}")
+    for epoch in range(first_epoch, a.epochs):
+        order = torch.randperm(len(train), generator=gen)
+        codes = torch.randint(0, 8, (len(train),), generator=gen)
+        sums = torch.zeros(6, dtype=torch.float64, device=dev)
         for step in range(steps_per_epoch):
-            idx = np.sort(order[step * a.batch:(step + 1) * a.batch])
-            env, state, target, solid = (x.to(dev) for x in to_inputs(train[idx]))
-            noise = torch.randn(env.shape, generator=gen).to(dev)
+            if a.schedule == "cosine":
+                scale = 0.5 * (1.0 + math.cos(math.pi * (epoch * steps_per_epoch + step) / total_steps))
+                for opt, lr in ((opt_g, a.lr_g), (opt_d, a.lr_d)):
+                    for group in opt.param_groups:
+                        group["lr"] = lr * scale
+            idx = torch.sort(order[step * a.batch:(step + 1) * a.batch]).values
+            batch = train[idx.to(dev)]
+            if a.augment:
+                batch = augment(batch, codes[idx].to(dev), swap_xy)
+            env, state, target, solid = to_inputs(batch)
+            noise = torch.randn(env.shape, generator=noise_gen, device=dev)
             o = G(env, state, noise)
             # Discriminators: real = ground truth, fake = generated (Eqs. connectivity/safety_loss).
             l_dc = bce(Dc(target, state), 1.0) + bce(Dc(o.detach(), state), 0.0)
@@ -146,61 +237,104 @@ def main(argv=None):
             opt_g.zero_grad()
             loss.backward()
             opt_g.step()
-            sums += [loss.item(), adv.item(), l_bce.item(), l_cont.item(), l_safe.item(), (l_dc + l_ds).item()]
-        q = evaluate(G, val, a, dev)
+            sums += torch.stack([loss, adv, l_bce, l_cont, l_safe, l_dc + l_ds]).detach().double()
+        scan = evaluate(G, val, val_endpoints, a, dev)
+        pick = best_threshold(scan)
         entry = {"epoch": epoch + 1,
                  **{k: float(v / steps_per_epoch) for k, v in
-                    zip(["loss_g", "adversarial", "bce", "continuity", "safety", "loss_d"], sums)}, **q}
+                    zip(["loss_g", "adversarial", "bce", "continuity", "safety", "loss_d"], sums.tolist())},
+                 "threshold": pick["threshold"], **quality_of(pick)}
         log.append(entry)  # the files hold no wall-clock time: same seed, same bytes
+        score = pick["val_connectivity_rate_raw"] + pick["val_safety_rate_raw"]
+        if best is None or a.select == "last" or score > best["score"]:
+            best = {"score": score, "epoch": epoch + 1, "threshold": pick["threshold"],
+                    "G": {k: v.detach().cpu().clone() for k, v in G.state_dict().items()}}
         print(json.dumps({**entry, "seconds": round(time.time() - t0, 1)}), flush=True)
+        if a.checkpoint:
+            save_checkpoint(a, epoch + 1, G, Dc, Ds, opt_g, opt_d, gen, noise_gen, log, best)
+        if a.stop_after and epoch + 1 >= a.stop_after and epoch + 1 < a.epochs:
+            print(f"train: stopped after epoch {epoch + 1}; resume with --resume {a.checkpoint}", flush=True)
+            return
 
-    # The raw region's threshold: the candidate with the best connectivity + safety on the
-    # validation split (ties: the one nearest 0.5).
-    if len(candidates) > 1:
-        scores = []
-        for t in candidates:
-            q = evaluate(G, val, a, dev, t)
-            scores.append((q["val_connectivity_rate_raw"] + q["val_safety_rate_raw"], -abs(t - 0.5), t, q))
-        best = max(scores)
-        a.threshold = best[2]
-        log[-1]["threshold_scan"] = [{"threshold": t, **q} for _, _, t, q in scores]
-        log[-1].update(best[3])
-        print(json.dumps({"threshold": a.threshold, **best[3]}), flush=True)
+    # The exported generator: the best (or last) epoch, at the threshold that scored best on
+    # the validation split (connectivity + safety; ties: the threshold nearest 0.5), scored
+    # again on the whole validation split.
+    G.load_state_dict(best["G"])
+    a.threshold = best["threshold"]
+    final = evaluate(G, val, val_endpoints, a, dev, all_samples=True)
+    summary = {"selected_epoch": best["epoch"], "threshold": a.threshold,
+               **quality_of(next(q for q in final if q["threshold"] == a.threshold)),
+               "threshold_scan": final}
+    print(json.dumps({k: v for k, v in summary.items() if k != "threshold_scan"}), flush=True)
     os.makedirs(a.out, exist_ok=True)
     args = list(argv if argv is not None else sys.argv[1:])
-    # The recorded command leaves out where the files went, so the same training gives
-    # the same bytes wherever it writes them.
-    for i, x in enumerate(args):
-        if x == "--out":
-            del args[i:i + 2]
-            break
-        if x.startswith("--out="):
-            del args[i]
-            break
-    export(G, a, meta, val, log, dev, args)
+    # The recorded command leaves out where the files went (and checkpoint paths), so the same
+    # training gives the same bytes wherever it writes them.
+    for flag in ("--out", "--checkpoint", "--resume", "--stop-after"):
+        for i, x in enumerate(args):
+            if x == flag:
+                del args[i:i + 2]
+                break
+            if x.startswith(flag + "="):
+                del args[i]
+                break
+    export(G, a, meta, val, log, summary, args)
 
 
-def evaluate(G, val, a, dev, threshold=None):
-    """Raw connectivity and safety rates on the validation split (quality.py, REQ-HEUR-004)."""
+def options_key(a):
+    """The options a checkpoint must share with the run that resumes it. --epochs may differ:
+    resuming with the epochs already done exports the best epoch so far; with more, the run
+    goes on (the cosine schedule then follows the new total from the step reached)."""
+    return json.dumps({k: getattr(a, k) for k in sorted(DEFAULTS) if k != "epochs"} | {"device": a.device},
+                      sort_keys=True)
+
+
+def save_checkpoint(a, epoch, G, Dc, Ds, opt_g, opt_d, gen, noise_gen, log, best):
+    state = {"options": options_key(a), "epoch": epoch, "log": log, "best": best,
+             "G": G.state_dict(), "Dc": Dc.state_dict(), "Ds": Ds.state_dict(),
+             "opt_g": opt_g.state_dict(), "opt_d": opt_d.state_dict(),
+             "gen": gen.get_state(), "noise_gen": noise_gen.get_state()}
+    tmp = a.checkpoint + ".tmp"
+    torch.save(state, tmp)
+    os.replace(tmp, a.checkpoint)  # a checkpoint is never half-written
+
+
+def quality_of(q):
+    return {"val_connectivity_rate_raw": q["val_connectivity_rate_raw"], "val_safety_rate_raw": q["val_safety_rate_raw"]}
+
+
+def best_threshold(scan):
+    """The scan entry with the best connectivity + safety; ties go to the threshold nearest 0.5."""
+    return max(scan, key=lambda q: (q["val_connectivity_rate_raw"] + q["val_safety_rate_raw"], -abs(q["threshold"] - 0.5)))
+
+
+def evaluate(G, val, val_endpoints, a, dev, all_samples=False):
+    """Raw connectivity and safety rates on the validation split (quality.py, REQ-HEUR-004) at
+    every candidate threshold; the first --val-samples samples unless all_samples."""
     G.eval()
-    conn = safe = 0
+    n = len(val) if all_samples or a.val_samples == 0 else min(a.val_samples, len(val))
+    conn = np.zeros(len(a.candidates))
+    safe = np.zeros(len(a.candidates))
     gen = torch.Generator().manual_seed(a.seed + 1)
     with torch.no_grad():
-        for i in range(0, len(val), a.batch):
-            b = val[i:i + a.batch]
+        for i in range(0, n, a.batch):
+            b = val[i:min(i + a.batch, n)]
             env, state, _, _ = to_inputs(b)
             noise = torch.randn(env.shape, generator=gen)
             p = G(env.to(dev), state.to(dev), noise.to(dev)).cpu().numpy()[:, 0]
             for k in range(len(b)):
-                region = p[k] >= (a.threshold if threshold is None else threshold)
-                c, s = quality.connected_and_safe(region, b[k, 0], b[k, 1])
-                conn += c
-                safe += s
+                ends = val_endpoints[i + k]
+                solid = b[k, 0] == 2
+                for j, t in enumerate(a.candidates):
+                    region = p[k] >= t
+                    conn[j] += ends[0] is not None and quality.connected(region, *ends)
+                    safe[j] += not bool((region & solid).any())
     G.train()
-    return {"val_connectivity_rate_raw": conn / len(val), "val_safety_rate_raw": safe / len(val)}
+    return [{"threshold": t, "val_connectivity_rate_raw": conn[j] / n, "val_safety_rate_raw": safe[j] / n}
+            for j, t in enumerate(a.candidates)]
 
 
-def export(G, a, meta, val, log, dev, argv):
+def export(G, a, meta, val, log, summary, argv):
     G = G.cpu().eval()
     names = [name for name, _, _ in sgan.GENERATOR_LAYERS]
     weights = []
@@ -216,7 +350,7 @@ def export(G, a, meta, val, log, dev, argv):
                      "train_samples": int(min(meta["splits"]["train"]["count"], a.max_train or 1 << 30)),
                      "command": "python3 src/python/sgan/train.py " + " ".join(argv) + " --out OUT"})
     tensors.write(os.path.join(a.out, "sgan.bin"), "sgan-weights", weights,
-                  {"architecture": arch, "training": training, "final": log[-1]})
+                  {"architecture": arch, "training": training, "final": {**log[-1], **summary}})
     # Reference tensors: the first validation samples with fixed noise, through PyTorch.
     refs = []
     gen = torch.Generator().manual_seed(a.seed + 2)
@@ -230,7 +364,8 @@ def export(G, a, meta, val, log, dev, argv):
     tensors.write(os.path.join(a.out, "reference.bin"), "sgan-reference", refs,
                   {"samples": min(a.references, len(val)), "weights": "sgan.bin"})
     with open(os.path.join(a.out, "metrics.json"), "w") as f:
-        json.dump({"format": "miner-sgan-training-v1", "architecture": arch, "training": training, "epochs": log},
+        json.dump({"format": "miner-sgan-training-v1", "architecture": arch, "training": training, "epochs": log,
+                   "selected": summary},
                   f, indent=1, sort_keys=True)
         f.write("\n")
 

@@ -59,6 +59,14 @@ struct PaperBenchResult {
   double total_s = 0.0;
 };
 
+/// Master seed of the heuristic test set that `miner bench paper` generates. Datasets draw
+/// map k from splitmix64(seed ^ k); a training set made with a seed and a count below 2^32
+/// feeds splitmix64 inputs below 2^32, while unseen_heuristic_seed(seed) ^ k keeps a salt's
+/// high bits, so (splitmix64 being a bijection) no generated test map is a map such a training
+/// set holds, whatever seed the bench is given. The test split of the bench's own seed would
+/// not do: with --count 1 its maps k >= 1 are the first training maps of that seed.
+std::uint64_t unseen_heuristic_seed(std::uint64_t seed);
+
 PaperBenchResult run_paper_bench(const PaperBenchOptions& options, const std::string& command, std::ostream* progress);
 
 /// docs/results.md: each table with the paper's numbers, this run's and OMPL's side by

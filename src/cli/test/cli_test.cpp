@@ -444,7 +444,7 @@ TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[RE
   const std::string src = std::getenv("MINER_SOURCE_DIR") ? std::getenv("MINER_SOURCE_DIR") : ".";
   const std::vector<std::string> campaign{"bench", "frontend", "--map", src + "/fixtures/maps/sim-2.json", "--runs", "5",
                                           "--planners", "rrtstar,informed,miner", "--throughput-iterations", "0",
-                                          "--max-iterations", "3000", "--quiet", "--json"};
+                                          "--max-iterations", "800", "--quiet", "--json"};
   const auto with = [&](std::vector<std::string> extra) {
     std::vector<std::string> a = campaign;
     a.insert(a.end(), extra.begin(), extra.end());

@@ -64,32 +64,50 @@ std::vector<std::uint8_t> encode_environment(const world::Map& map, const Eigen:
   const Eigen::Vector3d c = cell_size(b, dims);
   const auto cells = static_cast<std::size_t>(dims.prod());
   std::vector<std::uint8_t> e(cells, kFree);
-  std::vector<std::vector<int>> touching(cells);  // grown obstacles meeting each cell
+  // The grown obstacles and the cell range each one meets: cell i's closed box
+  // [b + i c, b + (i+1) c] meets [g.min, g.max] iff (g.min - b)/c - 1 <= i <= (g.max - b)/c.
   std::vector<world::Box> grown;
+  std::vector<std::pair<Eigen::Vector3i, Eigen::Vector3i>> range;
   for (const world::Box& o : map.obstacles()) {
     grown.push_back(o.inflated(radius));
     const world::Box& g = grown.back();
-    // Cell i's closed box [b + i c, b + (i+1) c] meets [g.min, g.max] iff
-    // (g.min - b)/c - 1 <= i <= (g.max - b)/c.
     Eigen::Vector3i lo, hi;
     for (int a = 0; a < 3; ++a) {
       lo[a] = std::max(0, static_cast<int>(std::ceil((g.min[a] - b.min[a]) / c[a] - 1.0)));
       hi[a] = std::min(dims[a] - 1, static_cast<int>(std::floor((g.max[a] - b.min[a]) / c[a])));
     }
+    range.emplace_back(lo, hi);
+  }
+  // Obstacles meeting each cell, as one flat list (offsets per cell): count, then fill.
+  std::vector<std::uint32_t> offset(cells + 1, 0);
+  const auto for_each_cell = [&](std::size_t o, auto&& f) {
+    const auto& [lo, hi] = range[o];
     for (int k = lo.z(); k <= hi.z(); ++k)
       for (int j = lo.y(); j <= hi.y(); ++j)
-        for (int i = lo.x(); i <= hi.x(); ++i) {
-          const std::size_t idx = cell_index(dims, i, j, k);
-          e[idx] = kPartial;
-          touching[idx].push_back(static_cast<int>(grown.size() - 1));
-        }
-  }
+        for (int i = lo.x(); i <= hi.x(); ++i) f(cell_index(dims, i, j, k));
+  };
+  for (std::size_t o = 0; o < grown.size(); ++o) for_each_cell(o, [&](std::size_t idx) { ++offset[idx + 1]; });
+  for (std::size_t idx = 0; idx < cells; ++idx) offset[idx + 1] += offset[idx];
+  std::vector<std::uint32_t> touching(offset[cells]);
+  std::vector<std::uint32_t> fill(offset.begin(), offset.end() - 1);
+  for (std::size_t o = 0; o < grown.size(); ++o)
+    for_each_cell(o, [&](std::size_t idx) { touching[fill[idx]++] = static_cast<std::uint32_t>(o); });
+
   std::vector<world::Box> local;
   for (std::size_t idx = 0; idx < cells; ++idx) {
-    if (e[idx] == kFree) continue;
+    if (offset[idx] == offset[idx + 1]) continue;
+    e[idx] = kPartial;
+    const world::Box cell = cell_box(b, dims, cell_coords(dims, idx));
     local.clear();
-    for (int o : touching[idx]) local.push_back(grown[static_cast<std::size_t>(o)]);
-    if (box_covered(cell_box(b, dims, cell_coords(dims, idx)), local)) e[idx] = kSolid;
+    bool inside_one = false;
+    for (std::uint32_t t = offset[idx]; t < offset[idx + 1]; ++t) {
+      const world::Box& g = grown[touching[t]];
+      inside_one = inside_one || ((cell.min.array() >= g.min.array()).all() && (cell.max.array() <= g.max.array()).all());
+      local.push_back(g);
+    }
+    // One box holding the whole cell covers it; a single box that does not, does not. Only
+    // cells met by several boxes, none holding them, need the exact cut (box_covered).
+    if (inside_one || (local.size() > 1 && box_covered(cell, local))) e[idx] = kSolid;
   }
   return e;
 }

@@ -21,6 +21,22 @@ extern const std::size_t kBuiltinSganWeightsSize;
 
 namespace {
 
+/// Single-threaded by design (the budget is per query on one core). oneDNN's OpenMP
+/// runtime reads this thread's setting, and a convolution primitive keeps the thread count
+/// it was created with: both the creation (Impl::build) and the execution (forward) run under
+/// this guard, which restores the caller's setting on the way out. (Until session 6 only the
+/// execution was guarded, and the primitives made at load time ran on two threads.)
+class OneOpenMpThread {
+ public:
+  OneOpenMpThread() : previous_(omp_get_max_threads()) { omp_set_num_threads(1); }
+  ~OneOpenMpThread() { omp_set_num_threads(previous_); }
+  OneOpenMpThread(const OneOpenMpThread&) = delete;
+  OneOpenMpThread& operator=(const OneOpenMpThread&) = delete;
+
+ private:
+  int previous_;
+};
+
 using dnnl::memory;
 using Tag = memory::format_tag;
 using Type = memory::data_type;
@@ -249,6 +265,7 @@ Sgan Sgan::from_bytes(const std::string& blob, const std::string& origin) {
   impl->path = origin;
   impl->meta = f.meta;
   try {
+    const OneOpenMpThread one_thread;  // the primitives keep the thread count they are made with
     impl->build(f);
   } catch (const dnnl::error& e) {
     throw Error(origin + ": oneDNN refused the network (" + e.what() + ")");
@@ -282,10 +299,7 @@ std::vector<float> Sgan::forward(const std::vector<float>& env, const std::vecto
     g.cond1.data[2 * v] = env[v];
     g.cond1.data[2 * v + 1] = state[v];
   }
-  // Single-threaded by design (the budget is per query on one core); oneDNN's
-  // OpenMP runtime reads this thread's setting.
-  const int previous = omp_get_max_threads();
-  omp_set_num_threads(1);
+  const OneOpenMpThread one_thread;
   dnnl::stream stream(g.engine);
   auto run = [&](std::size_t l) {
     g.conv[l].primitive.execute(stream, {{DNNL_ARG_SRC, g.conv[l].src},
@@ -313,7 +327,6 @@ std::vector<float> Sgan::forward(const std::vector<float>& env, const std::vecto
   concat(g.catd1, {{&g.d2, true}, {&g.a1, false}, {&g.cond1, false}});
   run(8);  // tap products of the last layer
   g.shift_sum();  // R
-  omp_set_num_threads(previous);
   return g.out.data;
 }
 

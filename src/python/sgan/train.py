@@ -113,6 +113,30 @@ def augment(batch, code, swap_xy):
     return batch
 
 
+class ProgressBar:
+    """The C++ ProgressBar's look (src/miner/core/progress.hpp) on stderr, drawn only when
+    stderr is a terminal; redrawn when the bar or the percentage changes."""
+    WIDTH = 30
+
+    def __init__(self, label, total):
+        self.label, self.total, self.drawn = label, max(total, 1), None
+        self.out = sys.stderr if sys.stderr.isatty() else None
+
+    def update(self, done):
+        if self.out is None:
+            return
+        done = min(done, self.total)
+        filled = self.WIDTH * done // self.total
+        key = (filled, 100 * done // self.total)
+        if key == self.drawn and done != self.total:
+            return
+        self.drawn = key
+        self.out.write(f"\r{self.label} [{'#' * filled}{' ' * (self.WIDTH - filled)}] {done}/{self.total}")
+        if done == self.total:
+            self.out.write("\n")
+        self.out.flush()
+
+
 def bce(p, label):
     return F.binary_cross_entropy(p, torch.full_like(p, label))
 
@@ -205,7 +229,9 @@ def main(argv=None):
         order = torch.randperm(len(train), generator=gen)
         codes = torch.randint(0, 8, (len(train),), generator=gen)
         sums = torch.zeros(6, dtype=torch.float64, device=dev)
+        bar = ProgressBar(f"epoch {epoch + 1}/{a.epochs}", steps_per_epoch)
         for step in range(steps_per_epoch):
+            bar.update(step)
             if a.schedule == "cosine":
                 scale = 0.5 * (1.0 + math.cos(math.pi * (epoch * steps_per_epoch + step) / total_steps))
                 for opt, lr in ((opt_g, a.lr_g), (opt_d, a.lr_d)):
@@ -238,6 +264,7 @@ def main(argv=None):
             loss.backward()
             opt_g.step()
             sums += torch.stack([loss, adv, l_bce, l_cont, l_safe, l_dc + l_ds]).detach().double()
+        bar.update(steps_per_epoch)
         scan = evaluate(G, val, val_endpoints, a, dev)
         pick = best_threshold(scan)
         entry = {"epoch": epoch + 1,

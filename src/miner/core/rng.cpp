@@ -1,5 +1,6 @@
 #include "miner/core/rng.hpp"
 
+#include <array>
 #include <cmath>
 #include <stdexcept>
 
@@ -7,7 +8,47 @@ namespace miner {
 
 namespace {
 __extension__ typedef unsigned __int128 Uint128;  // GCC/Clang extension, exact 64x64 product
+
+constexpr double kTwoPowMinus53 = 1.0 / 9007199254740992.0;  // 2^-53
+
+/// The ziggurat's layers for f(x) = exp(-x^2/2) (Marsaglia & Tsang 2000, Sec. 2): layer i >= 1
+/// is the rectangle [0, x_i] x [f(x_i), f(x_{i+1})], layer 0 the base [0, x_0] x [0, f(r)]
+/// with x_0 = v / f(r), which also stands for the tail beyond r. Every layer has area v:
+/// x_i (f(x_{i+1}) - f(x_i)) = v gives x_{i+1} = sqrt(-2 ln(v / x_i + f(x_i))), and r, v are
+/// the published 256-layer constants that close the top layer (x_256 = 0; checked in the tests
+/// to 1e-9 relative through ziggurat_top_layer_area()).
+struct Ziggurat {
+  static constexpr int kLayers = 256;
+  static constexpr double kR = 3.6541528853610088;
+  static constexpr double kV = 0.00492867323399;
+  std::array<double, kLayers + 1> x{};
+  std::array<double, kLayers + 1> fx{};    // f(x_i)
+  std::array<double, kLayers> inner{};     // x_{i+1} / x_i: |u| below it is under the curve
+
+  static double f(double t) { return std::exp(-0.5 * t * t); }
+
+  Ziggurat() {
+    x[0] = kV / f(kR);
+    x[1] = kR;
+    for (int i = 1; i + 1 < kLayers; ++i)
+      x[static_cast<std::size_t>(i + 1)] = std::sqrt(-2.0 * std::log(kV / x[static_cast<std::size_t>(i)] +
+                                                                      f(x[static_cast<std::size_t>(i)])));
+    x[kLayers] = 0.0;
+    for (std::size_t i = 0; i <= kLayers; ++i) fx[i] = f(x[i]);
+    for (std::size_t i = 0; i < kLayers; ++i) inner[i] = x[i + 1] / x[i];
+  }
+};
+
+const Ziggurat& ziggurat() {
+  static const Ziggurat z;
+  return z;
+}
 }  // namespace
+
+double ziggurat_top_layer_area() {
+  const Ziggurat& z = ziggurat();
+  return z.x[Ziggurat::kLayers - 1] * (1.0 - z.fx[Ziggurat::kLayers - 1]) / Ziggurat::kV;
+}
 
 std::uint64_t splitmix64(std::uint64_t x) {
   x += 0x9E3779B97F4A7C15ULL;
@@ -19,7 +60,6 @@ std::uint64_t splitmix64(std::uint64_t x) {
 Rng::Rng(std::uint64_t seed, std::uint64_t stream) : engine_(splitmix64(seed ^ stream)) {}
 
 double Rng::uniform01() {
-  constexpr double kTwoPowMinus53 = 1.0 / 9007199254740992.0;  // 2^-53
   return static_cast<double>(engine_() >> 11) * kTwoPowMinus53;
 }
 
@@ -55,6 +95,28 @@ double Rng::normal() {
   spare_ = v * factor;
   has_spare_ = true;
   return u * factor;
+}
+
+double Rng::normal_ziggurat() {
+  const Ziggurat& z = ziggurat();
+  for (;;) {
+    const std::uint64_t bits = engine_();
+    const std::size_t i = bits & (Ziggurat::kLayers - 1);
+    const double u = 2.0 * static_cast<double>(bits >> 11) * kTwoPowMinus53 - 1.0;  // [-1, 1)
+    if (std::fabs(u) < z.inner[i]) return u * z.x[i];  // inside the layer's core rectangle
+    if (i == 0) {
+      // Tail |x| > r: a = -ln(U1) / r, b = -ln(U2), accepted when 2b >= a^2 (Marsaglia 1964).
+      double a = 0.0, b = 0.0;
+      do {
+        a = -std::log(1.0 - uniform01()) / Ziggurat::kR;
+        b = -std::log(1.0 - uniform01());
+      } while (b + b < a * a);
+      return u < 0.0 ? -(Ziggurat::kR + a) : Ziggurat::kR + a;
+    }
+    // The wedge between x_{i+1} and x_i: a uniform height in the layer, kept under f.
+    const double t = u * z.x[i];
+    if (z.fx[i] + uniform01() * (z.fx[i + 1] - z.fx[i]) < Ziggurat::f(t)) return t;
+  }
 }
 
 }  // namespace miner

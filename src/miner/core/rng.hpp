@@ -16,6 +16,10 @@ namespace miner {
 /// (master seed, stream) into well-spread engine seeds.
 std::uint64_t splitmix64(std::uint64_t x);
 
+/// Area of Rng::normal_ziggurat()'s top layer over the common layer area v: 1 when the
+/// published (r, v) close the ziggurat with the recurrence computed here (a test checks it).
+double ziggurat_top_layer_area();
+
 /// Seeded random number generator.
 class Rng {
  public:
@@ -41,6 +45,14 @@ class Rng {
 
   /// N(mean, stddev^2).
   double normal(double mean, double stddev) { return mean + stddev * normal(); }
+
+  /// Standard normal N(0, 1) by the ziggurat method (Marsaglia & Tsang 2000, 256 layers of
+  /// equal area v under f(x) = exp(-x^2/2), tail beyond r = 3.6541528853610088 by Marsaglia's
+  /// 1964 exponential rejection). One draw gives the layer (its low 8 bits) and the signed
+  /// uniform (its top 53 bits, disjoint from the layer's, Doornik 2005); 98.5 % of the draws
+  /// end after one compare and one multiply, ~5x faster than normal(). A different sequence
+  /// than normal() for the same seed; the sGAN's 32^3 noise grid per query uses it.
+  double normal_ziggurat();
 
  private:
   std::mt19937_64 engine_;

@@ -151,13 +151,36 @@ std::vector<int> label_components(const std::vector<std::uint8_t>& mask, const E
   return label;
 }
 
+std::vector<std::uint8_t> component_of(const std::vector<std::uint8_t>& mask, const Eigen::Vector3i& dims,
+                                       std::size_t cell, std::size_t stop) {
+  std::vector<std::uint8_t> in(mask.size(), 0);
+  if (!mask[cell]) return in;
+  const auto nx = static_cast<std::size_t>(dims.x()), nxy = nx * static_cast<std::size_t>(dims.y());
+  std::vector<std::size_t> queue{cell};
+  in[cell] = 1;
+  for (std::size_t head = 0; head < queue.size(); ++head) {
+    const std::size_t u = queue[head];
+    if (u == stop) break;
+    const int x = static_cast<int>(u % nx), y = static_cast<int>(u / nx % static_cast<std::size_t>(dims.y())),
+              z = static_cast<int>(u / nxy);
+    for (int dz = z > 0 ? -1 : 0; dz <= (z + 1 < dims.z() ? 1 : 0); ++dz)
+      for (int dy = y > 0 ? -1 : 0; dy <= (y + 1 < dims.y() ? 1 : 0); ++dy)
+        for (int dx = x > 0 ? -1 : 0; dx <= (x + 1 < dims.x() ? 1 : 0); ++dx) {
+          const std::size_t v = cell_index(dims, x + dx, y + dy, z + dz);
+          if (!mask[v] || in[v]) continue;
+          in[v] = 1;
+          queue.push_back(v);
+        }
+  }
+  return in;
+}
+
 bool connects(const std::vector<std::uint8_t>& mask, const Eigen::Vector3i& dims, const Eigen::Vector3i& a,
               const Eigen::Vector3i& b) {
   const std::size_t ia = cell_index(dims, a.x(), a.y(), a.z());
   const std::size_t ib = cell_index(dims, b.x(), b.y(), b.z());
   if (!mask[ia] || !mask[ib]) return false;
-  const std::vector<int> label = label_components(mask, dims);
-  return label[ia] == label[ib];
+  return component_of(mask, dims, ia, ib)[ib] != 0;
 }
 
 std::size_t solid_cells_in(const std::vector<std::uint8_t>& mask, const std::vector<std::uint8_t>& env) {

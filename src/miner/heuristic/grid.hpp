@@ -60,6 +60,12 @@ std::vector<std::uint8_t> encode_state(const world::Box& bounds, const Eigen::Ve
 /// outside the mask, 1.. for components in order of their lowest index.
 std::vector<int> label_components(const std::vector<std::uint8_t>& mask, const Eigen::Vector3i& dims);
 
+/// The 26-connected component of the mask cells that holds `cell`: 1 on its cells, 0 elsewhere
+/// (all 0 if mask[cell] is 0). A breadth-first search that touches only that component, not
+/// the whole grid as label_components does; `stop`, if a valid index, ends it once reached.
+std::vector<std::uint8_t> component_of(const std::vector<std::uint8_t>& mask, const Eigen::Vector3i& dims,
+                                       std::size_t cell, std::size_t stop = SIZE_MAX);
+
 /// Whether the region `mask` is connected between the cells a and b (see the file comment).
 bool connects(const std::vector<std::uint8_t>& mask, const Eigen::Vector3i& dims, const Eigen::Vector3i& a,
               const Eigen::Vector3i& b);

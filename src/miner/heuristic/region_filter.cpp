@@ -55,15 +55,17 @@ FilteredRegion filter_region(const std::vector<float>& p, const std::vector<std:
   const std::size_t ig = cell_index(dims, goal_cell.x(), goal_cell.y(), goal_cell.z());
   for (std::size_t i : {is, ig})
     if (env[i] != kSolid) mask[i] = 1;
-  // 3. islands
-  std::vector<int> label = label_components(mask, dims);
+  // 3. islands: only the components of start and goal stay.
+  const std::vector<std::uint8_t> from_start = component_of(mask, dims, is);
+  const bool joined_now = from_start[ig] != 0;
+  const std::vector<std::uint8_t> from_goal = joined_now ? from_start : component_of(mask, dims, ig);
   for (std::size_t i = 0; i < n; ++i)
-    if (mask[i] && label[i] != label[is] && label[i] != label[ig]) {
+    if (mask[i] && !from_start[i] && !from_goal[i]) {
       mask[i] = 0;
       ++r.island_dropped;
     }
   // Connected now iff start and goal share a component; the bridge below joins them.
-  bool joined = mask[is] && mask[ig] && label[is] == label[ig];
+  bool joined = mask[is] && mask[ig] && joined_now;
   // 4. bridge: Dijkstra over non-solid cells from the start's component to the goal's.
   if (mask[is] && mask[ig] && !joined) {
     const double inf = std::numeric_limits<double>::infinity();
@@ -72,7 +74,7 @@ FilteredRegion filter_region(const std::vector<float>& p, const std::vector<std:
     using Item = std::pair<double, std::size_t>;
     std::priority_queue<Item, std::vector<Item>, std::greater<>> open;
     for (std::size_t i = 0; i < n; ++i)
-      if (mask[i] && label[i] == label[is]) {
+      if (from_start[i]) {
         dist[i] = 0.0;
         open.emplace(0.0, i);
       }
@@ -81,7 +83,7 @@ FilteredRegion filter_region(const std::vector<float>& p, const std::vector<std:
       const auto [d, u] = open.top();
       open.pop();
       if (d > dist[u]) continue;
-      if (mask[u] && label[u] == label[ig]) {
+      if (from_goal[u]) {
         reached = u;
         break;
       }

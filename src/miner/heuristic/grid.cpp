@@ -1,6 +1,7 @@
 #include "miner/heuristic/grid.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <deque>
 
@@ -158,19 +159,32 @@ std::vector<std::uint8_t> component_of(const std::vector<std::uint8_t>& mask, co
   const auto nx = static_cast<std::size_t>(dims.x()), nxy = nx * static_cast<std::size_t>(dims.y());
   std::vector<std::size_t> queue{cell};
   in[cell] = 1;
+  // Index offsets of the 26 neighbours, for cells off the grid's border (no bounds tests).
+  std::array<std::ptrdiff_t, 26> offsets{};
+  std::size_t k = 0;
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx)
+        if (dx || dy || dz)
+          offsets[k++] = (static_cast<std::ptrdiff_t>(dz) * dims.y() + dy) * dims.x() + dx;
+  auto visit = [&](std::size_t v) {
+    if (!mask[v] || in[v]) return;
+    in[v] = 1;
+    queue.push_back(v);
+  };
   for (std::size_t head = 0; head < queue.size(); ++head) {
     const std::size_t u = queue[head];
     if (u == stop) break;
     const int x = static_cast<int>(u % nx), y = static_cast<int>(u / nx % static_cast<std::size_t>(dims.y())),
               z = static_cast<int>(u / nxy);
+    if (x > 0 && y > 0 && z > 0 && x + 1 < dims.x() && y + 1 < dims.y() && z + 1 < dims.z()) {
+      for (const std::ptrdiff_t o : offsets) visit(static_cast<std::size_t>(static_cast<std::ptrdiff_t>(u) + o));
+      continue;
+    }
     for (int dz = z > 0 ? -1 : 0; dz <= (z + 1 < dims.z() ? 1 : 0); ++dz)
       for (int dy = y > 0 ? -1 : 0; dy <= (y + 1 < dims.y() ? 1 : 0); ++dy)
-        for (int dx = x > 0 ? -1 : 0; dx <= (x + 1 < dims.x() ? 1 : 0); ++dx) {
-          const std::size_t v = cell_index(dims, x + dx, y + dy, z + dz);
-          if (!mask[v] || in[v]) continue;
-          in[v] = 1;
-          queue.push_back(v);
-        }
+        for (int dx = x > 0 ? -1 : 0; dx <= (x + 1 < dims.x() ? 1 : 0); ++dx)
+          if (dx || dy || dz) visit(cell_index(dims, x + dx, y + dy, z + dz));
   }
   return in;
 }

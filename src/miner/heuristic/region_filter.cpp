@@ -43,21 +43,25 @@ FilteredRegion filter_region(const std::vector<float>& p, const std::vector<std:
   std::vector<std::uint8_t> mask(n, 0);
   for (std::size_t i = 0; i < n; ++i) mask[i] = p[i] >= threshold ? 1 : 0;
   r.raw_cells = static_cast<std::size_t>(std::count(mask.begin(), mask.end(), 1));
-  r.raw_connected = connects(mask, dims, start_cell, goal_cell);
   r.raw_safe = solid_cells_in(mask, env) == 0;
+  const std::size_t is = cell_index(dims, start_cell.x(), start_cell.y(), start_cell.z());
+  const std::size_t ig = cell_index(dims, goal_cell.x(), goal_cell.y(), goal_cell.z());
+  // Steps 2-3 usually change nothing (a safe raw region holding start and goal); then the raw
+  // connectivity is read off step 3's search instead of a search of its own.
+  const bool raw_kept = r.raw_safe && mask[is] && mask[ig];
+  if (!raw_kept) r.raw_connected = connects(mask, dims, start_cell, goal_cell);
   // 2. safety
   for (std::size_t i = 0; i < n; ++i)
     if (mask[i] && env[i] == kSolid) {
       mask[i] = 0;
       ++r.solid_dropped;
     }
-  const std::size_t is = cell_index(dims, start_cell.x(), start_cell.y(), start_cell.z());
-  const std::size_t ig = cell_index(dims, goal_cell.x(), goal_cell.y(), goal_cell.z());
   for (std::size_t i : {is, ig})
     if (env[i] != kSolid) mask[i] = 1;
   // 3. islands: only the components of start and goal stay.
   const std::vector<std::uint8_t> from_start = component_of(mask, dims, is);
   const bool joined_now = from_start[ig] != 0;
+  if (raw_kept) r.raw_connected = joined_now;
   const std::vector<std::uint8_t> from_goal = joined_now ? from_start : component_of(mask, dims, ig);
   for (std::size_t i = 0; i < n; ++i)
     if (mask[i] && !from_start[i] && !from_goal[i]) {

@@ -158,6 +158,12 @@ FrontendBenchResult run_frontend_bench(const world::Map& map, const std::string&
   ProgressBar bar(progress, "frontend " + map_name,
                   out.options.planners.size() * static_cast<std::size_t>(options.runs));
   std::size_t done = 0;
+  struct Entry {
+    std::string name;
+    bool ompl = false, sgan_planner = false;
+    plan::PlannerKind kind = plan::PlannerKind::kRrtStar;
+  };
+  std::vector<Entry> entries;
   for (const std::string& name : out.options.planners) {
     const bool ompl = is_ompl_planner(name);
     if (ompl) {
@@ -176,19 +182,28 @@ FrontendBenchResult run_frontend_bench(const world::Map& map, const std::string&
       // once at start-up on board.
       heuristic::query_region(*sgan, map, start, goal, robot_radius, options.seed);
     }
-    for (int run = 0; run < options.runs; ++run) {
-      if (run % options.shard_count != options.shard_index) continue;
+    entries.push_back({name, ompl, sgan_planner, kind});
+  }
+  // Interleaved: run k of every planner before run k + 1 of any, so every planner's times are
+  // sampled over the same stretch of the campaign and a slow spell of a shared machine falls
+  // on all of them alike (planner after planner, it fell on whichever ran then: BIT*'s median
+  // on sim-3 moved between 3.6 and 5.3 ms from one campaign to the next).
+  std::vector<std::vector<RunRecord>> records(entries.size());
+  for (int run = 0; run < options.runs; ++run) {
+    if (run % options.shard_count != options.shard_index) continue;
+    for (std::size_t i = 0; i < entries.size(); ++i) {
+      const Entry& e = entries[i];
       RunRecord record;
-      record.planner = name;
+      record.planner = e.name;
       record.run = run;
-      if (ompl) {
-        record.result = run_ompl(problem, ompl_options(name));
+      if (e.ompl) {
+        record.result = run_ompl(problem, ompl_options(e.name));
       } else {
         plan::PlannerOptions po = base;
-        po.planner = kind;
+        po.planner = e.kind;
         po.seed = options.seed;
         po.stream = static_cast<std::uint64_t>(run);  // common random numbers across planners
-        if (sgan_planner) {
+        if (e.sgan_planner) {
           // End to end: encoding, inference and filtering count in every time (Alg. 1 lines 2-3).
           const Clock::time_point t0 = Clock::now();
           const heuristic::HeuristicQuery q =
@@ -197,13 +212,16 @@ FrontendBenchResult run_frontend_bench(const world::Map& map, const std::string&
           record.result = plan::plan(problem, po, &q.region);
           plan::add_setup_time(record.result, region_ms);
         } else {
-          record.result = plan::plan(problem, po, kind == plan::PlannerKind::kMiner ? &region : nullptr);
+          record.result = plan::plan(problem, po, e.kind == plan::PlannerKind::kMiner ? &region : nullptr);
         }
       }
-      out.runs.push_back(std::move(record));
+      records[i].push_back(std::move(record));
       bar.update(++done);
     }
-    out.summaries.push_back(summarise(name, out.runs));
+  }
+  for (std::size_t i = 0; i < entries.size(); ++i) {  // records grouped by planner, as before
+    for (RunRecord& r : records[i]) out.runs.push_back(std::move(r));
+    out.summaries.push_back(summarise(entries[i].name, out.runs));
   }
   bar.finish();
 

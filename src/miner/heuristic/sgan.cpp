@@ -57,15 +57,16 @@ struct Activation {
 /// or, with `up`, from half of it (nearest-neighbour upsampling by 2, as
 /// torch.nn.functional.interpolate(scale_factor=2, mode="nearest")). kChannels = src.channels
 /// when known at compile time (a fixed-size copy the compiler turns into vector moves), else 0.
+/// dst may be a slab of planes of the full grid, starting at plane z0.
 template <std::size_t kChannels>
-void copy_into(Activation& dst, const Activation& src, bool up, std::size_t offset) {
+void copy_into(Activation& dst, const Activation& src, bool up, std::size_t offset, int z0) {
   const std::size_t sc = kChannels ? kChannels : static_cast<std::size_t>(src.channels);
   const Eigen::Vector3i d = dst.dims;
   const auto dc = static_cast<std::size_t>(dst.channels);
   const auto sx = static_cast<std::size_t>(src.dims.x()), sy = static_cast<std::size_t>(src.dims.y());
   float* out = dst.data.data() + offset;
   const float* in = src.data.data();
-  for (int z = 0; z < d.z(); ++z)
+  for (int z = z0; z < z0 + d.z(); ++z)
     for (int y = 0; y < d.y(); ++y) {
       const std::size_t row = up ? (static_cast<std::size_t>(z / 2) * sy + static_cast<std::size_t>(y / 2)) * sx
                                  : (static_cast<std::size_t>(z) * sy + static_cast<std::size_t>(y)) * sx;
@@ -77,16 +78,16 @@ void copy_into(Activation& dst, const Activation& src, bool up, std::size_t offs
 }
 
 /// dst <- [srcs...] along channels; every source is at dst's resolution or, with `upsample`
-/// set for it, at half of it (see copy_into).
-void concat(Activation& dst, const std::vector<std::pair<const Activation*, bool>>& srcs) {
+/// set for it, at half of it (see copy_into); dst holds the planes from z0 on.
+void concat(Activation& dst, const std::vector<std::pair<const Activation*, bool>>& srcs, int z0 = 0) {
   std::size_t offset = 0;  // channel offset of the current source in dst
   for (const auto& [src, up] : srcs) {
     switch (src->channels) {  // the widths of the shipped width-8 network
-      case 2: copy_into<2>(dst, *src, up, offset); break;
-      case 8: copy_into<8>(dst, *src, up, offset); break;
-      case 16: copy_into<16>(dst, *src, up, offset); break;
-      case 32: copy_into<32>(dst, *src, up, offset); break;
-      default: copy_into<0>(dst, *src, up, offset);
+      case 2: copy_into<2>(dst, *src, up, offset, z0); break;
+      case 8: copy_into<8>(dst, *src, up, offset, z0); break;
+      case 16: copy_into<16>(dst, *src, up, offset, z0); break;
+      case 32: copy_into<32>(dst, *src, up, offset, z0); break;
+      default: copy_into<0>(dst, *src, up, offset, z0);
     }
     offset += static_cast<std::size_t>(src->channels);
   }
@@ -135,7 +136,9 @@ struct Sgan::Impl {
   dnnl::engine engine{dnnl::engine::kind::cpu, 0};
   // Buffers, in graph order (model.py's names; cat* are the concatenated conv inputs).
   Activation x0, cond1, a1, c2, a2, cat2, c4, a3, cat3, c8, a4, cat4, m1, m2, catd3, d3, catd2, d2, catd1, out;
-  Activation taps;                      // the last layer's 27 tap products per voxel (+5 zero channels)
+  // The last layer streams plane by plane (catd1 is one plane of its input, taps a ring of three
+  // planes of its tap products), so its 7.6 MB of full-grid buffers stay out of the caches.
+  Activation taps;                      // 27 tap products per voxel (+5 zero channels), 3 planes
   std::vector<float> last_tap_weights;  // [kTapChannels][cin], oidhw of the 1x1x1 tap convolution
   float last_bias = 0.0f;
   dnnl::eltwise_forward sigmoid;        // R = sigmoid(logits), in place on out
@@ -167,9 +170,11 @@ struct Sgan::Impl {
   /// The generator on the input set by set_input: R, one probability per voxel.
   std::vector<float> run();
 
-  /// out[v] = bias + sum over taps t = (dz, dy, dx) of taps[v + (dz-1, dy-1, dx-1)][t] (the logits),
-  /// skipping taps outside the grid (zero padding): the 3x3x3 last layer, finished.
-  void shift_sum();
+  /// Plane z of the logits: out[v] = bias + sum over taps t = (dz, dy, dx) of
+  /// Y_{z+dz}[v + (dy-1, dx-1)][t], with Y_{z-1}, Y_z, Y_{z+1} the tap products of the planes
+  /// around z (nullptr off the grid), skipping taps outside the grid (zero padding): the 3x3x3
+  /// last layer, finished.
+  void shift_sum_plane(int z, const std::array<const float*, 3>& planes);
 
   /// enc1 (3 input channels) as described at planar_input; false if oneDNN has no optimised
   /// kernel for it here, and then nothing is changed.
@@ -214,7 +219,7 @@ void Sgan::Impl::build(const TensorFile& f) {
   d3 = Activation(2 * w, n4);
   catd2 = Activation(2 * w + 2 * w + 2, n2);
   d2 = Activation(2 * w, n2);
-  catd1 = Activation(2 * w + w + 2, n1);
+  catd1 = Activation(2 * w + w + 2, Eigen::Vector3i(n1.x(), n1.y(), 1));
   out = Activation(1, n1);
   io = {{{&x0, &a1}, {&a1, &a2}, {&cat2, &a3}, {&cat3, &a4}, {&cat4, &m1}, {&m1, &m2}, {&catd3, &d3},
          {&catd2, &d2}, {&catd1, &out}}};
@@ -234,12 +239,13 @@ void Sgan::Impl::build(const TensorFile& f) {
     if (last) {
       // A single output channel keeps oneDNN's kernels ~5 % busy; instead a 1x1x1
       // convolution computes, per voxel u, the 27 tap products Y[u][t] = sum_c W[0][c][t]
-      // in[u][c] (a GEMM), and shift_sum() adds Y[v + offset_t][t] over the taps.
-      taps = Activation(kTapChannels, n1);
+      // in[u][c] (a GEMM), and shift_sum_plane() adds Y[v + offset_t][t] over the taps.
+      taps = Activation(kTapChannels, Eigen::Vector3i(n1.x(), n1.y(), 3));
+      const memory::desc taps_plane({1, kTapChannels, 1, n1.y(), n1.x()}, Type::f32, Tag::ndhwc);
       const dnnl::convolution_forward::primitive_desc pd(
           dnnl::convolution_forward::desc(dnnl::prop_kind::forward_inference, dnnl::algorithm::convolution_direct,
                                           src.desc(), memory::desc({kTapChannels, cin, 1, 1, 1}, Type::f32, Tag::any),
-                                          taps.desc(), {1, 1, 1}, {0, 0, 0}, {0, 0, 0}),
+                                          taps_plane, {1, 1, 1}, {0, 0, 0}, {0, 0, 0}),
           engine);
       c.primitive = dnnl::convolution_forward(pd);
       std::vector<float> tap_weights(static_cast<std::size_t>(kTapChannels * cin), 0.0f);
@@ -252,7 +258,7 @@ void Sgan::Impl::build(const TensorFile& f) {
       dnnl::reorder(user, c.weights).execute(stream, user, c.weights);
       last_bias = bt.values[0];
       c.src = memory(src.desc(), engine, src.data.data());
-      c.dst = memory(taps.desc(), engine, taps.data.data());
+      c.dst = memory(taps_plane, engine, taps.data.data());  // moved along the ring in run()
       out_memory = memory(out.desc(), engine, out.data.data());
       sigmoid = dnnl::eltwise_forward(dnnl::eltwise_forward::primitive_desc(
           dnnl::eltwise_forward::desc(dnnl::prop_kind::forward_inference, dnnl::algorithm::eltwise_logistic,
@@ -322,26 +328,26 @@ bool Sgan::Impl::build_planar_first_layer(const memory::desc& weights_user, cons
   return true;
 }
 
-void Sgan::Impl::shift_sum() {
+void Sgan::Impl::shift_sum_plane(int z, const std::array<const float*, 3>& planes) {
   const Eigen::Vector3i d = out.dims;
   constexpr std::ptrdiff_t C = kTapChannels;  // a constant: fixed-stride loads below
-  const std::ptrdiff_t sy = C * d.x(), sz = sy * d.y();
-  // Where tap t = (dz+1) 9 + (dy+1) 3 + (dx+1) of voxel v lies, relative to v's row of taps.
-  std::array<std::ptrdiff_t, 27> offset{};
-  for (int t = 0; t < 27; ++t) offset[static_cast<std::size_t>(t)] = (t / 9 - 1) * sz + (t / 3 % 3 - 1) * sy + (t % 3 - 1) * C + t;
-  const float* y = taps.data.data();
-  float* o = out.data.data();
+  const std::ptrdiff_t sy = C * d.x();
+  // Where tap t = (dz+1) 9 + (dy+1) 3 + (dx+1) of voxel v lies: tap[t][v C].
+  std::array<const float*, 27> tap{};
+  for (int t = 0; t < 27; ++t)
+    if (planes[static_cast<std::size_t>(t / 9)])
+      tap[static_cast<std::size_t>(t)] = planes[static_cast<std::size_t>(t / 9)] + (t / 3 % 3 - 1) * sy + (t % 3 - 1) * C + t;
+  float* o = out.data.data() + static_cast<std::ptrdiff_t>(z) * d.x() * d.y();
   // Border voxels: taps outside the grid are skipped; the sum runs in tap order as below.
-  auto border = [&](int x, int yy, int z) {
-    const std::size_t v = cell_index(d, x, yy, z);
-    const float* row = y + static_cast<std::ptrdiff_t>(v) * C;
+  auto border = [&](int x, int yy) {
+    const std::ptrdiff_t v = static_cast<std::ptrdiff_t>(yy) * d.x() + x;
     float sum = last_bias;
     for (int dz = -1; dz <= 1; ++dz) {
-      if (z + dz < 0 || z + dz >= d.z()) continue;
+      if (!planes[static_cast<std::size_t>(dz + 1)]) continue;
       for (int dy = -1; dy <= 1; ++dy) {
         if (yy + dy < 0 || yy + dy >= d.y()) continue;
         for (int dx = -1; dx <= 1; ++dx)
-          if (x + dx >= 0 && x + dx < d.x()) sum += row[offset[static_cast<std::size_t>((dz + 1) * 9 + (dy + 1) * 3 + dx + 1)]];
+          if (x + dx >= 0 && x + dx < d.x()) sum += tap[static_cast<std::size_t>((dz + 1) * 9 + (dy + 1) * 3 + dx + 1)][v * C];
       }
     }
     o[v] = sum;
@@ -349,32 +355,30 @@ void Sgan::Impl::shift_sum() {
   // Interior voxels, kChains at a time: independent sums hide the add latency (one voxel's 27
   // adds form a dependent chain); each voxel still adds its taps in tap order.
   constexpr int kChains = 4;  // 0.15 ms for the 32^3 grid here, vs 0.25 ms one voxel at a time
-  for (int z = 0; z < d.z(); ++z)
-    for (int yy = 0; yy < d.y(); ++yy) {
-      if (z == 0 || z + 1 == d.z() || yy == 0 || yy + 1 == d.y() || d.x() < 3) {
-        for (int x = 0; x < d.x(); ++x) border(x, yy, z);
-        continue;
-      }
-      border(0, yy, z);
-      int x = 1;
-      for (; x + kChains < d.x(); x += kChains) {
-        const std::size_t v = cell_index(d, x, yy, z);
-        const float* row = y + static_cast<std::ptrdiff_t>(v) * C;
-        std::array<float, kChains> acc;
-        acc.fill(last_bias);
-        for (std::size_t t = 0; t < 27; ++t)
-          for (int j = 0; j < kChains; ++j) acc[static_cast<std::size_t>(j)] += row[j * C + offset[t]];
-        std::copy(acc.begin(), acc.end(), o + v);
-      }
-      for (; x + 1 < d.x(); ++x) {
-        const std::size_t v = cell_index(d, x, yy, z);
-        const float* row = y + static_cast<std::ptrdiff_t>(v) * C;
-        float sum = last_bias;
-        for (std::size_t t = 0; t < 27; ++t) sum += row[offset[t]];
-        o[v] = sum;
-      }
-      border(d.x() - 1, yy, z);
+  const bool inner_plane = planes[0] && planes[2];
+  for (int yy = 0; yy < d.y(); ++yy) {
+    if (!inner_plane || yy == 0 || yy + 1 == d.y() || d.x() < 3) {
+      for (int x = 0; x < d.x(); ++x) border(x, yy);
+      continue;
     }
+    border(0, yy);
+    int x = 1;
+    for (; x + kChains < d.x(); x += kChains) {
+      const std::ptrdiff_t v = static_cast<std::ptrdiff_t>(yy) * d.x() + x;
+      std::array<float, kChains> acc;
+      acc.fill(last_bias);
+      for (std::size_t t = 0; t < 27; ++t)
+        for (int j = 0; j < kChains; ++j) acc[static_cast<std::size_t>(j)] += tap[t][(v + j) * C];
+      std::copy(acc.begin(), acc.end(), o + v);
+    }
+    for (; x + 1 < d.x(); ++x) {
+      const std::ptrdiff_t v = static_cast<std::ptrdiff_t>(yy) * d.x() + x;
+      float sum = last_bias;
+      for (std::size_t t = 0; t < 27; ++t) sum += tap[t][v * C];
+      o[v] = sum;
+    }
+    border(d.x() - 1, yy);
+  }
 }
 
 Sgan::Sgan(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -450,9 +454,18 @@ std::vector<float> Sgan::Impl::run() {
   run(6);  // d3
   concat(g.catd2, {{&g.d3, true}, {&g.cat2, false}});
   run(7);  // d2
-  concat(g.catd1, {{&g.d2, true}, {&g.a1, false}, {&g.cond1, false}});
-  run(8);  // tap products of the last layer
-  g.shift_sum();  // logits
+  // The last layer, plane by plane: the tap products of plane p go to ring slot p % 3, and
+  // plane p - 1 of the logits is finished once planes p - 2, p - 1 and p are there.
+  const int nz = g.out.dims.z();
+  const std::size_t plane = g.taps.voxels() / 3 * static_cast<std::size_t>(kTapChannels);
+  const auto slot = [&](int p) -> float* { return g.taps.data.data() + static_cast<std::size_t>(p % 3) * plane; };
+  for (int p = 0; p < nz; ++p) {
+    concat(g.catd1, {{&g.d2, true}, {&g.a1, false}, {&g.cond1, false}}, p);
+    g.conv[8].dst.set_data_handle(slot(p));
+    run(8);  // tap products of plane p
+    if (p >= 1) g.shift_sum_plane(p - 1, {p >= 2 ? slot(p - 2) : nullptr, slot(p - 1), slot(p)});
+  }
+  g.shift_sum_plane(nz - 1, {slot(nz - 2), slot(nz - 1), nullptr});  // logits
   g.sigmoid.execute(stream, {{DNNL_ARG_SRC, g.out_memory}, {DNNL_ARG_DST, g.out_memory}});
   stream.wait();  // R
   return g.out.data;

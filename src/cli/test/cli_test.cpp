@@ -478,7 +478,7 @@ TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[RE
   for (const char* bad : {"3/3", "-1/2", "1", "a/b", "1/2x"}) CHECK(miner_cli(with({"--shard", bad})).code == 1);
 
   // Datasets: the merged parts are byte-identical to the unsharded folder.
-  const std::vector<std::string> gen{"dataset", "--count", "4", "--test-count", "2", "--shard-size", "1", "--seed", "5"};
+  const std::vector<std::string> gen{"dataset", "--count", "4", "--test-count", "2", "--shard-size", "1", "--seed", "5", "--preset", "indoor"};
   const auto dataset = [&](std::vector<std::string> extra) {
     std::vector<std::string> args = gen;
     args.insert(args.end(), extra.begin(), extra.end());

@@ -181,10 +181,10 @@ struct Sgan::Impl {
   bool build_planar_first_layer(const memory::desc& weights_user, const float* weights, const float* bias,
                                 dnnl::stream& stream);
 
-  void build(const TensorFile& f);
+  void build(const TensorFile& f, Sgan::FirstLayer first_layer);
 };
 
-void Sgan::Impl::build(const TensorFile& f) {
+void Sgan::Impl::build(const TensorFile& f, Sgan::FirstLayer first_layer) {
   const JsonField a(f.meta, "meta", f.path);
   const JsonField ar = a.at("architecture");
   if (ar.at("name").string() != "sgan-unet4") ar.at("name").fail("unknown architecture (expected sgan-unet4)");
@@ -267,7 +267,7 @@ void Sgan::Impl::build(const TensorFile& f) {
       continue;
     }
     const memory::dims wdims = {cout, cin, 3, 3, 3};
-    if (l == 0 && build_planar_first_layer(memory::desc(wdims, Type::f32, Tag::oidhw), wt.values.data(),
+    if (l == 0 && first_layer == Sgan::FirstLayer::kFastest && build_planar_first_layer(memory::desc(wdims, Type::f32, Tag::oidhw), wt.values.data(),
                                            bt.values.data(), stream))
       continue;
     const memory::desc wany(wdims, Type::f32, Tag::any);
@@ -386,14 +386,14 @@ Sgan::~Sgan() = default;
 Sgan::Sgan(Sgan&&) noexcept = default;
 Sgan& Sgan::operator=(Sgan&&) noexcept = default;
 
-Sgan Sgan::from_bytes(const std::string& blob, const std::string& origin) {
+Sgan Sgan::from_bytes(const std::string& blob, const std::string& origin, FirstLayer first_layer) {
   const TensorFile f = parse_tensor_file(blob, origin, "sgan-weights");
   auto impl = std::make_unique<Impl>();
   impl->path = origin;
   impl->meta = f.meta;
   try {
     const OneOpenMpThread one_thread;  // the primitives keep the thread count they are made with
-    impl->build(f);
+    impl->build(f, first_layer);
   } catch (const dnnl::error& e) {
     throw Error(origin + ": oneDNN refused the network (" + e.what() + ")");
   }
@@ -412,6 +412,7 @@ Sgan Sgan::builtin() {
 const SganArchitecture& Sgan::architecture() const { return impl_->arch; }
 const Json& Sgan::meta() const { return impl_->meta; }
 const std::string& Sgan::path() const { return impl_->path; }
+bool Sgan::planar_first_layer() const { return impl_->planar_input; }
 
 std::vector<float> Sgan::forward(const std::vector<float>& env, const std::vector<float>& state,
                                  const std::vector<float>& noise) const {

@@ -40,10 +40,17 @@ struct SganArchitecture {
 
 class Sgan {
  public:
+  /// How the first layer (3 input channels) runs: kFastest takes a planar input and oneDNN's
+  /// blocked-output kernel where this CPU has an optimised one (else channels-last, as every
+  /// other layer); kChannelsLast always the latter (what a CPU without the planar kernel runs;
+  /// the tests compare the two).
+  enum class FirstLayer { kFastest, kChannelsLast };
+
   /// Loads and checks the weights file; builds the oneDNN primitives for one query.
   static Sgan load(const std::string& path);
   /// The same from the file's bytes (`origin` names them in messages).
-  static Sgan from_bytes(const std::string& blob, const std::string& origin);
+  static Sgan from_bytes(const std::string& blob, const std::string& origin,
+                         FirstLayer first_layer = FirstLayer::kFastest);
   /// The weights shipped in fixtures/sgan/sgan.bin, compiled into the library (nothing is
   /// read or downloaded at run time).
   static Sgan builtin();
@@ -57,6 +64,8 @@ class Sgan {
   /// The file's "meta" object (architecture, training command, seeds, metrics).
   const Json& meta() const;
   const std::string& path() const;
+  /// Whether the first layer runs on the planar input (see FirstLayer).
+  bool planar_first_layer() const;
 
   /// R = G(N | E, S) on the grid: three inputs of dims.prod() floats (x fastest) — the
   /// One query at a time per object (the buffers are reused). Inputs: the

@@ -29,7 +29,6 @@ using Clock = std::chrono::steady_clock;
 /// See unseen_heuristic_seed() (paper_bench.hpp).
 constexpr std::uint64_t kUnseenSalt = 0x9E3779B97F4A7C15ull;
 
-
 /// The paper's Table I (sim maps 1-3): initial iteration, nodes, cost, time (ms),
 /// optimal iteration, nodes, time (ms).
 struct PaperFrontRow {

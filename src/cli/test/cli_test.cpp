@@ -3,6 +3,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <sstream>
 
 #include <unistd.h>
@@ -46,7 +47,7 @@ std::string write(const std::string& name, const std::string& text) {
 }
 
 std::string read(const std::string& path) {
-  std::ifstream in(path);
+  std::ifstream in(path, std::ios::binary);
   std::stringstream ss;
   ss << in.rdbuf();
   return ss.str();
@@ -614,15 +615,16 @@ TEST_CASE("Training is deterministic for a seed and exports weights C++ loads an
                             data + " --epochs 1 --batch 4 --width 4 --threads 1 --seed 3";
   REQUIRE(std::system((train + " --out " + dir() + "/train-a > /dev/null").c_str()) == 0);
   REQUIRE(std::system((train + " --out " + dir() + "/train-b > /dev/null").c_str()) == 0);
-  for (const char* f : {"/sgan.bin", "/reference.bin", "/metrics.json"}) {
-    std::ifstream a(dir() + "/train-a" + f, std::ios::binary), b(dir() + "/train-b" + f, std::ios::binary);
-    std::stringstream sa, sb;
-    sa << a.rdbuf();
-    sb << b.rdbuf();
-    INFO(f);
-    CHECK(sa.str().size() > 10);
-    CHECK(sa.str() == sb.str());
-  }
+  // Each named file of run a has the same bytes as run b's, and is not empty.
+  const auto same_bytes = [](const std::string& a, const std::string& b, std::initializer_list<const char*> files) {
+    for (const char* f : files) {
+      INFO(f);
+      const std::string bytes = read(dir() + a + f);
+      CHECK(bytes.size() > 10);
+      CHECK(bytes == read(dir() + b + f));
+    }
+  };
+  same_bytes("/train-a", "/train-b", {"/sgan.bin", "/reference.bin", "/metrics.json"});
   const Run check = miner_cli({"sgan", "check", "--weights", dir() + "/train-a/sgan.bin", "--reference",
                                dir() + "/train-a/reference.bin"});
   INFO(check.err);
@@ -641,15 +643,7 @@ TEST_CASE("Training is deterministic for a seed and exports weights C++ loads an
                        "/train-e > /dev/null")
                           .c_str()) == 0);
   REQUIRE(std::system((train + " --epochs 2 --out " + dir() + "/train-f > /dev/null").c_str()) == 0);
-  for (const char* f : {"/sgan.bin", "/metrics.json"}) {
-    std::ifstream a(dir() + "/train-e" + f, std::ios::binary), b(dir() + "/train-f" + f, std::ios::binary);
-    std::stringstream sa, sb;
-    sa << a.rdbuf();
-    sb << b.rdbuf();
-    INFO(f);
-    CHECK(sa.str().size() > 10);
-    CHECK(sa.str() == sb.str());
-  }
+  same_bytes("/train-e", "/train-f", {"/sgan.bin", "/metrics.json"});
   // A checkpoint from other options, and a CUDA device PyTorch does not see, are refused.
   CHECK(std::system((train + " --resume " + dir() + "/train-e.ckpt --alpha4 7 --out " + dir() + "/train-g 2> /dev/null")
                         .c_str()) != 0);

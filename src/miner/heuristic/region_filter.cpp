@@ -60,16 +60,15 @@ FilteredRegion filter_region(const std::vector<float>& p, const std::vector<std:
     if (env[i] != kSolid) mask[i] = 1;
   // 3. islands: only the components of start and goal stay.
   const std::vector<std::uint8_t> from_start = component_of(mask, dims, is);
-  const bool joined_now = from_start[ig] != 0;
-  if (raw_kept) r.raw_connected = joined_now;
-  const std::vector<std::uint8_t> from_goal = joined_now ? from_start : component_of(mask, dims, ig);
+  // Connected now iff the goal is in the start's component; the bridge below joins them.
+  bool joined = from_start[ig] != 0;
+  if (raw_kept) r.raw_connected = joined;
+  const std::vector<std::uint8_t> from_goal = joined ? from_start : component_of(mask, dims, ig);
   for (std::size_t i = 0; i < n; ++i)
     if (mask[i] && !from_start[i] && !from_goal[i]) {
       mask[i] = 0;
       ++r.island_dropped;
     }
-  // Connected now iff start and goal share a component; the bridge below joins them.
-  bool joined = mask[is] && mask[ig] && joined_now;
   // 4. bridge: Dijkstra over non-solid cells from the start's component to the goal's.
   if (mask[is] && mask[ig] && !joined) {
     const double inf = std::numeric_limits<double>::infinity();

@@ -120,6 +120,35 @@ struct Conv {
   memory weights, bias, src, dst;  // src and dst wrap the Activation buffers
 };
 
+/// A 3x3x3 convolution (padding 1) with fused ReLU from src to dst, weights in the layout
+/// oneDNN picks for the kernel it chooses.
+dnnl::convolution_forward::primitive_desc relu_conv(const dnnl::engine& engine, const memory::desc& src,
+                                                    const memory::desc& dst, int stride) {
+  const memory::dim cin = src.dims()[1], cout = dst.dims()[1];
+  const dnnl::convolution_forward::desc cd(
+      dnnl::prop_kind::forward_inference, dnnl::algorithm::convolution_direct, src,
+      memory::desc({cout, cin, 3, 3, 3}, Type::f32, Tag::any), memory::desc({cout}, Type::f32, Tag::a), dst,
+      {stride, stride, stride}, {1, 1, 1}, {1, 1, 1});
+  dnnl::post_ops po;
+  po.append_eltwise(1.0f, dnnl::algorithm::eltwise_relu, 0.0f, 0.0f);
+  dnnl::primitive_attr attr;
+  attr.set_post_ops(po);
+  return {cd, attr, engine};
+}
+
+/// c's primitive, weights (PyTorch's oidhw reordered to pd's layout) and bias; src and dst
+/// are the caller's.
+void set_conv(Conv& c, const dnnl::convolution_forward::primitive_desc& pd, const dnnl::engine& engine,
+              dnnl::stream& stream, const Tensor& weights, const Tensor& bias) {
+  c.primitive = dnnl::convolution_forward(pd);
+  memory user(memory::desc(pd.weights_desc().dims(), Type::f32, Tag::oidhw), engine,
+              const_cast<float*>(weights.values.data()));
+  c.weights = memory(pd.weights_desc(), engine);
+  dnnl::reorder(user, c.weights).execute(stream, user, c.weights);
+  c.bias = memory(pd.bias_desc(), engine);
+  std::copy(bias.values.begin(), bias.values.end(), static_cast<float*>(c.bias.get_data_handle()));
+}
+
 constexpr std::size_t kConvs = 9;
 /// The last layer's tap products per voxel: 27, padded to 32 channels (zero filters) so each
 /// voxel's row is 128 bytes and oneDNN's 1x1 kernel takes whole vector blocks (0.28 vs 0.34 ms).
@@ -178,8 +207,7 @@ struct Sgan::Impl {
 
   /// enc1 (3 input channels) as described at planar_input; false if oneDNN has no optimised
   /// kernel for it here, and then nothing is changed.
-  bool build_planar_first_layer(const memory::desc& weights_user, const float* weights, const float* bias,
-                                dnnl::stream& stream);
+  bool build_planar_first_layer(const Tensor& weights, const Tensor& bias, dnnl::stream& stream);
 
   void build(const TensorFile& f, Sgan::FirstLayer first_layer);
 };
@@ -266,26 +294,8 @@ void Sgan::Impl::build(const TensorFile& f, Sgan::FirstLayer first_layer) {
           engine));
       continue;
     }
-    const memory::dims wdims = {cout, cin, 3, 3, 3};
-    if (l == 0 && first_layer == Sgan::FirstLayer::kFastest && build_planar_first_layer(memory::desc(wdims, Type::f32, Tag::oidhw), wt.values.data(),
-                                           bt.values.data(), stream))
-      continue;
-    const memory::desc wany(wdims, Type::f32, Tag::any);
-    const memory::desc bdesc({cout}, Type::f32, Tag::a);
-    const memory::dims s = {kStrides[l], kStrides[l], kStrides[l]};
-    const dnnl::convolution_forward::desc cd(dnnl::prop_kind::forward_inference, dnnl::algorithm::convolution_direct,
-                                             src.desc(), wany, bdesc, dst.desc(), s, {1, 1, 1}, {1, 1, 1});
-    dnnl::post_ops po;
-    po.append_eltwise(1.0f, dnnl::algorithm::eltwise_relu, 0.0f, 0.0f);
-    dnnl::primitive_attr attr;
-    attr.set_post_ops(po);
-    const dnnl::convolution_forward::primitive_desc pd(cd, attr, engine);
-    c.primitive = dnnl::convolution_forward(pd);
-    memory user(memory::desc(wdims, Type::f32, Tag::oidhw), engine, const_cast<float*>(wt.values.data()));
-    c.weights = memory(pd.weights_desc(), engine);
-    dnnl::reorder(user, c.weights).execute(stream, user, c.weights);
-    c.bias = memory(bdesc, engine);
-    std::copy(bt.values.begin(), bt.values.end(), static_cast<float*>(c.bias.get_data_handle()));
+    if (l == 0 && first_layer == Sgan::FirstLayer::kFastest && build_planar_first_layer(wt, bt, stream)) continue;
+    set_conv(c, relu_conv(engine, src.desc(), dst.desc(), kStrides[l]), engine, stream, wt, bt);
     c.src = memory(src.desc(), engine, src.data.data());
     c.dst = memory(dst.desc(), engine, dst.data.data());
   }
@@ -297,28 +307,14 @@ void Sgan::Impl::build(const TensorFile& f, Sgan::FirstLayer first_layer) {
                 std::to_string(2 * kConvs));
 }
 
-bool Sgan::Impl::build_planar_first_layer(const memory::desc& weights_user, const float* weights, const float* bias,
-                                          dnnl::stream& stream) {
+bool Sgan::Impl::build_planar_first_layer(const Tensor& weights, const Tensor& bias, dnnl::stream& stream) {
   const Eigen::Vector3i n = x0.dims;
   const memory::desc src({1, x0.channels, n.z(), n.y(), n.x()}, Type::f32, Tag::ncdhw);
   const memory::desc dst({1, a1.channels, n.z(), n.y(), n.x()}, Type::f32, Tag::any);
-  const memory::desc bdesc({a1.channels}, Type::f32, Tag::a);
-  const dnnl::convolution_forward::desc cd(dnnl::prop_kind::forward_inference, dnnl::algorithm::convolution_direct,
-                                           src, memory::desc(weights_user.dims(), Type::f32, Tag::any), bdesc, dst,
-                                           {1, 1, 1}, {1, 1, 1}, {1, 1, 1});
-  dnnl::post_ops po;
-  po.append_eltwise(1.0f, dnnl::algorithm::eltwise_relu, 0.0f, 0.0f);
-  dnnl::primitive_attr attr;
-  attr.set_post_ops(po);
-  const dnnl::convolution_forward::primitive_desc pd(cd, attr, engine);
+  const dnnl::convolution_forward::primitive_desc pd = relu_conv(engine, src, dst, 1);
   if (std::string(pd.impl_info_str()).rfind("ref", 0) == 0) return false;  // reference kernel: far slower
   Conv& c = conv[0];
-  c.primitive = dnnl::convolution_forward(pd);
-  memory user(weights_user, engine, const_cast<float*>(weights));
-  c.weights = memory(pd.weights_desc(), engine);
-  dnnl::reorder(user, c.weights).execute(stream, user, c.weights);
-  c.bias = memory(bdesc, engine);
-  std::copy(bias, bias + a1.channels, static_cast<float*>(c.bias.get_data_handle()));
+  set_conv(c, pd, engine, stream, weights, bias);
   c.src = memory(src, engine, x0.data.data());
   a1_blocked = memory(pd.dst_desc(), engine);
   a1_memory = memory(a1.desc(), engine, a1.data.data());

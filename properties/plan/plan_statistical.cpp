@@ -171,7 +171,7 @@ TEST_CASE("Shared contract: every planner solves the fixture queries", "[REQ-PLA
   std::vector<std::string> planners;
   for (PlannerKind kind : miner::plan::all_planners()) planners.push_back(miner::plan::planner_name(kind));
   for (const auto& name : miner::bench::ompl_planner_names()) planners.push_back(name);
-  miner::bench::init_ompl(20261122);
+  miner::bench::init_ompl();
   std::vector<miner::world::Map> maps;
   for (const char* name : {"indoor-1.json", "indoor-2.json"}) {
     maps.push_back(miner::world::Map::load(std::string(MINER_SOURCE_DIR) + "/fixtures/maps/" + name));
@@ -193,6 +193,7 @@ TEST_CASE("Shared contract: every planner solves the fixture queries", "[REQ-PLA
           o.max_condition_checks = 20000;
           o.time_limit_s = 1e9;  // the condition-check budget decides
           o.stop_at_first = true;
+          o.seed = miner::bench::ompl_run_seed(20261122, trial);
           r = miner::bench::run_ompl(problem, o);
         } else {
           PlannerOptions o;

@@ -1,6 +1,7 @@
 #include "bench/frontend_bench.hpp"
 
 #include <algorithm>
+#include <map>
 #include <optional>
 #include <chrono>
 #include <cmath>
@@ -141,7 +142,7 @@ FrontendBenchResult run_frontend_bench(const world::Map& map, const std::string&
   out.region_cells = region.cells().size();
 
   std::optional<heuristic::Sgan> sgan;
-  init_ompl(options.seed);
+  init_ompl();
   const auto ompl_options = [&](const std::string& name) {
     OmplRunOptions o;
     o.planner = name;
@@ -197,7 +198,9 @@ FrontendBenchResult run_frontend_bench(const world::Map& map, const std::string&
       record.planner = e.name;
       record.run = run;
       if (e.ompl) {
-        record.result = run_ompl(problem, ompl_options(e.name));
+        OmplRunOptions oo = ompl_options(e.name);
+        oo.seed = ompl_run_seed(options.seed, run);  // this run's seed, whatever ran before
+        record.result = run_ompl(problem, oo);
       } else {
         plan::PlannerOptions po = base;
         po.planner = e.kind;
@@ -241,6 +244,7 @@ FrontendBenchResult run_frontend_bench(const world::Map& map, const std::string&
         OmplRunOptions oo = ompl_options("ompl:RRTstar");
         oo.target_cost.reset();
         oo.max_iterations = options.throughput_iterations;
+        oo.seed = ompl_run_seed(options.seed, run);
         const plan::PlanResult t = run_ompl(problem, oo);
         theirs.push_back(static_cast<double>(t.iterations) / (t.time_ms / 1000.0));
       }
@@ -369,6 +373,21 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts) {
     if (part.at("shard").at("index").get<int>() == 0) {
       merged["throughput"] = part.at("throughput");
       merged["region"] = part.at("region");
+    }
+  }
+  // A record twice (the same planner and run in two parts, or twice in one) would count
+  // one sample as two: refused, naming both places.
+  std::map<std::pair<std::string, int>, std::string> seen;
+  for (std::size_t p = 0; p < parts.size(); ++p) {
+    const auto& records = parts[p].at("run_records");
+    for (std::size_t k = 0; k < records.size(); ++k) {
+      const std::pair<std::string, int> key{records[k].at("planner").get<std::string>(), records[k].at("run").get<int>()};
+      const std::string where = names[p] + " run_records[" + std::to_string(k) + "]";
+      const auto [it, fresh] = seen.emplace(key, where);
+      if (!fresh) {
+        throw Error("merge: " + where + ": planner " + key.first + " run " + std::to_string(key.second) +
+                    " is already in " + it->second + " (a duplicated record)");
+      }
     }
   }
   std::vector<std::string> order;

@@ -8,6 +8,8 @@
 #include "miner/core/stopwatch.hpp"
 #include "miner/world/map.hpp"
 
+#include "miner/core/rng.hpp"
+
 #if MINER_WITH_OMPL
 #include <ompl/base/PlannerData.h>
 #include <ompl/base/ProblemDefinition.h>
@@ -27,6 +29,13 @@
 
 namespace miner::bench {
 
+std::uint32_t ompl_run_seed(std::uint64_t campaign_seed, int run) {
+  // Stream 2^40 + run: far from the project planners' streams (the run number itself).
+  Rng rng(campaign_seed, (std::uint64_t{1} << 40) + static_cast<std::uint64_t>(run));
+  const auto s = static_cast<std::uint32_t>(rng.next_u64() >> 33);  // [0, 2^31)
+  return s == 0 ? 1u : s;
+}
+
 #if MINER_WITH_OMPL
 
 namespace ob = ompl::base;
@@ -35,6 +44,10 @@ namespace og = ompl::geometric;
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+/// Goal threshold of OMPL's GoalState: x_goal itself (a steered state that lands on the
+/// goal sample is the goal to the last bit; 1e-9 m absorbs an interpolation's rounding).
+constexpr double kExactGoal = 1e-9;
 
 Eigen::Vector3d to_vec(const ob::State* s) {
   const auto* r = s->as<ob::RealVectorStateSpace::StateType>();
@@ -136,16 +149,18 @@ std::vector<std::string> ompl_planner_names() {
 }
 bool ompl_available() { return true; }
 
-void init_ompl(std::uint64_t seed) {
-  ompl::msg::setLogLevel(ompl::msg::LOG_NONE);
-  static bool seeded = false;
-  if (!seeded) {
-    ompl::RNG::setSeed(static_cast<std::uint_fast32_t>(seed == 0 ? 1 : seed));
-    seeded = true;
-  }
-}
+void init_ompl() { ompl::msg::setLogLevel(ompl::msg::LOG_NONE); }
 
 plan::PlanResult run_ompl(const plan::PlanningProblem& problem, const OmplRunOptions& o) {
+  // Reseed OMPL's seed generator before anything of this run draws a seed: every RNG the
+  // run creates (samplers, planners, nearest-neighbour structures) is seeded from it in
+  // creation order, so the run is a function of o.seed (OMPL logs an error that reseeding
+  // after the first seed "will not be deterministic"; it reseeds all the same, and its log
+  // is off).
+  if (o.seed != 0) {
+    ompl::msg::setLogLevel(ompl::msg::LOG_NONE);
+    ompl::RNG::setSeed(o.seed);
+  }
   const world::Map& map = *problem.map;
   auto space = std::make_shared<MapStateSpace>();
   ob::RealVectorBounds bounds(3);
@@ -166,9 +181,15 @@ plan::PlanResult run_ompl(const plan::PlanningProblem& problem, const OmplRunOpt
     goal[static_cast<unsigned>(a)] = problem.goal[a];
   }
   auto pdef = std::make_shared<ob::ProblemDefinition>(si);
-  pdef->setStartAndGoalStates(start, goal, o.goal_radius);
+  // The goal rule (REQ-PLAN-018): a path ends exactly at x_goal and costs its whole length.
+  // OMPL gets x_goal as an exact goal state (threshold kExactGoal; it samples x_goal with its
+  // goal bias and steers onto it), so its costs need no correction; with the goal ball as
+  // its goal it would stop up to goal_radius short and count that as free.
+  pdef->setStartAndGoalStates(start, goal, kExactGoal);
   auto objective = std::make_shared<ob::PathLengthOptimizationObjective>(si);
-  objective->setCostThreshold(ob::Cost(o.target_cost ? *o.target_cost : 0.0));
+  // OMPL never stops on its own cost (which ends in the goal ball): the termination
+  // condition below judges the target on the cost to x_goal.
+  objective->setCostThreshold(ob::Cost(0.0));
   pdef->setOptimizationObjective(objective);
 
   ob::PlannerPtr planner = make_planner(o.planner, si, o);
@@ -261,7 +282,7 @@ plan::PlanResult run_ompl(const plan::PlanningProblem& problem, const OmplRunOpt
 
 std::vector<std::string> ompl_planner_names() { return {}; }
 bool ompl_available() { return false; }
-void init_ompl(std::uint64_t) {}
+void init_ompl() {}
 plan::PlanResult run_ompl(const plan::PlanningProblem&, const OmplRunOptions& o) {
   throw Error("planner " + o.planner + ": this build has no OMPL (configure with -DMINER_WITH_OMPL=ON)");
 }

@@ -26,16 +26,22 @@ struct GenOptions {
   std::string preset = "sim";
   std::uint64_t seed = 1;
   int obstacles = -1;
+  std::vector<double> size;
+  double resolution = 0.0;
   std::string out;
 };
 
 void run_gen(const GenOptions& o, std::ostream& out) {
   const auto preset = world::generator_preset(o.preset);
-  const Map map = world::generate_map(preset, o.seed,
-                                      o.obstacles >= 0 ? std::optional<int>(o.obstacles) : std::nullopt);
+  world::GeneratorOverrides overrides;
+  if (o.obstacles >= 0) overrides.obstacles = o.obstacles;
+  if (!o.size.empty()) overrides.size = Eigen::Vector3d(o.size[0], o.size[1], o.size[2]);
+  if (o.resolution != 0.0) overrides.resolution = o.resolution;
+  const Map map = world::generate_map(preset, o.seed, overrides);
   map.save(o.out);
-  out << "wrote " << o.out << ": preset " << o.preset << ", seed " << o.seed << ", "
-      << map.obstacles().size() << " obstacles\n";
+  const Eigen::Vector3d e = map.bounds().extent();
+  out << "wrote " << o.out << ": preset " << o.preset << ", seed " << o.seed << ", " << e.x() << " x " << e.y()
+      << " x " << e.z() << " m at " << map.resolution() << " m, " << map.obstacles().size() << " obstacles\n";
 }
 
 struct InfoOptions {
@@ -130,12 +136,16 @@ void add_map_commands(CLI::App& app, std::ostream& out) {
   map->require_subcommand(1);
 
   auto gen = std::make_shared<GenOptions>();
-  CLI::App* g = map->add_subcommand("gen", "generate a seeded cluttered map (presets: sim, indoor)");
-  g->add_option("--preset", gen->preset, "map preset: sim (100 m, paper Sec. V-B) or indoor (10 m site, Sec. V-D)")
+  CLI::App* g = map->add_subcommand("gen", "generate a seeded map (presets: sim, indoor, cluttered, rooms, forest, multilevel)");
+  g->add_option("--preset", gen->preset,
+                "map preset: sim (100 m, paper Sec. V-B), indoor (10 m site, Sec. V-D), or a family drawing its "
+                "size per map: cluttered, rooms, forest, multilevel")
       ->capture_default_str();
   g->add_option("--seed", gen->seed, "random seed")->capture_default_str();
   g->add_option("--obstacles", gen->obstacles, "number of obstacles (default: the preset's range)")
       ->check(CLI::NonNegativeNumber);
+  g->add_option("--size", gen->size, "families: extents X Y Z in m instead of drawn ones")->expected(3);
+  g->add_option("--resolution", gen->resolution, "families: grid resolution in m instead of the drawn one");
   g->add_option("--out", gen->out, "output file (.json, or .bt for OctoMap)")->required();
   g->callback([gen, &out] { run_gen(*gen, out); });
 

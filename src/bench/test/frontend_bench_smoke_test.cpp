@@ -11,6 +11,7 @@
 #include "bench/ompl_planners.hpp"
 #include "cli/cli.hpp"
 #include "miner/core/json_io.hpp"
+#include "miner/world/map.hpp"
 
 using Catch::Matchers::Contains;
 
@@ -113,4 +114,36 @@ TEST_CASE("The OMPL benchmark log is read by ompl_benchmark_statistics into SQLi
                             "s=c.execute('select count(*) from runs where solved=1').fetchone()[0]; "
                             "sys.exit(0 if (r, p) == (12, 4) and s >= 10 else 1)\" '" + db + "'";
   CHECK(std::system(query.c_str()) == 0);
+}
+
+TEST_CASE("An OMPL run depends on its own seed only, not on the runs before it", "[REQ-PLAN-017]") {
+  if (!miner::bench::ompl_available()) return;
+  const miner::world::Map map = miner::world::Map::load(fixture("indoor-1.json"));
+  const auto& q = *map.query();
+  const auto problem = miner::plan::PlanningProblem::make(map, q.start, q.goal, q.robot_radius);
+  const auto run = [&](const std::string& planner, std::uint32_t seed) {
+    miner::bench::OmplRunOptions o;
+    o.planner = planner;
+    o.steer_step = miner::plan::resolved_steer_step(miner::plan::PlannerOptions{}, map);
+    o.max_condition_checks = 3000;
+    o.time_limit_s = 1e9;  // the condition-check budget decides
+    o.seed = seed;
+    return miner::bench::run_ompl(problem, o);
+  };
+  miner::bench::init_ompl();
+  const std::uint32_t s1 = miner::bench::ompl_run_seed(7, 1), s2 = miner::bench::ompl_run_seed(7, 2);
+  CHECK(s1 != s2);
+  CHECK(s1 == miner::bench::ompl_run_seed(7, 1));
+  const auto alone = run("ompl:RRTConnect", s1);
+  run("ompl:RRTstar", s2);  // another planner and seed in between draws from OMPL's generators
+  run("ompl:RRTConnect", s2);
+  const auto after = run("ompl:RRTConnect", s1);
+  REQUIRE(alone.solved);
+  CHECK(alone.path == after.path);
+  CHECK(alone.cost == after.cost);
+  // ... and the seed matters: another seed gives another path.
+  CHECK(run("ompl:RRTConnect", s2).path != alone.path);
+  // One goal rule: OMPL's path ends at x_goal itself and its cost is its whole length.
+  CHECK(alone.path.back() == problem.goal);
+  CHECK(alone.cost == Approx(miner::plan::path_length(alone.path)).epsilon(1e-12));
 }

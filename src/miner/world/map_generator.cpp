@@ -98,9 +98,50 @@ std::vector<Box> indoor_obstacles(Rng& rng, const GeneratorPreset& p, int count,
 
 }  // namespace
 
-std::vector<std::string> generator_preset_names() { return {"sim", "indoor"}; }
+std::vector<std::string> generator_preset_names() {
+  return {"sim", "indoor", "cluttered", "rooms", "forest", "multilevel"};
+}
+
+bool is_family(const GeneratorPreset& preset) { return !preset.resolutions.empty(); }
+
+namespace {
+
+/// A family preset: extents in [min_extent, max_extent], resolution from `resolutions`.
+GeneratorPreset family(const std::string& name, const Eigen::Vector3d& min_extent, const Eigen::Vector3d& max_extent,
+                       std::vector<double> resolutions, double robot_radius) {
+  GeneratorPreset p;
+  p.name = name;
+  p.bounds = Box{Eigen::Vector3d::Zero(), max_extent};
+  p.min_extent = min_extent;
+  p.resolutions = std::move(resolutions);
+  p.resolution = p.resolutions.front();
+  p.min_obstacles = p.max_obstacles = 0;
+  p.min_side = p.max_side = 0.0;
+  p.robot_radius = robot_radius;
+  p.keep_free = 1.0;
+  p.quantum = 0.05;
+  return p;
+}
+
+/// Largest grid a drawn family resolution may give (A*'s arrays stay ~100 MB).
+constexpr double kMaxFamilyGridCells = 6e6;
+
+double family_resolution(const GeneratorPreset& p, const Eigen::Vector3d& extent) {
+  for (double r : p.resolutions) {  // finest first
+    const Eigen::Vector3d cells = (extent / r).array().ceil();
+    if (cells.maxCoeff() <= kMaxFamilyCells && cells.prod() <= kMaxFamilyGridCells) return r;
+  }
+  return p.resolutions.back();
+}
+
+}  // namespace
 
 GeneratorPreset generator_preset(const std::string& name) {
+  // Families (REQ-WORLD-011): extent ranges, resolutions finest first, robot radius.
+  if (name == "cluttered") return family(name, {10, 10, 6}, {60, 60, 30}, {0.1, 0.2, 0.25, 0.5}, 0.3);
+  if (name == "rooms") return family(name, {20, 15, 3}, {60, 40, 4.5}, {0.1, 0.2}, 0.2);
+  if (name == "forest") return family(name, {20, 20, 8}, {150, 150, 25}, {0.2, 0.25, 0.5, 1.0}, 0.3);
+  if (name == "multilevel") return family(name, {20, 20, 7}, {50, 50, 16}, {0.1, 0.2, 0.25, 0.5}, 0.25);
   if (name == "sim") {
     return {"sim",
             Box{{0, 0, 0}, {100, 100, 40}},
@@ -111,7 +152,9 @@ GeneratorPreset generator_preset(const std::string& name) {
             3.0,
             Box{{2, 2, 2}, {10, 10, 10}},
             Box{{90, 90, 2}, {98, 98, 10}},
-            0.1};
+            0.1,
+            Eigen::Vector3d::Zero(),
+            {}};
   }
   if (name == "indoor") {
     return {"indoor",
@@ -123,7 +166,9 @@ GeneratorPreset generator_preset(const std::string& name) {
             0.7,
             Box{{0.5, 0.5, 0.8}, {1.5, 1.5, 1.5}},
             Box{{8.5, 8.5, 0.8}, {9.5, 9.5, 1.5}},
-            0.05};
+            0.05,
+            Eigen::Vector3d::Zero(),
+            {}};
   }
   std::string known;
   for (const auto& n : generator_preset_names()) known += (known.empty() ? "" : ", ") + n;
@@ -132,8 +177,56 @@ GeneratorPreset generator_preset(const std::string& name) {
 
 Map generate_map(const GeneratorPreset& preset, std::uint64_t seed,
                  std::optional<int> obstacle_count) {
+  GeneratorOverrides o;
+  o.obstacles = obstacle_count;
+  return generate_map(preset, seed, o);
+}
+
+Map generate_map(const GeneratorPreset& preset, std::uint64_t seed, const GeneratorOverrides& overrides) {
+  const std::optional<int> obstacle_count = overrides.obstacles;
   if (obstacle_count && *obstacle_count < 0) {
     throw Error("obstacles: count must not be negative, got " + std::to_string(*obstacle_count));
+  }
+  if (!is_family(preset) && (overrides.size || overrides.resolution)) {
+    throw Error("size/resolution: preset \"" + preset.name + "\" has fixed bounds and resolution; "
+                "the map families (cluttered, rooms, forest, multilevel) take them");
+  }
+  if (overrides.size) {
+    const Eigen::Vector3d& s = *overrides.size;
+    if (!s.allFinite() || (s.array() < 3.0).any() || (s.array() > 1000.0).any())
+      throw Error("size: every extent must be between 3 and 1000 m");
+  }
+  if (overrides.resolution && !(*overrides.resolution >= 0.01 && *overrides.resolution <= 10.0))
+    throw Error("resolution: must be between 0.01 and 10 m");
+  if (is_family(preset)) {
+    for (int attempt = 0; attempt < kMaxGeneratorAttempts; ++attempt) {
+      Rng rng(seed, static_cast<std::uint64_t>(attempt));
+      Eigen::Vector3d extent;
+      for (int k = 0; k < 3; ++k) {
+        extent[k] = quantize(rng.uniform(preset.min_extent[k], preset.bounds.max[k]), 0.5);
+      }
+      if (overrides.size) extent = *overrides.size;
+      const double resolution = overrides.resolution ? *overrides.resolution : family_resolution(preset, extent);
+      const Eigen::Vector3d cells = (extent / resolution).array().ceil();
+      if (cells.prod() > 5e7) {
+        throw Error("resolution: " + std::to_string(resolution) + " m gives " + std::to_string(cells.prod()) +
+                    " grid cells (at most 5e7)");
+      }
+      const Box bounds{Eigen::Vector3d::Zero(), extent};
+      detail::FamilyDraw draw = detail::draw_family(preset, rng, bounds, obstacle_count);
+      Map map(bounds, resolution, std::move(draw.obstacles), draw.query);
+      try {
+        map.require_free(draw.query.start, draw.query.robot_radius, "start");
+        map.require_free(draw.query.goal, draw.query.robot_radius, "goal");
+        const VoxelGrid grid(map, draw.query.robot_radius);
+        astar(map, grid, draw.query.start, draw.query.goal);
+        return map;
+      } catch (const Error&) {
+        continue;  // blocked query: draw the next attempt's map
+      }
+    }
+    throw NoSolution("preset \"" + preset.name + "\": no solvable map in " + std::to_string(kMaxGeneratorAttempts) +
+                     " attempts for seed " + std::to_string(seed) + " (too many obstacles, or too small a size?)");
   }
   for (int attempt = 0; attempt < kMaxGeneratorAttempts; ++attempt) {
     Rng rng(seed, static_cast<std::uint64_t>(attempt));

@@ -1,18 +1,28 @@
 #pragma once
 /// \file
-/// Seeded cluttered-map generator with the paper's presets (REQ-WORLD-009):
+/// Seeded map generator. The paper's presets (REQ-WORLD-009):
 ///  - "sim": the simulation maps of Sec. V-B, 100 x 100 x 40 m, cuboids with sides of
 ///    4-15 m, resolution 0.5 m, start and goal in opposite corners;
 ///  - "indoor": the real-flight site of Sec. V-D, 10 x 10 x 5 m, 15-20 cuboid pillars
 ///    with a 0.6 x 1.2 m footprint and a hoop of 1 m diameter, resolution 0.1 m.
+/// Map families beyond the paper (REQ-WORLD-011), each drawing its extents and
+/// resolution per map so a family spans sizes and aspect ratios (map_families.cpp):
+///  - "cluttered": 10-60 m, dense cuboids with sides 5-20 % of the map's size;
+///  - "rooms": an office floor (20-60 x 15-40 x 3-4.5 m): a corridor, rooms behind
+///    walls with doors, furniture;
+///  - "forest": 20-150 m, thin trunks (0.2-0.6 m) with branches, 3-9 per 100 m^2;
+///  - "multilevel": 2-4 storeys of slabs with stair/atrium openings, bridges across
+///    them, overhangs, partition walls and a roof, start on the ground floor and goal
+///    on the top one.
 /// Every generated map carries its query (start, goal, robot radius) and is checked to
-/// be solvable by A* for that radius; the same (preset, seed) gives the same bytes.
+/// be solvable by A* for that radius; the same (preset, seed, overrides) gives the same bytes.
 
 #include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "miner/core/rng.hpp"
 #include "miner/world/map.hpp"
 
 namespace miner::world {
@@ -27,7 +37,24 @@ struct GeneratorPreset {
   double keep_free;                  ///< no obstacle within this distance of start/goal
   Box start_region, goal_region;     ///< where the query's start and goal are drawn
   double quantum;                    ///< coordinates are rounded to multiples of this
+  /// Families (REQ-WORLD-011): extents drawn per map, uniformly in [min_extent, max_extent]
+  /// (bounds.max is max_extent); unused (zero) for "sim" and "indoor", whose bounds are fixed.
+  Eigen::Vector3d min_extent = Eigen::Vector3d::Zero();
+  /// Families: the resolution is the finest of these giving at most kMaxFamilyCells per axis.
+  std::vector<double> resolutions;
 };
+
+/// Overrides of what a preset would draw (`miner map gen --size/--resolution/--obstacles`):
+/// a held-out benchmark map of another size is the same family at another extent.
+struct GeneratorOverrides {
+  std::optional<int> obstacles;           ///< count (sim, indoor, cluttered, forest trunks)
+  std::optional<Eigen::Vector3d> size;    ///< extents in m (families only)
+  std::optional<double> resolution;       ///< m (families only)
+};
+
+/// Largest grid axis a family map gets when its resolution is drawn (A* and the
+/// voxel grid stay within ~10^7 cells).
+inline constexpr double kMaxFamilyCells = 300.0;
 
 /// The named preset; throws miner::Error listing the known names otherwise.
 GeneratorPreset generator_preset(const std::string& name);
@@ -38,6 +65,20 @@ std::vector<std::string> generator_preset_names();
 /// finds the query's path; throws NoSolution if none of the attempts is solvable.
 Map generate_map(const GeneratorPreset& preset, std::uint64_t seed,
                  std::optional<int> obstacle_count = std::nullopt);
+Map generate_map(const GeneratorPreset& preset, std::uint64_t seed, const GeneratorOverrides& overrides);
+
+/// Whether the preset is one of the REQ-WORLD-011 families (extents drawn per map).
+bool is_family(const GeneratorPreset& preset);
+
+namespace detail {
+/// One family map's obstacles and query for the given bounds and resolution (map_families.cpp).
+struct FamilyDraw {
+  std::vector<Box> obstacles;
+  Query query;
+};
+FamilyDraw draw_family(const GeneratorPreset& preset, Rng& rng, const Box& bounds,
+                       std::optional<int> obstacles);
+}  // namespace detail
 
 inline constexpr int kMaxGeneratorAttempts = 16;
 

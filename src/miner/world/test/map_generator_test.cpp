@@ -1,5 +1,7 @@
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+
 #include "miner/core/error.hpp"
 #include "miner/core/json_io.hpp"
 #include "miner/world/astar.hpp"
@@ -64,7 +66,8 @@ TEST_CASE("Indoor maps: 15-20 pillars of 0.6 x 1.2 m on the floor and a 1 m hoop
 }
 
 TEST_CASE("Generator input errors: unknown preset, negative count, impossible clutter", "[REQ-WORLD-009]") {
-  CHECK_THROWS_WITH(generator_preset("forest"), Contains("unknown map preset \"forest\" (known: sim, indoor)"));
+  CHECK_THROWS_WITH(generator_preset("swamp"),
+                    Contains("unknown map preset \"swamp\" (known: sim, indoor, cluttered, rooms, forest, multilevel)"));
   CHECK_THROWS_WITH(generate_map(generator_preset("sim"), 1, -3), Contains("obstacles: count must not be negative"));
   const Map empty = generate_map(generator_preset("sim"), 1, 0);
   CHECK(empty.obstacles().empty());
@@ -77,4 +80,92 @@ TEST_CASE("Generator input errors: unknown preset, negative count, impossible cl
   cramped.keep_free = 0.5;
   cramped.robot_radius = 4.0;
   CHECK_THROWS_WITH(generate_map(cramped, 1, 30), Contains("no solvable map in 16 attempts for seed 1"));
+}
+
+TEST_CASE("Map families draw their size per map, carry a solvable query and repeat their bytes", "[REQ-WORLD-011]") {
+  for (const std::string name : {"cluttered", "rooms", "forest", "multilevel"}) {
+    const GeneratorPreset p = generator_preset(name);
+    REQUIRE(is_family(p));
+    std::vector<Eigen::Vector3d> extents;
+    for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+      INFO(name << " seed " << seed);
+      const Map map = generate_map(p, seed);
+      CHECK(miner::dump_json(map.to_json()) == miner::dump_json(generate_map(p, seed).to_json()));
+      const Eigen::Vector3d e = map.bounds().extent();
+      CHECK((e.array() >= p.min_extent.array() - 1e-9).all());
+      CHECK((e.array() <= p.bounds.max.array() + 1e-9).all());
+      CHECK(std::find(p.resolutions.begin(), p.resolutions.end(), map.resolution()) != p.resolutions.end());
+      CHECK((e / map.resolution()).maxCoeff() <= kMaxFamilyCells + 1e-9);
+      extents.push_back(e);
+      REQUIRE(map.query());
+      const auto& q = *map.query();
+      CHECK(q.robot_radius == p.robot_radius);
+      CHECK(map.is_free(q.start, q.robot_radius));
+      CHECK(map.is_free(q.goal, q.robot_radius));
+      // start and goal far apart: at least half the map's horizontal diagonal
+      CHECK((q.goal - q.start).head<2>().norm() >= 0.5 * e.head<2>().norm());
+      for (const Box& b : map.obstacles()) {
+        CHECK(map.bounds().contains(b.min));
+        CHECK(map.bounds().contains(b.max));
+      }
+      const VoxelGrid grid(map, q.robot_radius);
+      CHECK_NOTHROW(astar(map, grid, q.start, q.goal));
+    }
+    CHECK(extents[0] != extents[1]);  // the size is drawn per map
+  }
+}
+
+TEST_CASE("Family shapes: rooms are flat with walls and doors, multilevel spans storeys, forests are thin", "[REQ-WORLD-011]") {
+  const Map rooms = generate_map(generator_preset("rooms"), 4);
+  CHECK(rooms.bounds().extent().z() <= 4.5);
+  int walls = 0;
+  for (const Box& b : rooms.obstacles()) walls += (b.extent().x() <= 0.2 + 1e-9 || b.extent().y() <= 0.2 + 1e-9);
+  CHECK(walls >= 6);
+  // A door: the straight line from start to goal is blocked, yet A* gets through.
+  const auto& rq = *rooms.query();
+  CHECK_FALSE(rooms.segment_free(rq.start, rq.goal, rq.robot_radius));
+
+  const Map multi = generate_map(generator_preset("multilevel"), 4);
+  const auto& mq = *multi.query();
+  CHECK(mq.goal.z() - mq.start.z() >= 2.5);  // the goal is storeys above the start
+  const Map forest = generate_map(generator_preset("forest"), 4);
+  int trunks = 0;
+  for (const Box& b : forest.obstacles()) {
+    if (b.min.z() == 0.0) {
+      ++trunks;
+      CHECK(b.extent().x() <= 0.6 + 1e-9);
+      CHECK(b.extent().y() <= 0.6 + 1e-9);
+    }
+  }
+  const double area = forest.bounds().extent().x() * forest.bounds().extent().y();
+  CHECK(trunks >= 3.0 * area / 100.0 - 1);
+  CHECK(trunks <= 9.0 * area / 100.0 + 1);
+}
+
+TEST_CASE("Family overrides: size, resolution and count; bad overrides are refused", "[REQ-WORLD-011]") {
+  GeneratorOverrides o;
+  o.size = Eigen::Vector3d(40, 40, 20);
+  o.obstacles = 80;
+  const Map m = generate_map(generator_preset("cluttered"), 2, o);
+  CHECK(m.bounds().extent() == Eigen::Vector3d(40, 40, 20));
+  CHECK(m.obstacles().size() == 80);
+  o = {};
+  o.resolution = 0.5;
+  CHECK(generate_map(generator_preset("forest"), 2, o).resolution() == 0.5);
+  GeneratorOverrides bad;
+  bad.size = Eigen::Vector3d(40, 40, 1);
+  CHECK_THROWS_WITH(generate_map(generator_preset("cluttered"), 1, bad), Contains("size: every extent must be between 3 and 1000 m"));
+  bad = {};
+  bad.size = Eigen::Vector3d(20, 20, 10);
+  CHECK_THROWS_WITH(generate_map(generator_preset("sim"), 1, bad), Contains("has fixed bounds and resolution"));
+  bad = {};
+  bad.resolution = 0.0;
+  CHECK_THROWS_WITH(generate_map(generator_preset("rooms"), 1, bad), Contains("resolution: must be between"));
+  bad = {};
+  bad.size = Eigen::Vector3d(1000, 1000, 1000);
+  bad.resolution = 0.01;
+  CHECK_THROWS_WITH(generate_map(generator_preset("forest"), 1, bad), Contains("grid cells (at most 5e7)"));
+  bad = {};
+  bad.obstacles = 3;
+  CHECK_THROWS_WITH(generate_map(generator_preset("rooms"), 1, bad), Contains("has no obstacle count to override"));
 }

@@ -200,7 +200,7 @@ TEST_CASE("Every family map has a solvable query and the same bytes from the sam
     const GeneratorPreset p = generator_preset(families[rng.uniform_index(families.size())]);
     GeneratorOverrides o;
     V size;
-    for (int k = 0; k < 3; ++k) size[k] = std::round(rng.uniform(p.min_extent[k], 1.5 * p.min_extent[k]));
+    for (int k = 0; k < 3; ++k) size[k] = std::round(rng.uniform(p.min_extent[k], 1.1 * p.min_extent[k]));
     o.size = size;
     o.resolution = 0.25;
     try {

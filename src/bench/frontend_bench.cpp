@@ -95,6 +95,25 @@ PlannerSummary summarise(const std::string& planner, const std::vector<RunRecord
   s.target_nodes_mean = mean(reached_only(tn));
   s.target_time_ms_mean = mean(reached_only(tt));
   s.final_cost = median(final_cost);
+  s.target_reached = reached;
+  // First-solution stage over all runs too: a run without a solution counts as +inf.
+  std::vector<double> fi_all = fi, ft_all = ft;
+  for (int k = static_cast<int>(fi.size()); k < s.runs; ++k) {
+    fi_all.push_back(inf);
+    ft_all.push_back(inf);
+  }
+  s.first_iterations_sd = stddev(fi);
+  s.first_iterations_q1 = quantile(fi_all, 0.25);
+  s.first_iterations_q3 = quantile(fi_all, 0.75);
+  s.first_time_ms_sd = stddev(ft);
+  s.first_time_ms_q1 = quantile(ft_all, 0.25);
+  s.first_time_ms_q3 = quantile(ft_all, 0.75);
+  s.target_iterations_sd = stddev(ti);
+  s.target_iterations_q1 = quantile(ti, 0.25);
+  s.target_iterations_q3 = quantile(ti, 0.75);
+  s.target_time_ms_sd = stddev(tt);
+  s.target_time_ms_q1 = quantile(tt, 0.25);
+  s.target_time_ms_q3 = quantile(tt, 0.75);
   return s;
 }
 
@@ -277,7 +296,20 @@ nlohmann::json summary_json(const PlannerSummary& s) {
           {"target_iterations_mean", num(s.target_iterations_mean)},
           {"target_nodes_mean", num(s.target_nodes_mean)},
           {"target_time_ms_mean", num(s.target_time_ms_mean)},
-          {"final_cost", num(s.final_cost)}};
+          {"final_cost", num(s.final_cost)},
+          {"target_reached", s.target_reached},
+          {"first_iterations_sd", num(s.first_iterations_sd)},
+          {"first_iterations_q1", num(s.first_iterations_q1)},
+          {"first_iterations_q3", num(s.first_iterations_q3)},
+          {"first_time_ms_sd", num(s.first_time_ms_sd)},
+          {"first_time_ms_q1", num(s.first_time_ms_q1)},
+          {"first_time_ms_q3", num(s.first_time_ms_q3)},
+          {"target_iterations_sd", num(s.target_iterations_sd)},
+          {"target_iterations_q1", num(s.target_iterations_q1)},
+          {"target_iterations_q3", num(s.target_iterations_q3)},
+          {"target_time_ms_sd", num(s.target_time_ms_sd)},
+          {"target_time_ms_q1", num(s.target_time_ms_q1)},
+          {"target_time_ms_q3", num(s.target_time_ms_q3)}};
 }
 
 nlohmann::json count_json(std::size_t c) { return c == kUnknownCount ? nlohmann::json(nullptr) : nlohmann::json(c); }

@@ -73,6 +73,14 @@ struct PlannerSummary {
   double target_iterations = NAN, target_nodes = NAN, target_time_ms = NAN;
   double target_iterations_mean = NAN, target_nodes_mean = NAN, target_time_ms_mean = NAN;
   double final_cost = NAN;  ///< median final cost of solved runs
+  // Spread (REQ-PLAN-019): sample standard deviation over the runs that reached the stage,
+  // lower and upper quartile over all runs (a missed stage counting as +inf, so a quartile
+  // that lands on a miss is NaN / null).
+  double first_iterations_sd = NAN, first_iterations_q1 = NAN, first_iterations_q3 = NAN;
+  double first_time_ms_sd = NAN, first_time_ms_q1 = NAN, first_time_ms_q3 = NAN;
+  double target_iterations_sd = NAN, target_iterations_q1 = NAN, target_iterations_q3 = NAN;
+  double target_time_ms_sd = NAN, target_time_ms_q1 = NAN, target_time_ms_q3 = NAN;
+  int target_reached = 0;  ///< runs that reached the target (target_rate x runs)
 };
 
 struct FrontendBenchResult {

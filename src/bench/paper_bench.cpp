@@ -263,7 +263,8 @@ std::string results_markdown(const PaperBenchResult& r, const std::string& figur
     const auto& fr = r.frontend[i];
     md << "### Map " << (i + 1) << " (" << fr.map << ", A* cost " << f(fr.reference_cost, 1) << " m)\n\n"
        << "| method | source | success | initial iteration | initial nodes | initial cost (m) | initial time (ms) "
-          "| optimal iteration | optimal nodes | optimal time (ms) |\n|---|---|---|---|---|---|---|---|---|---|\n";
+          "| optimal iteration | optimal nodes | optimal time (ms) | n | target reached | optimal time mean ± sd (ms, reached runs) "
+          "| optimal time median [IQR] (ms, misses as +inf) |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const auto& planner : r.options.planners) {
       const PlannerSummary* s = find_summary(fr, planner);
       if (!s) continue;
@@ -273,12 +274,15 @@ std::string results_markdown(const PaperBenchResult& r, const std::string& figur
           if (std::string(row.method) == pn)
             md << "| " << pn << " | paper | — | " << f(row.v[0], 1) << " | " << f(row.v[1], 1) << " | "
                << f(row.v[2], 1) << " | " << f(row.v[3], 1) << " | " << f(row.v[4], 1) << " | " << f(row.v[5], 1)
-               << " | " << f(row.v[6], 1) << " |\n";
+               << " | " << f(row.v[6], 1) << " | 50 (means) | — | — | — |\n";
       const bool ompl = is_ompl_planner(planner);
       md << "| " << (pn ? pn : planner.c_str()) << " | " << (ompl ? "OMPL " : "MINER ") << "`" << planner << "` | "
          << pct(s->success_rate) << " | " << f(s->first_iterations, 1) << " | " << f(s->first_nodes, 1) << " | "
          << f(s->first_cost, 1) << " | " << f(s->first_time_ms, 2) << " | " << f(s->target_iterations, 1) << " | "
-         << f(s->target_nodes, 1) << " | " << f(s->target_time_ms, 2) << " |\n";
+         << f(s->target_nodes, 1) << " | " << f(s->target_time_ms, 2) << " | " << s->runs << " | " << s->target_reached
+         << "/" << s->runs << " | " << f(s->target_time_ms_mean, 2) << " ± " << f(s->target_time_ms_sd, 2) << " | "
+         << f(s->target_time_ms, 2) << " [" << f(s->target_time_ms_q1, 2) << ", " << f(s->target_time_ms_q3, 2)
+         << "] |\n";
     }
     md << "\n![" << fr.map << " first](" << figure_dir << "/" << fr.map << "-first.svg) ![" << fr.map << " target]("
        << figure_dir << "/" << fr.map << "-target.svg)\n\n";

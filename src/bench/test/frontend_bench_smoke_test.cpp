@@ -59,6 +59,34 @@ TEST_CASE("Summaries take medians over solved runs and null the target median be
   CHECK(summarise("b", runs).runs == 0);
 }
 
+TEST_CASE("Summaries report spread: sd over reached runs, quartiles with misses as +inf, reach count", "[REQ-PLAN-019]") {
+  using miner::bench::summarise;
+  std::vector<miner::bench::RunRecord> runs;
+  for (double ms : {10.0, 20.0, 30.0, 40.0, 50.0}) runs.push_back(fake("a", true, ms / 10, ms));
+  auto s = summarise("a", runs);
+  CHECK(s.target_reached == 5);
+  CHECK(s.target_time_ms_sd == Approx(std::sqrt(250.0)));  // sample sd of 10..50
+  CHECK(s.target_time_ms_q1 == 20.0);
+  CHECK(s.target_time_ms_q3 == 40.0);
+  CHECK(s.first_time_ms_q1 == 2.0);
+  // A sixth run that missed: the reached-run sd is unchanged, the upper quartile moves
+  // (type 7 on {10, 20, 30, 40, 50, inf}: h = 3.75 -> between 40 and 50) and the count drops.
+  runs.push_back(fake("a", false, 0, std::nullopt));
+  s = summarise("a", runs);
+  CHECK(s.target_reached == 5);
+  CHECK(s.runs == 6);
+  CHECK(s.target_time_ms_sd == Approx(std::sqrt(250.0)));
+  CHECK(s.target_time_ms_q1 == Approx(22.5));  // h = 1.25
+  CHECK(s.target_time_ms_q3 == Approx(47.5));
+  CHECK(s.first_time_ms_q3 == Approx(4.75));
+  // Two more misses: 3 of 8 missed, so the upper quartile (h = 5.25) lands on a miss: unknown.
+  runs.push_back(fake("a", false, 0, std::nullopt));
+  runs.push_back(fake("a", true, 1.0, std::nullopt));
+  s = summarise("a", runs);
+  CHECK(std::isnan(s.target_time_ms_q3));
+  CHECK(std::isfinite(s.target_time_ms_q1));
+}
+
 TEST_CASE("bench frontend runs every planner and prints the documented JSON fields", "[REQ-PLAN-010][REQ-PLAN-011]") {
   std::ostringstream out, err;
   const int code = miner::cli::run_cli({"bench", "frontend", "--map", fixture("indoor-1.json"), "--runs", "2",
@@ -75,7 +103,8 @@ TEST_CASE("bench frontend runs every planner and prints the documented JSON fiel
   for (const auto& p : doc["planners"]) {
     names.push_back(p["planner"].get<std::string>());
     for (const char* key : {"planner", "runs", "success_rate", "first_time_ms", "first_cost", "target_time_ms",
-                            "target_iterations", "target_nodes"}) {
+                            "target_iterations", "target_nodes", "target_reached", "target_time_ms_sd",
+                            "target_time_ms_q1", "target_time_ms_q3", "first_time_ms_sd", "first_iterations_q1"}) {
       CHECK(p.contains(key));
     }
     CHECK(p["runs"] == 2);
@@ -116,7 +145,7 @@ TEST_CASE("The OMPL benchmark log is read by ompl_benchmark_statistics into SQLi
   CHECK(std::system(query.c_str()) == 0);
 }
 
-TEST_CASE("An OMPL run depends on its own seed only, not on the runs before it", "[REQ-PLAN-017]") {
+TEST_CASE("An OMPL run depends on its own seed only, not on the runs before it", "[REQ-PLAN-017][REQ-PLAN-018]") {
   if (!miner::bench::ompl_available()) return;
   const miner::world::Map map = miner::world::Map::load(fixture("indoor-1.json"));
   const auto& q = *map.query();

@@ -190,8 +190,8 @@ TEST_CASE("Bad dataset options are refused naming the option", "[REQ-HEUR-003]")
   o.dims = Eigen::Vector3i(2, 32, 32);
   CHECK_THROWS_WITH(heuristic::validate(o), Contains("--dims"));
   o = small_options();
-  o.preset = "forest";
-  CHECK_THROWS_WITH(heuristic::validate(o), Contains("forest"));
+  o.preset = "swamp";
+  CHECK_THROWS_WITH(heuristic::validate(o), Contains("swamp"));
   o = small_options();
   o.jobs = 0;
   CHECK_THROWS_WITH(heuristic::validate(o), Contains("--jobs"));

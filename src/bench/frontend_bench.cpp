@@ -102,18 +102,17 @@ PlannerSummary summarise(const std::string& planner, const std::vector<RunRecord
     fi_all.push_back(inf);
     ft_all.push_back(inf);
   }
-  s.first_iterations_sd = stddev(fi);
-  s.first_iterations_q1 = quantile(fi_all, 0.25);
-  s.first_iterations_q3 = quantile(fi_all, 0.75);
-  s.first_time_ms_sd = stddev(ft);
-  s.first_time_ms_q1 = quantile(ft_all, 0.25);
-  s.first_time_ms_q3 = quantile(ft_all, 0.75);
-  s.target_iterations_sd = stddev(ti);
-  s.target_iterations_q1 = quantile(ti, 0.25);
-  s.target_iterations_q3 = quantile(ti, 0.75);
-  s.target_time_ms_sd = stddev(tt);
-  s.target_time_ms_q1 = quantile(tt, 0.25);
-  s.target_time_ms_q3 = quantile(tt, 0.75);
+  // sd over the runs that reached the stage, quartiles over all runs (a miss is +inf).
+  const auto spread = [](const std::vector<double>& reached_runs, const std::vector<double>& all_runs, double& sd,
+                         double& q1, double& q3) {
+    sd = stddev(reached_runs);
+    q1 = quantile(all_runs, 0.25);
+    q3 = quantile(all_runs, 0.75);
+  };
+  spread(fi, fi_all, s.first_iterations_sd, s.first_iterations_q1, s.first_iterations_q3);
+  spread(ft, ft_all, s.first_time_ms_sd, s.first_time_ms_q1, s.first_time_ms_q3);
+  spread(ti, ti, s.target_iterations_sd, s.target_iterations_q1, s.target_iterations_q3);
+  spread(tt, tt, s.target_time_ms_sd, s.target_time_ms_q1, s.target_time_ms_q3);
   return s;
 }
 

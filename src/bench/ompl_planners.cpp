@@ -158,7 +158,7 @@ plan::PlanResult run_ompl(const plan::PlanningProblem& problem, const OmplRunOpt
   // after the first seed "will not be deterministic"; it reseeds all the same, and its log
   // is off).
   if (o.seed != 0) {
-    ompl::msg::setLogLevel(ompl::msg::LOG_NONE);
+    init_ompl();  // the reseeding's error log stays silent even if the caller did not call it
     ompl::RNG::setSeed(o.seed);
   }
   const world::Map& map = *problem.map;

@@ -366,6 +366,7 @@ nlohmann::json to_json(const FrontendBenchResult& r) {
           {"goal_radius", r.goal_radius},
           {"max_iterations", r.options.max_iterations},
           {"time_limit_s", r.options.time_limit_s},
+          {"safeguard", r.options.planner_options.safeguard},
           {"region", {{"source", r.region_source}, {"cells", r.region_cells}, {"build_ms", r.region_ms}}},
           {"throughput",
            {{"iterations", r.options.throughput_iterations},

@@ -98,6 +98,8 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
       ->check(CLI::PositiveNumber);
   fc->add_option("--goal-radius", f->bench.planner_options.goal_radius, "goal radius in m (default 2 x resolution)")
       ->check(CLI::PositiveNumber);
+  fc->add_flag("!--no-safeguard", f->bench.planner_options.safeguard,
+               "miner, miner-sgan: the paper's fixed mu, without the safeguard (REQ-PLAN-020)");
   fc->add_option("--region", f->bench.region_file, "miner's region file (default: the A*-dilated region)");
   fc->add_option("--weights", f->bench.weights_file, "miner-sgan's weights (default: the shipped fixtures/sgan/sgan.bin)");
   fc->add_option("--region-dims", f->region_dims, "A*-dilated region grid")->expected(3)->check(CLI::PositiveNumber);

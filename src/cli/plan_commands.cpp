@@ -108,7 +108,10 @@ void run_plan(PlanCliOptions o, std::ostream& out) {
     const bool named = o.region == "sgan" || o.region == "astar";
     doc["region"] = {{"source", named ? region->source() : o.region},
                      {"cells", region->cells().size()},
-                     {"volume", region->volume()}};
+                     {"volume", region->volume()},
+                     {"safeguard", o.planner_options.safeguard},
+                     {"samples", r.region_samples},
+                     {"trust", r.region_trust}};
     if (sgan_query) {
       doc["region"]["connected"] = sgan_query->report.connected;
       doc["region"]["bridge_cells"] = sgan_query->report.bridge_cells;
@@ -207,6 +210,12 @@ void add_plan_commands(CLI::App& app, std::ostream& out) {
       ->capture_default_str();
   p->add_option("--mu2", po->planner_options.mu_2, "miner: P(sample region) before the first solution, < 1")
       ->check(CLI::Range(0.0, 0.999999))
+      ->capture_default_str();
+  p->add_flag("!--no-safeguard", po->planner_options.safeguard,
+              "miner: the paper's fixed mu_1/mu_2, without the online trust of REQ-PLAN-020");
+  p->add_option("--safeguard-iterations", po->planner_options.safeguard_iterations,
+                "miner safeguard: k_0, iterations without a solution after which mu decays as k_0 / t")
+      ->check(CLI::PositiveNumber)
       ->capture_default_str();
   p->add_option("--rewire-factor", po->planner_options.rewire_factor, "rewiring radius factor (>= 1)")
       ->check(CLI::Range(1.0, 100.0))

@@ -170,13 +170,56 @@ world::Box HeuristicRegion::cell_box(std::size_t index) const {
   return {lo, lo + cell_size_};
 }
 
-bool HeuristicRegion::contains(const Eigen::Vector3d& p) const {
-  if (!bounds_.contains(p)) return false;
+long HeuristicRegion::cell_at(const Eigen::Vector3d& p) const {
+  if (!bounds_.contains(p)) return -1;
   Eigen::Vector3i c;
   for (int a = 0; a < 3; ++a) {
     c[a] = std::min(static_cast<int>(std::floor((p[a] - bounds_.min[a]) / cell_size_[a])), dims_[a] - 1);
   }
-  return probabilities_[index(c.x(), c.y(), c.z())] >= threshold_;
+  return static_cast<long>(index(c.x(), c.y(), c.z()));
+}
+
+bool HeuristicRegion::contains(const Eigen::Vector3d& p) const {
+  const long c = cell_at(p);
+  return c >= 0 && probabilities_[static_cast<std::size_t>(c)] >= threshold_;
+}
+
+std::vector<int> HeuristicRegion::hops_to(const Eigen::Vector3d& p) const {
+  std::vector<int> hops(probabilities_.size(), -1);
+  const long source = cell_at(p);
+  if (source < 0) return hops;
+  std::vector<std::size_t> queue{static_cast<std::size_t>(source)};
+  hops[queue.front()] = 0;
+  for (std::size_t head = 0; head < queue.size(); ++head) {
+    const std::size_t u = queue[head];
+    const Eigen::Vector3i c = coords(u);
+    for (int dk = -1; dk <= 1; ++dk)
+      for (int dj = -1; dj <= 1; ++dj)
+        for (int di = -1; di <= 1; ++di) {
+          const Eigen::Vector3i n = c + Eigen::Vector3i(di, dj, dk);
+          if ((n.array() < 0).any() || (n.array() >= dims_.array()).any()) continue;
+          const std::size_t v = index(n.x(), n.y(), n.z());
+          if (hops[v] >= 0 || probabilities_[v] < threshold_) continue;
+          hops[v] = hops[u] + 1;
+          queue.push_back(v);
+        }
+  }
+  return hops;
+}
+
+double HeuristicRegion::length_fraction_inside(const std::vector<Eigen::Vector3d>& path) const {
+  const double step = 0.25 * cell_size_.minCoeff();
+  double inside = 0.0, total = 0.0;
+  for (std::size_t s = 1; s < path.size(); ++s) {
+    const Eigen::Vector3d a = path[s - 1], d = path[s] - path[s - 1];
+    const double length = d.norm();
+    const int steps = std::max(1, static_cast<int>(std::ceil(length / step)));
+    int in = 0;
+    for (int t = 0; t < steps; ++t) in += contains(a + d * ((t + 0.5) / steps));
+    inside += length * in / steps;
+    total += length;
+  }
+  return total > 0.0 ? inside / total : 0.0;
 }
 
 double HeuristicRegion::volume() const { return static_cast<double>(cells_.size()) * cell_size_.prod(); }

@@ -69,8 +69,19 @@ class HeuristicRegion {
   }
   Eigen::Vector3i coords(std::size_t index) const;
   world::Box cell_box(std::size_t index) const;
+  /// Index of the cell holding p, or -1 for a point outside the bounds (the max faces
+  /// belong to the last cells).
+  long cell_at(const Eigen::Vector3d& p) const;
+  /// Breadth-first hop counts through H's cells (26-connected) from the cell holding p:
+  /// entry i is the number of steps from cell i to p's cell moving only through cells
+  /// of H (p's own cell counts as in H), -1 where no such chain exists.
+  std::vector<int> hops_to(const Eigen::Vector3d& p) const;
   /// Whether p lies in a cell of H (points outside the bounds are not).
   bool contains(const Eigen::Vector3d& p) const;
+  /// The share of a polyline's length that lies in H (0 for a path of zero length): each
+  /// segment is walked in steps of a quarter of the smallest cell side, a step counting
+  /// as inside when its midpoint is (REQ-PLAN-020's path trust).
+  double length_fraction_inside(const std::vector<Eigen::Vector3d>& path) const;
   /// Lebesgue measure of H: number of cells times the cell volume.
   double volume() const;
 

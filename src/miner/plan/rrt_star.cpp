@@ -28,6 +28,16 @@ constexpr double kRewireRelativeMargin = 1e-12;
 /// Rejection tries for a sample of (informed set) x (map bounds) before falling back
 /// to a uniform sample of the map (which keeps completeness and never loops forever).
 constexpr int kMaxRejectionTries = 64;
+/// Safeguard (REQ-PLAN-020): a region whose cells hold at least this share of the best
+/// path's length has guided the solution and keeps the full mu_1; below it the trust falls
+/// in proportion. Not 1: a good region's solution still cuts corners between cells and
+/// leaves H near x_init and x_goal (the A*-dilated region keeps tau = 1 in 195 of 200
+/// door-map trials at 0.75), while a region that merely holds x_init's surroundings holds
+/// a quarter of the path or less.
+constexpr double kTrustedPathFraction = 0.75;
+/// Safeguard: a region whose cells do not chain x_init's cell to x_goal's (H disconnected
+/// on the grid) cannot lead the tree to the goal by itself; its patience is k_0 / 3.
+constexpr double kDisconnectedPatience = 3.0;
 
 using Clock = std::chrono::steady_clock;
 
@@ -47,6 +57,11 @@ class RrtStar {
         rng_(options.seed, options.stream) {
     eta_ = resolved_steer_step(options, map_);
     goal_radius_ = resolved_goal_radius(options, map_);
+    if (options.planner == PlannerKind::kMiner && options.safeguard) {
+      goal_hops_ = region->hops_to(problem.goal);
+      const long c = region->cell_at(problem.start);
+      region_connected_ = c >= 0 && goal_hops_[static_cast<std::size_t>(c)] >= 0;
+    }
     gamma_ = options.rewire_factor * std::pow(2.0 * (1.0 + 1.0 / kDimension), 1.0 / kDimension) *
              std::pow(problem.free_volume / kUnitBallVolume, 1.0 / kDimension);
   }
@@ -74,6 +89,8 @@ class RrtStar {
     return sample_in(ProlateHyperspheroid(problem_.start, problem_.goal, best_cost_));
   }
   Eigen::Vector3d sample_guided_local();
+  /// tau_t of REQ-PLAN-020, set before iteration t's sample.
+  void update_trust(std::size_t t);
 
   double rewire_radius() const {
     const double n = static_cast<double>(positions_.size() + 1);
@@ -105,6 +122,26 @@ class RrtStar {
   long best_vertex_ = -1;
   // Guided RRT* beacons: interior vertices of the current solution, with cost-to-come.
   std::vector<std::pair<Eigen::Vector3d, double>> beacons_;
+  // MINER safeguard (REQ-PLAN-020): samples drawn from H, the trust from the best path,
+  // and tau_t itself.
+  std::size_t region_tries_ = 0;
+  double path_trust_ = 1.0;
+  double trust_ = 1.0;
+  // Progress along H: hops through H's cells from each cell to x_goal's cell, the fewest
+  // reached by a vertex so far, and the iteration that reached it.
+  std::vector<int> goal_hops_;
+  int best_hops_ = std::numeric_limits<int>::max();
+  bool region_connected_ = true;
+  std::size_t progress_iteration_ = 0;
+  void note_progress(const Eigen::Vector3d& x, std::size_t iteration) {
+    if (goal_hops_.empty()) return;
+    const long c = region_->cell_at(x);
+    const int h = c >= 0 ? goal_hops_[static_cast<std::size_t>(c)] : -1;
+    if (h >= 0 && h < best_hops_) {
+      best_hops_ = h;
+      progress_iteration_ = iteration;
+    }
+  }
 
   PlanResult result_;
   // Scratch buffers reused every iteration.
@@ -129,11 +166,26 @@ Eigen::Vector3d RrtStar::sample() {
       }
       return sample_informed();
     case PlannerKind::kMiner: {
-      const double mu = solved ? options_.mu_1 : options_.mu_2;
-      return rng_.uniform01() < mu ? region_->sample(rng_) : sample_uniform();
+      const double mu = (solved ? options_.mu_1 : options_.mu_2) * trust_;
+      if (rng_.uniform01() < mu) {
+        ++region_tries_;
+        return region_->sample(rng_);
+      }
+      return sample_uniform();
     }
   }
   return sample_uniform();
+}
+
+void RrtStar::update_trust(std::size_t t) {
+  if (options_.planner != PlannerKind::kMiner || !options_.safeguard) return;
+  // Before the first solution: k_0 / (t - t_p) once the tree has gone k_0 iterations
+  // without a vertex fewer H-hops from x_goal than any before (t_p: the last such
+  // iteration); after it: the share of the best path that H holds.
+  const double stalled = static_cast<double>(t - progress_iteration_);
+  const double k0 =
+      static_cast<double>(options_.safeguard_iterations) / (region_connected_ ? 1.0 : kDisconnectedPatience);
+  trust_ = best_vertex_ >= 0 ? path_trust_ : std::min(1.0, k0 / stalled);
 }
 
 Eigen::Vector3d RrtStar::sample_guided_local() {
@@ -195,6 +247,10 @@ void RrtStar::update_best(std::size_t iteration, Clock::time_point t0) {
   if (!result_.first) result_.first = record;
   result_.improvements.push_back(record);
   if (options_.target_cost && !result_.target && best <= *options_.target_cost) result_.target = record;
+  if (options_.planner == PlannerKind::kMiner && options_.safeguard) {
+    const double inside = region_->length_fraction_inside(path_to(static_cast<std::size_t>(vertex)));
+    path_trust_ = std::min(1.0, inside / kTrustedPathFraction);
+  }
   if (options_.planner == PlannerKind::kGuided) {
     beacons_.clear();
     const auto path = path_to(static_cast<std::size_t>(vertex));
@@ -217,6 +273,7 @@ PlanResult RrtStar::run() {
   cost_.push_back(0.0);
   children_.emplace_back();
   tree_.insert(problem_.start);
+  note_progress(problem_.start, 0);
   if ((problem_.start - problem_.goal).norm() <= goal_radius_ && free(problem_.start, problem_.goal)) {
     goal_vertices_.push_back(0);
   }
@@ -227,6 +284,7 @@ PlanResult RrtStar::run() {
     if (options_.stop_at_first && result_.first) break;
     if (result_.target) break;
     ++iteration;
+    update_trust(iteration);
     const Eigen::Vector3d x_rand = sample();
     const std::size_t nearest = tree_.nearest(x_rand);
     const Eigen::Vector3d& x_nearest = positions_[nearest];
@@ -262,6 +320,7 @@ PlanResult RrtStar::run() {
     children_.emplace_back();
     tree_.insert(x_new);
     set_parent(v_new, parent, cost_new);
+    note_progress(x_new, iteration);
 
     // Rewire: X_near vertices that x_new reaches more cheaply.
     for (std::size_t c = 0; c < candidates_.size(); ++c) {
@@ -282,6 +341,8 @@ PlanResult RrtStar::run() {
 
   result_.iterations = iteration;
   result_.nodes = positions_.size() - 1;
+  result_.region_samples = region_tries_;
+  result_.region_trust = trust_;
   result_.time_ms = elapsed_ms(t0);
   if (best_vertex_ >= 0) {
     result_.solved = true;
@@ -370,6 +431,7 @@ PlanResult plan(const PlanningProblem& problem, const PlannerOptions& options, c
     throw Error("rewire_factor: must be a finite number >= 1 (Lemma 2's radius condition)");
   }
   if (options.target_cost) require_finite(*options.target_cost, "target_cost");
+  if (options.safeguard_iterations < 1) throw Error("safeguard_iterations: must be >= 1 (k_0 of the safeguard)");
   if (options.planner == PlannerKind::kMiner) {
     if (region == nullptr) throw Error("planner miner: needs a heuristic region");
     region->require_matches(*problem.map, "planner miner");

@@ -15,7 +15,10 @@
 ///                in proportion to their volumes; beacons are the solution's interior vertices.
 ///  - `miner`:    Alg. 1 Lines 5-17: Nonuniform(H) with probability mu_2 before the first
 ///                solution and mu_1 after it, else Uniform(Map). mu_1, mu_2 < 1, which is what
-///                keeps Lemma 1 (probabilistic completeness) whatever H is.
+///                keeps Lemma 1 (probabilistic completeness) whatever H is. With the
+///                safeguard (default, REQ-PLAN-020) mu is scaled online by a trust
+///                tau_t in [0, 1] that falls when H proves poor, so sampling moves toward
+///                Uniform(Map); tau_t <= 1 keeps Lemma 1.
 ///
 /// Every policy first draws x_goal itself with probability `goal_bias` (as OMPL does).
 ///
@@ -68,6 +71,11 @@ struct PlannerOptions {
   double mu_1 = 0.5;         ///< miner: P(sample H) after the first solution
   double mu_2 = 0.9;         ///< miner: P(sample H) before the first solution
   double guided_local_fraction = 0.5;  ///< guided: P(local subset) after the first solution
+  /// miner: scale mu by the region's trust tau_t (REQ-PLAN-020); false: the paper's fixed mu.
+  bool safeguard = true;
+  /// miner safeguard: k_0, the patience before the first solution: after k_0 iterations
+  /// without the tree getting closer to x_goal through H, tau_t = k_0 / (iterations stalled).
+  std::size_t safeguard_iterations = 300;
   std::optional<double> target_cost;   ///< stop as soon as the cost is <= this
   bool stop_at_first = false;          ///< stop at the first solution (Alg. 1 Line 24)
   bool record_tree = false;            ///< keep the final tree in the result
@@ -115,6 +123,10 @@ struct PlanResult {
   std::optional<StageRecord> target;
   std::vector<StageRecord> improvements;  ///< every time the best cost dropped
   double time_ms = 0.0;
+  /// miner: samples drawn from H, and the trust tau of the last iteration (1 without the
+  /// safeguard or for the other planners).
+  std::size_t region_samples = 0;
+  double region_trust = 1.0;
   double steer_step = 0.0;   ///< the eta and r actually used (defaults resolved)
   double goal_radius = 0.0;
   /// The final tree when options.record_tree: vertex positions, parent indices (-1: root)

@@ -97,3 +97,23 @@ TEST_CASE("A region must match the map's bounds and hold at least one cell", "[R
   CHECK_THROWS_WITH(empty.require_matches(map, "planner miner"), Contains("no cell with probability >= threshold"));
   CHECK_THROWS_AS(empty.sample(*std::make_unique<miner::Rng>(1)), miner::Error);
 }
+
+TEST_CASE("Hops through H and a path's share in H are measured on the region's cells", "[REQ-PLAN-020]") {
+  // 4 x 2 x 1 cells over [0,8] x [0,2] x [0,1]; H = cells 0, 1, 2 (the row y = 0, x < 6) and 7.
+  std::vector<double> p(8, 0.0);
+  for (int c : {0, 1, 2, 7}) p[static_cast<std::size_t>(c)] = 1.0;
+  const HeuristicRegion r(Box{{0, 0, 0}, {8, 2, 1}}, I(4, 2, 1), p, 0.5);
+  CHECK(r.cell_at(V(0.5, 0.5, 0.5)) == 0);
+  CHECK(r.cell_at(V(8, 2, 1)) == 7);  // the max faces belong to the last cells
+  CHECK(r.cell_at(V(8.5, 0.5, 0.5)) == -1);
+  // From cell 0: 1 and 2 by chain, 7 = (3, 1) touches 2 = (2, 0) at a corner edge.
+  CHECK(r.hops_to(V(0.5, 0.5, 0.5)) == std::vector<int>{0, 1, 2, -1, -1, -1, -1, 3});
+  // The source cell counts as in H even when it is not; cells off H are never entered.
+  CHECK(r.hops_to(V(0.5, 1.5, 0.5)) == std::vector<int>{1, 1, 2, -1, 0, -1, -1, 3});
+  CHECK(r.hops_to(V(9, 0, 0)) == std::vector<int>(8, -1));
+  // A path along y = 0.5 from x = 0 to 8: cells 0-2 hold 6 of its 8 m.
+  CHECK(r.length_fraction_inside({V(0, 0.5, 0.5), V(8, 0.5, 0.5)}) == Approx(0.75));
+  CHECK(r.length_fraction_inside({V(0, 1.5, 0.5), V(6, 1.5, 0.5)}) == 0.0);
+  CHECK(r.length_fraction_inside({V(0, 1.5, 0.5), V(6, 1.5, 0.5), V(6, 0.5, 0.5), V(6.5, 1.5, 0.5)}) > 0.0);
+  CHECK(r.length_fraction_inside({V(1, 1, 1)}) == 0.0);
+}

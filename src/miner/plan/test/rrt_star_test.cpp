@@ -211,6 +211,9 @@ TEST_CASE("Invalid planner options and a missing or mismatched region are refuse
   o.steer_step = 0;
   o.target_cost = INFINITY;
   CHECK_THROWS_WITH(miner::plan::plan(problem, o, &region), Contains("target_cost"));
+  o.target_cost.reset();
+  o.safeguard_iterations = 0;
+  CHECK_THROWS_WITH(miner::plan::plan(problem, o, &region), Contains("safeguard_iterations"));
   CHECK_THROWS_WITH(miner::plan::planner_from_name("rrt"), Contains("rrtstar, informed, guided, miner"));
   CHECK(miner::plan::planner_from_name("guided") == PlannerKind::kGuided);
   PlanningProblem no_map;
@@ -227,4 +230,42 @@ TEST_CASE("A start inside the goal region is solved at once", "[REQ-PLAN-001]") 
   CHECK(r.iterations == 0);
   CHECK(r.path == std::vector<V>{problem.start, problem.goal});
   CHECK(r.cost == Approx(0.5));
+}
+
+TEST_CASE("The safeguard keeps full trust in a region the solution runs through and lowers it otherwise", "[REQ-PLAN-020]") {
+  const auto map = miner::testing::wall_with_door_map();
+  const auto problem = PlanningProblem::make(map, V(1, 1, 0.5), V(9, 1, 0.5), 0.1);
+  const HeuristicRegion good = astar_region(problem);
+  // H = the start's corner only: no chain of its cells reaches x_goal's cell.
+  std::vector<double> p(10 * 10 * 3, 0.0);
+  const HeuristicRegion shape(map.bounds(), I(10, 10, 3), p, 0.5);
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 3; ++i) p[shape.index(i, j, k)] = 1.0;
+  const HeuristicRegion corner(map.bounds(), I(10, 10, 3), p, 0.5, "corner");
+  PlannerOptions o;
+  o.planner = PlannerKind::kMiner;
+  o.max_iterations = 3000;
+  o.seed = 3;
+  const PlanResult with_good = miner::plan::plan(problem, o, &good);
+  const PlanResult with_corner = miner::plan::plan(problem, o, &corner);
+  REQUIRE(with_good.solved);
+  REQUIRE(with_corner.solved);
+  // The solution runs through the A* tube: tau = 1 and mu_1 = 0.5 of the samples go to H.
+  CHECK(with_good.region_trust == 1.0);
+  CHECK(good.length_fraction_inside(with_good.path) >= 0.75);
+  CHECK(with_good.region_samples > o.max_iterations / 3);
+  // The corner holds a sliver of the path: tau is its share / 0.75, and H gets few samples.
+  const double f = corner.length_fraction_inside(with_corner.path);
+  CHECK(f < 0.25);
+  CHECK(with_corner.region_trust == Approx(f / 0.75));
+  CHECK(with_corner.region_samples < with_good.region_samples / 3);
+  // Without the safeguard the trust stays 1 and H gets its fixed share.
+  o.safeguard = false;
+  const PlanResult paper = miner::plan::plan(problem, o, &corner);
+  CHECK(paper.region_trust == 1.0);
+  CHECK(paper.region_samples > 2 * with_corner.region_samples);
+  // The other planners draw nothing from H.
+  o.planner = PlannerKind::kRrtStar;
+  CHECK(miner::plan::plan(problem, o, &good).region_samples == 0);
 }

@@ -13,7 +13,9 @@
 #include "miner/heuristic/dataset.hpp"
 #include "miner/heuristic/region_filter.hpp"
 #include "miner/heuristic/sgan.hpp"
+#include "miner/heuristic/strict_quality.hpp"
 #include "miner/world/map_generator.hpp"
+#include "miner/world/voxel_grid.hpp"
 
 namespace miner::bench {
 
@@ -54,91 +56,153 @@ HeuristicBenchResult run_heuristic_bench(const HeuristicBenchOptions& o, std::os
   if (o.samples < 0) throw Error("--samples: must be >= 0");
   if (o.max_iterations < 1) throw Error("--iterations: must be >= 1");
   if (!(o.target_factor > 0.0)) throw Error("--target-factor: must be > 0");
+  if (o.data.empty()) throw Error("--data: at least one `miner dataset` folder");
   const Clock::time_point t_start = Clock::now();
-  const Json meta = read_json_file(o.data + "/dataset.json");
   HeuristicBenchResult out;
   out.options = o;
-  out.preset = JsonField(meta, "", o.data + "/dataset.json").at("preset").string();
-  const world::GeneratorPreset preset = world::generator_preset(out.preset);
-  std::vector<heuristic::Sample> split = heuristic::read_split(o.data, o.split);
-  if (o.samples > 0 && static_cast<std::size_t>(o.samples) < split.size()) split.resize(static_cast<std::size_t>(o.samples));
-  if (split.empty()) throw Error(o.data + ": split '" + o.split + "' has no samples");
   const heuristic::Sgan sgan = heuristic::Sgan::load_or_builtin(o.weights);
-  const Eigen::Vector3i dims(meta["dims"][0].get<int>(), meta["dims"][1].get<int>(), meta["dims"][2].get<int>());
-  if (dims != sgan.architecture().dims)
-    throw Error(o.data + ": the dataset's grid differs from the weights' grid (" + sgan.path() + ")");
+  // Every folder is read and checked before the first sample is measured.
+  struct Family {
+    std::string data, preset;
+    std::vector<heuristic::Sample> split;
+  };
+  std::vector<Family> families;
+  std::size_t total = 0;
+  for (const std::string& data : o.data) {
+    const Json meta = read_json_file(data + "/dataset.json");
+    Family f{data, JsonField(meta, "", data + "/dataset.json").at("preset").string(), {}};
+    for (const Family& g : families)
+      if (g.preset == f.preset) throw Error(data + ": family '" + f.preset + "' is already measured from " + g.data);
+    f.split = heuristic::read_split(data, o.split);
+    if (o.samples > 0 && static_cast<std::size_t>(o.samples) < f.split.size()) f.split.resize(static_cast<std::size_t>(o.samples));
+    if (f.split.empty()) throw Error(data + ": split '" + o.split + "' has no samples");
+    const Eigen::Vector3i dims(meta["dims"][0].get<int>(), meta["dims"][1].get<int>(), meta["dims"][2].get<int>());
+    if (dims != sgan.architecture().dims)
+      throw Error(data + ": the dataset's grid differs from the weights' grid (" + sgan.path() + ")");
+    total += f.split.size();
+    out.families.push_back(f.preset);
+    out.data_label += (out.data_label.empty() ? "" : ", ") + data;
+    families.push_back(std::move(f));
+  }
 
-  ProgressBar bar(progress, "heuristic", split.size());
-  for (std::size_t k = 0; k < split.size(); ++k) {
-    const heuristic::Sample& s = split[k];
-    const world::Map map = world::generate_map(preset, s.map_seed);
-    HeuristicSampleRecord rec;
-    rec.map_seed = s.map_seed;
-    const Clock::time_point t0 = Clock::now();
-    const heuristic::HeuristicQuery q =
-        heuristic::query_region(sgan, map, s.start, s.goal, preset.robot_radius, o.seed + k);
-    rec.region_ms = elapsed_ms(t0);
-    rec.inference_ms = q.inference_ms;
-    rec.raw_connected = q.report.raw_connected;
-    rec.raw_safe = q.report.raw_safe;
-    rec.connected = q.report.connected;
-    rec.safe = q.report.safe;
-    rec.raw_cells = q.report.raw_cells;
-    rec.cells = q.report.cells;
-    rec.bridge_cells = q.report.bridge_cells;
-    if (o.planners) {
-      const plan::PlanningProblem problem = plan::PlanningProblem::make(map, s.start, s.goal, preset.robot_radius);
-      plan::PlannerOptions po;
-      po.max_iterations = o.max_iterations;
-      po.target_cost = o.target_factor * s.astar_cost;
-      po.seed = o.seed;
-      po.stream = k;  // common random numbers for the two planners
-      po.planner = plan::PlannerKind::kMiner;
-      rec.miner = plan::plan(problem, po, &q.region);
-      plan::add_setup_time(rec.miner, rec.region_ms);
-      po.planner = plan::PlannerKind::kRrtStar;
-      rec.rrtstar = plan::plan(problem, po);
+  ProgressBar bar(progress, "heuristic", total);
+  std::size_t k = 0;  // sample number over all families: noise seed + k, planner stream k
+  for (const Family& family : families) {
+    const world::GeneratorPreset preset = world::generator_preset(family.preset);
+    for (const heuristic::Sample& s : family.split) {
+      const world::Map map = world::generate_map(preset, s.map_seed);
+      HeuristicSampleRecord rec;
+      rec.family = family.preset;
+      rec.map_seed = s.map_seed;
+      const Clock::time_point t0 = Clock::now();
+      const heuristic::HeuristicQuery q =
+          heuristic::query_region(sgan, map, s.start, s.goal, preset.robot_radius, o.seed + k);
+      rec.region_ms = elapsed_ms(t0);
+      rec.inference_ms = q.inference_ms;
+      rec.raw_connected = q.report.raw_connected;
+      rec.raw_safe = q.report.raw_safe;
+      rec.connected = q.report.connected;
+      rec.safe = q.report.safe;
+      rec.raw_cells = q.report.raw_cells;
+      rec.cells = q.report.cells;
+      rec.bridge_cells = q.report.bridge_cells;
+      // Strict quality (REQ-HEUR-011) on the map's voxels, raw and filtered.
+      const world::VoxelGrid voxels(map, preset.robot_radius);
+      const plan::HeuristicRegion raw(map.bounds(), sgan.architecture().dims,
+                                      std::vector<double>(q.probabilities.begin(), q.probabilities.end()),
+                                      sgan.architecture().threshold, "sgan-raw");
+      const heuristic::StrictQuality raw_strict = heuristic::strict_quality(map, voxels, raw, s.start, s.goal);
+      const heuristic::StrictQuality strict = heuristic::strict_quality(map, voxels, q.region, s.start, s.goal);
+      const plan::HeuristicRegion truth(map.bounds(), sgan.architecture().dims,
+                                        std::vector<double>(s.target.begin(), s.target.end()), 0.5, "astar-dilated");
+      const heuristic::StrictQuality truth_strict = heuristic::strict_quality(map, voxels, truth, s.start, s.goal);
+      rec.truth_connected_strict = truth_strict.connected;
+      rec.truth_safe_strict = truth_strict.safe;
+      rec.raw_connected_strict = raw_strict.connected;
+      rec.raw_safe_strict = raw_strict.safe;
+      rec.connected_strict = strict.connected;
+      rec.safe_strict = strict.safe;
+      if (o.planners) {
+        const plan::PlanningProblem problem = plan::PlanningProblem::make(map, s.start, s.goal, preset.robot_radius);
+        plan::PlannerOptions po;
+        po.max_iterations = o.max_iterations;
+        po.target_cost = o.target_factor * s.astar_cost;
+        po.seed = o.seed;
+        po.stream = k;  // common random numbers for the two planners
+        po.planner = plan::PlannerKind::kMiner;
+        rec.miner = plan::plan(problem, po, &q.region);
+        plan::add_setup_time(rec.miner, rec.region_ms);
+        po.planner = plan::PlannerKind::kRrtStar;
+        rec.rrtstar = plan::plan(problem, po);
+      }
+      out.samples.push_back(std::move(rec));
+      bar.update(++k);
     }
-    out.samples.push_back(std::move(rec));
-    bar.update(k + 1);
   }
   bar.finish();
   out.total_s = std::chrono::duration<double>(Clock::now() - t_start).count();
   return out;
 }
 
-nlohmann::json to_json(const HeuristicBenchResult& r) {
+namespace {
+
+/// Quality, timing and planner figures over a set of samples (all, or one family's).
+nlohmann::json quality_json(const std::vector<HeuristicSampleRecord>& samples, bool planners) {
   std::vector<double> inference, region, raw_cells, cells;
   std::size_t bridged = 0;
-  for (const auto& s : r.samples) {
+  for (const auto& s : samples) {
     inference.push_back(s.inference_ms);
     region.push_back(s.region_ms);
     raw_cells.push_back(static_cast<double>(s.raw_cells));
     cells.push_back(static_cast<double>(s.cells));
     bridged += s.bridge_cells > 0 ? 1 : 0;
   }
-  nlohmann::json j = {{"data", r.options.data},
-                      {"split", r.options.split},
-                      {"preset", r.preset},
-                      {"weights", r.options.weights.empty() ? "builtin" : r.options.weights},
-                      {"samples", r.samples.size()},
-                      {"seed", r.options.seed},
-                      {"connectivity_rate_raw", rate(r.samples, &HeuristicSampleRecord::raw_connected)},
-                      {"safety_rate_raw", rate(r.samples, &HeuristicSampleRecord::raw_safe)},
-                      {"connectivity_rate_filtered", rate(r.samples, &HeuristicSampleRecord::connected)},
-                      {"safety_rate_filtered", rate(r.samples, &HeuristicSampleRecord::safe)},
-                      {"bridged_rate", static_cast<double>(bridged) / static_cast<double>(std::max<std::size_t>(r.samples.size(), 1))},
+  using R = HeuristicSampleRecord;
+  nlohmann::json j = {{"samples", samples.size()},
+                      {"connectivity_rate_raw", rate(samples, &R::raw_connected)},
+                      {"safety_rate_raw", rate(samples, &R::raw_safe)},
+                      {"connectivity_rate_filtered", rate(samples, &R::connected)},
+                      {"safety_rate_filtered", rate(samples, &R::safe)},
+                      {"connectivity_rate_strict", rate(samples, &R::raw_connected_strict)},
+                      {"safety_rate_strict", rate(samples, &R::raw_safe_strict)},
+                      {"connectivity_rate_strict_filtered", rate(samples, &R::connected_strict)},
+                      {"safety_rate_strict_filtered", rate(samples, &R::safe_strict)},
+                      {"connectivity_rate_strict_truth", rate(samples, &R::truth_connected_strict)},
+                      {"safety_rate_strict_truth", rate(samples, &R::truth_safe_strict)},
+                      {"bridged_rate", static_cast<double>(bridged) / static_cast<double>(std::max<std::size_t>(samples.size(), 1))},
                       {"raw_cells_median", num(median(raw_cells))},
                       {"cells_median", num(median(cells))},
                       {"inference_ms", num(median(inference))},
-                      {"region_ms", num(median(region))},
-                      {"total_s", r.total_s}};
+                      {"region_ms", num(median(region))}};
+  if (planners) {
+    j["miner"] = stage_summary(samples, &R::miner);
+    j["rrtstar"] = stage_summary(samples, &R::rrtstar);
+  }
+  return j;
+}
+
+}  // namespace
+
+nlohmann::json to_json(const HeuristicBenchResult& r) {
+  nlohmann::json j = quality_json(r.samples, r.options.planners);
+  j["data"] = r.data_label;
+  j["split"] = r.options.split;
+  j["preset"] = r.families.size() == 1 ? r.families.front() : std::string("mixed");
+  j["weights"] = r.options.weights.empty() ? "builtin" : r.options.weights;
+  j["seed"] = r.options.seed;
+  j["total_s"] = r.total_s;
   if (r.options.planners) {
     j["max_iterations"] = r.options.max_iterations;
     j["target_factor"] = r.options.target_factor;
-    j["miner"] = stage_summary(r.samples, &HeuristicSampleRecord::miner);
-    j["rrtstar"] = stage_summary(r.samples, &HeuristicSampleRecord::rrtstar);
   }
+  nlohmann::json families = nlohmann::json::object();
+  for (const std::string& family : r.families) {
+    std::vector<HeuristicSampleRecord> of;
+    for (const auto& s : r.samples)
+      if (s.family == family) of.push_back(s);
+    families[family] = quality_json(of, r.options.planners);
+  }
+  j["families"] = families;
   return j;
 }
 
@@ -146,12 +210,19 @@ std::string to_text(const HeuristicBenchResult& r) {
   const nlohmann::json j = to_json(r);
   std::ostringstream s;
   s << std::fixed << std::setprecision(1);
-  s << "sGAN on " << r.options.data << " (" << r.options.split << ", " << r.samples.size() << " samples, preset "
-    << r.preset << ")\n"
+  s << "sGAN on " << r.data_label << " (" << r.options.split << ", " << r.samples.size() << " samples, preset "
+    << j["preset"].get<std::string>() << ")\n"
     << "connectivity: raw " << 100.0 * j["connectivity_rate_raw"].get<double>() << " %, filtered "
     << 100.0 * j["connectivity_rate_filtered"].get<double>() << " %\n"
     << "safety:       raw " << 100.0 * j["safety_rate_raw"].get<double>() << " %, filtered "
     << 100.0 * j["safety_rate_filtered"].get<double>() << " %\n"
+    << "strict (continuous map, REQ-HEUR-011): connectivity raw "
+    << 100.0 * j["connectivity_rate_strict"].get<double>() << " %, filtered "
+    << 100.0 * j["connectivity_rate_strict_filtered"].get<double>() << " %; safety raw "
+    << 100.0 * j["safety_rate_strict"].get<double>() << " %, filtered "
+    << 100.0 * j["safety_rate_strict_filtered"].get<double>() << " % (ground truth T: "
+    << 100.0 * j["connectivity_rate_strict_truth"].get<double>() << " % / "
+    << 100.0 * j["safety_rate_strict_truth"].get<double>() << " %)\n"
     << "bridged by the filter: " << 100.0 * j["bridged_rate"].get<double>() << " % of queries\n"
     << std::setprecision(2) << "median inference " << j["inference_ms"].get<double>() << " ms, region (encode + "
     << "inference + filter) " << j["region_ms"].get<double>() << " ms\n";

@@ -5,6 +5,8 @@
 /// never seen in training, plus what the region buys the planner: iterations and time to
 /// the first solution and to the target cost for MINER with the filtered sGAN region
 /// (region time included) and for RRT*, on the same queries with the same random streams.
+/// Several datasets (one map family each) give one summary per family besides the total
+/// (REQ-HEUR-009); strict rates are measured on the continuous map (REQ-HEUR-011).
 
 #include <cstdint>
 #include <iosfwd>
@@ -18,7 +20,7 @@
 namespace miner::bench {
 
 struct HeuristicBenchOptions {
-  std::string data;             ///< a `miner dataset` folder
+  std::vector<std::string> data;  ///< `miner dataset` folders (one family each)
   std::string split = "test";
   int samples = 0;              ///< first N samples of the split (0: all)
   std::string weights;          ///< empty: the shipped weights
@@ -29,8 +31,14 @@ struct HeuristicBenchOptions {
 };
 
 struct HeuristicSampleRecord {
+  std::string family;  ///< the dataset's preset
   std::uint64_t map_seed = 0;
   bool raw_connected = false, raw_safe = false, connected = false, safe = false;
+  /// REQ-HEUR-011 on the continuous map, for the raw and the filtered region.
+  bool raw_connected_strict = false, raw_safe_strict = false, connected_strict = false, safe_strict = false;
+  /// The same for the sample's ground truth T (the A*-dilated region): what a perfect
+  /// network would score.
+  bool truth_connected_strict = false, truth_safe_strict = false;
   std::size_t raw_cells = 0, cells = 0, bridge_cells = 0;
   double inference_ms = 0.0, region_ms = 0.0;  ///< region: encode + inference + filter
   plan::PlanResult miner, rrtstar;
@@ -38,7 +46,8 @@ struct HeuristicSampleRecord {
 
 struct HeuristicBenchResult {
   HeuristicBenchOptions options;
-  std::string preset;
+  std::string data_label;            ///< what the data was (the folders, or how it was generated)
+  std::vector<std::string> families;  ///< presets in the order of the datasets
   std::vector<HeuristicSampleRecord> samples;
   double total_s = 0.0;
 };

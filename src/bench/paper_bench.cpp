@@ -190,9 +190,9 @@ PaperBenchResult run_paper_bench(const PaperBenchOptions& o, const std::string& 
     d.jobs = std::max(1, o.jobs);
     if (progress) *progress << "generating " << o.heuristic_samples << " unseen heuristic test samples\n";
     heuristic::write_dataset(d, generated, progress);
-    ho.data = generated;
+    ho.data = {generated};
   } else {
-    ho.data = o.heuristic_data;
+    ho.data = {o.heuristic_data};
   }
   try {
     out.heuristic = run_heuristic_bench(ho, progress);
@@ -202,7 +202,7 @@ PaperBenchResult run_paper_bench(const PaperBenchOptions& o, const std::string& 
   }
   if (!generated.empty()) {
     std::filesystem::remove_all(generated);
-    out.heuristic.options.data = "(generated: miner dataset --count 1 --test-count " +
+    out.heuristic.data_label = "(generated: miner dataset --count 1 --test-count " +
                                  std::to_string(o.heuristic_samples) + " --seed " +
                                  std::to_string(unseen_heuristic_seed(o.seed)) + ")";
   }
@@ -290,7 +290,7 @@ std::string results_markdown(const PaperBenchResult& r, const std::string& figur
 
   const auto h = to_json(r.heuristic);
   md << "## Heuristic quality (" << r.heuristic.samples.size() << " unseen maps)\n\n"
-     << "Data: " << r.heuristic.options.data << ". Exact definitions of connected and safe: spec/heuristic.md "
+     << "Data: " << r.heuristic.data_label << ". Exact definitions of connected and safe: spec/heuristic.md "
         "REQ-HEUR-004. Raw = the network's thresholded output; filtered = after Alg. 1 line 3's filter.\n\n"
      << "| method | connectivity rate | safety rate |\n|---|---|---|\n"
      << "| Li et al. (paper) | 91.53 % | 91.90 % |\n| Ma et al. (paper) | 91.80 % | 92.40 % |\n"

@@ -119,7 +119,8 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   auto h = std::make_shared<HeuristicOptions>();
   CLI::App* hc = bench_cmd->add_subcommand(
       "heuristic", "sGAN quality like the paper's heuristic table, and what its region buys MINER over RRT*");
-  hc->add_option("--data", h->bench.data, "a `miner dataset` folder")->required();
+  hc->add_option("--data", h->bench.data, "`miner dataset` folders, one map family each (a summary per family)")
+      ->required();
   hc->add_option("--split", h->bench.split, "split to measure (test: map seeds never trained on)")->capture_default_str();
   hc->add_option("--samples", h->bench.samples, "first N samples of the split (0: all)")->capture_default_str();
   hc->add_option("--weights", h->bench.weights, "sGAN weights (default: the shipped fixtures/sgan/sgan.bin)");

@@ -619,6 +619,33 @@ TEST_CASE("miner bench heuristic measures raw and filtered quality and the plann
   CHECK(doc["inference_ms"].get<double>() > 0.0);
   CHECK(doc["miner"]["success_rate"].get<double>() > 0.0);
   CHECK(doc["rrtstar"].contains("target_time_ms"));
+  // Strict rates (REQ-HEUR-011) for raw, filtered and the ground truth, which A* connects.
+  for (const char* k : {"connectivity_rate_strict", "safety_rate_strict", "connectivity_rate_strict_filtered",
+                        "safety_rate_strict_filtered", "safety_rate_strict_truth"}) {
+    CHECK(doc[k].get<double>() >= 0.0);
+    CHECK(doc[k].get<double>() <= 1.0);
+  }
+  CHECK(doc["connectivity_rate_strict_truth"] == 1.0);
+  // One family: its summary is the total.
+  REQUIRE(doc["families"].size() == 1);
+  CHECK(doc["families"]["sim"]["samples"] == 3);
+  CHECK(doc["families"]["sim"]["connectivity_rate_strict"] == doc["connectivity_rate_strict"]);
+  // Two families: a summary each, the total over both; the same family twice is refused.
+  const std::string rooms = dir() + "/bench-data-rooms";
+  REQUIRE(miner_cli({"dataset", "--preset", "rooms", "--count", "1", "--test-count", "2", "--seed", "8", "--out", rooms})
+              .code == 0);
+  const Run two = miner_cli({"bench", "heuristic", "--data", data, rooms, "--no-planners", "--json"});
+  INFO(two.err);
+  REQUIRE(two.code == 0);
+  const miner::Json both = miner::parse_json(two.out, "stdout");
+  CHECK(both["samples"] == 5);
+  CHECK(both["preset"] == "mixed");
+  CHECK(both["families"]["sim"]["samples"] == 3);
+  CHECK(both["families"]["rooms"]["samples"] == 2);
+  CHECK(both["families"]["sim"]["connectivity_rate_raw"] == doc["connectivity_rate_raw"]);
+  const Run twice = miner_cli({"bench", "heuristic", "--data", data, data, "--no-planners"});
+  CHECK(twice.code == 1);
+  CHECK_THAT(twice.err, Contains("already measured"));
   const Run text = miner_cli({"bench", "heuristic", "--data", data, "--samples", "1", "--no-planners"});
   REQUIRE(text.code == 0);
   CHECK_THAT(text.out, Contains("connectivity: raw") && !Contains("rrtstar"));

@@ -1,6 +1,8 @@
 #include "bench/paper_bench.hpp"
 
 #include <chrono>
+#include <cmath>
+#include <limits>
 #include <cstdio>
 #include <filesystem>
 #include <iomanip>
@@ -48,6 +50,10 @@ const PaperFrontRow kPaperTable1[3][4] = {
      {"I-RRT*", {2192.7, 1882.3, 99.3, 10.2, 3930.5, 3519.0, 26.5}},
      {"G-RRT*", {1937.9, 1706.8, 98.0, 9.9, 5680.8, 5294.3, 44.3}},
      {"Ours", {209.7, 198.5, 81.9, 2.0, 380.7, 314.2, 4.6}}}};
+/// `miner` samples the A*-dilated region built from the same A* path that defines the
+/// target: an upper bound on what a learned region can give, never a headline.
+constexpr const char* kOraclePlanner = "miner";
+
 /// The paper's planner names for the project's planners.
 const char* paper_name(const std::string& planner) {
   if (planner == "rrtstar") return "RRT*";
@@ -106,6 +112,55 @@ const BackendRecord* find_record(const std::vector<BackendRecord>& records, cons
   for (const auto& r : records)
     if (r.method == method && r.order == order && !r.skipped) return &r;
   return nullptr;
+}
+
+/// The map's headline, generated from its campaign: the fastest planner to the target and
+/// to the first solution (medians, misses as +inf) among every planner run except the
+/// oracle, miner-sgan's ratio to it, and whether the paper's claims reproduce here.
+
+std::string headline(const FrontendBenchResult& fr, const std::vector<std::string>& planners) {
+  std::vector<std::string> set;
+  for (const auto& p : planners)
+    if (p != kOraclePlanner && find_summary(fr, p)) set.push_back(p);
+  const auto value = [](const PlannerSummary* s, bool target) {
+    const double v = target ? s->target_time_ms : s->first_time_ms;
+    return std::isfinite(v) ? v : std::numeric_limits<double>::infinity();
+  };
+  std::ostringstream h;
+  h << "**Headline (generated; comparison set: " << set.size() << " planners, every one run here except the oracle: ";
+  for (std::size_t i = 0; i < set.size(); ++i) h << (i ? ", " : "") << "`" << set[i] << "`";
+  h << ").**";
+  const PlannerSummary* ours = find_summary(fr, kMinerSgan);
+  for (const bool target : {true, false}) {
+    const char* stage = target ? "the target" : "the first solution";
+    std::string best;
+    double best_v = std::numeric_limits<double>::infinity();
+    for (const auto& p : set) {
+      const double v = value(find_summary(fr, p), target);
+      if (v < best_v) best_v = v, best = p;
+    }
+    if (best.empty()) {
+      h << " No planner reached " << stage << " in half its runs.";
+      continue;
+    }
+    h << " Fastest to " << stage << " (median): `" << best << "`, " << f(best_v, 2) << " ms.";
+    if (!ours) continue;
+    const double mine = value(ours, target);
+    if (best == kMinerSgan) {
+      // The margin over the runner-up.
+      double second = std::numeric_limits<double>::infinity();
+      for (const auto& p : set)
+        if (p != kMinerSgan) second = std::min(second, value(find_summary(fr, p), target));
+      h << " miner-sgan is the fastest, " << (std::isfinite(second) ? f(second / mine, 2) + "x" : std::string("alone"))
+        << " ahead of the next.";
+    } else {
+      h << " miner-sgan: " << (std::isfinite(mine) ? f(mine, 2) + " ms, " + f(mine / best_v, 2) + "x the fastest" : "—")
+        << ".";
+    }
+    h << " The paper's claim (MINER reaches " << stage << " before every baseline) "
+      << (best == kMinerSgan ? "reproduces" : "does **not** reproduce") << " on this map.";
+  }
+  return h.str();
 }
 
 }  // namespace
@@ -276,7 +331,8 @@ std::string results_markdown(const PaperBenchResult& r, const std::string& figur
                << f(row.v[2], 1) << " | " << f(row.v[3], 1) << " | " << f(row.v[4], 1) << " | " << f(row.v[5], 1)
                << " | " << f(row.v[6], 1) << " | 50 (means) | — | — | — |\n";
       const bool ompl = is_ompl_planner(planner);
-      md << "| " << (pn ? pn : planner.c_str()) << " | " << (ompl ? "OMPL " : "MINER ") << "`" << planner << "` | "
+      md << "| " << (pn ? pn : planner == kOraclePlanner ? "A* oracle region (upper bound)" : planner.c_str()) << " | "
+         << (ompl ? "OMPL " : "MINER ") << "`" << planner << "` | "
          << pct(s->success_rate) << " | " << f(s->first_iterations, 1) << " | " << f(s->first_nodes, 1) << " | "
          << f(s->first_cost, 1) << " | " << f(s->first_time_ms, 2) << " | " << f(s->target_iterations, 1) << " | "
          << f(s->target_nodes, 1) << " | " << f(s->target_time_ms, 2) << " | " << s->runs << " | " << s->target_reached
@@ -284,6 +340,7 @@ std::string results_markdown(const PaperBenchResult& r, const std::string& figur
          << f(s->target_time_ms, 2) << " [" << f(s->target_time_ms_q1, 2) << ", " << f(s->target_time_ms_q3, 2)
          << "] |\n";
     }
+    md << "\n" << headline(fr, r.options.planners) << "\n";
     md << "\n![" << fr.map << " first](" << figure_dir << "/" << fr.map << "-first.svg) ![" << fr.map << " target]("
        << figure_dir << "/" << fr.map << "-target.svg)\n\n";
   }

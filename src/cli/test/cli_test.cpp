@@ -398,7 +398,7 @@ TEST_CASE("miner bench paper writes the four tables beside the paper's numbers, 
   const std::string src = std::getenv("MINER_SOURCE_DIR") ? std::getenv("MINER_SOURCE_DIR") : ".";
   const std::string results = dir() + "/paper/results.md";
   const Run r = miner_cli({"bench", "paper", "--maps", src + "/fixtures/maps/sim-1.json", "--planners",
-                           "rrtstar,miner-sgan,ompl:RRTConnect", "--runs", "2", "--time-limit", "0.2",
+                           "rrtstar,miner-sgan,miner,ompl:RRTConnect", "--runs", "2", "--time-limit", "0.2",
                            "--heuristic-samples", "2", "--heuristic-iterations", "300", "--backend-budget", "0.005",
                            "--tracking-maps", src + "/fixtures/maps/indoor-2.json", "--results", results, "--quiet"});
   INFO(r.err);
@@ -410,6 +410,12 @@ TEST_CASE("miner bench paper writes the four tables beside the paper's numbers, 
   CHECK_THAT(md, Contains("| RRT* | paper | — | 737.0 | 590.4 | 99.4 | 2.1 | 34007.9 | 30579.4 | 491.1 |"));
   CHECK_THAT(md, Contains("| RRT* | MINER `rrtstar` |") && Contains("| Ours | MINER `miner-sgan` |") &&
                      Contains("OMPL `ompl:RRTConnect`"));
+  // The oracle is labelled an upper bound and left out of the generated headline, whose
+  // comparison set names every other planner run (issue 17 items 4-5).
+  CHECK_THAT(md, Contains("| A* oracle region (upper bound) | MINER `miner` |"));
+  CHECK_THAT(md, Contains("**Headline (generated; comparison set: 3 planners, every one run here except the oracle: "
+                          "`rrtstar`, `miner-sgan`, `ompl:RRTConnect`).**"));
+  CHECK_THAT(md, Contains("Fastest to the first solution (median): `") && Contains("reproduce"));
   CHECK_THAT(md, Contains("| Ours (paper) | 96.3 % | 97.1 % |") && Contains("| MINER sGAN, filtered | 100.0 % | 100.0 % |"));
   CHECK_THAT(md, Contains("0.0023/0.0043") && Contains("| Map1 | paper (real flight) | 0.0513 |"));
   CHECK_THAT(md, Contains("| indoor-1 | MINER (simulation) |") && Contains("| indoor-2 | MINER (simulation) |"));

@@ -13,7 +13,6 @@
 #include "miner/plan/informed_set.hpp"
 #include "miner/plan/kd_tree.hpp"
 #include "miner/world/map.hpp"
-#include "miner/world/voxel_grid.hpp"
 
 namespace miner::plan {
 
@@ -63,7 +62,7 @@ class RrtStar {
       region_connected_ = c >= 0 && goal_hops_[static_cast<std::size_t>(c)] >= 0;
     }
     gamma_ = options.rewire_factor * std::pow(2.0 * (1.0 + 1.0 / kDimension), 1.0 / kDimension) *
-             std::pow(problem.free_volume / kUnitBallVolume, 1.0 / kDimension);
+             std::pow(problem.sampled_volume / kUnitBallVolume, 1.0 / kDimension);
   }
 
   PlanResult run();
@@ -413,9 +412,7 @@ PlanningProblem PlanningProblem::make(const world::Map& map, const Eigen::Vector
   p.start = start;
   p.goal = goal;
   p.robot_radius = robot_radius;
-  const world::VoxelGrid grid(map, 0.0);
-  const double cell = grid.resolution() * grid.resolution() * grid.resolution();
-  p.free_volume = static_cast<double>(grid.cell_count() - grid.occupied_count()) * cell;
+  p.sampled_volume = map.bounds().volume();
   return p;
 }
 

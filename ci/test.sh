@@ -4,7 +4,7 @@
 #
 #   1. ci/setup.sh installs the Debian packages (idempotent)
 #   2. configure + build preset "ci": Debug, ASan + UBSan, gcov, -Werror
-#   3. ctest (labels unit, property, golden, statistical, bench-smoke; not "long")
+#   3. ctest (labels unit, property, golden, statistical, bench-smoke; not "long" or "cluster")
 #      including the traceability check (build/ci/traceability.md)
 #   4. no sanitizer report anywhere in the test log
 #   5. gcovr: >= 90 % lines and >= 75 % branches over src/ (build/ci/coverage/)

@@ -45,19 +45,24 @@ double median(std::vector<double> v) {
   return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
 }
 
+/// An adversarial H on wall_with_door_map(): the start's side of the wall away from the
+/// door (x in [0, 4), y in [0, 5)); it holds no path to the goal.
+HeuristicRegion adversarial_door_region(const miner::world::Map& map) {
+  std::vector<double> p(10 * 10 * 3, 0.0);
+  const HeuristicRegion grid(map.bounds(), I(10, 10, 3), p, 0.5);
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j < 5; ++j)
+      for (int i = 0; i < 4; ++i) p[grid.index(i, j, k)] = 1.0;
+  return HeuristicRegion(map.bounds(), I(10, 10, 3), p, 0.5, "adversarial");
+}
+
 }  // namespace
 
 TEST_CASE("Lemma 1: miner with a region that holds no path still solves within K iterations", "[REQ-PLAN-012]") {
   const auto map = wall_with_door_map();
   const auto problem = PlanningProblem::make(map, kStart, kGoal, 0.0);
-  // Adversarial H: the start's side of the wall away from the door, x in [0, 4), y in
-  // [0, 5): it holds no path to the goal, yet mu_2 = 0.9 sends 90 % of samples there.
-  std::vector<double> p(10 * 10 * 3, 0.0);
-  HeuristicRegion all(map.bounds(), I(10, 10, 3), p, 0.5);
-  for (int k = 0; k < 3; ++k)
-    for (int j = 0; j < 5; ++j)
-      for (int i = 0; i < 4; ++i) p[all.index(i, j, k)] = 1.0;
-  const HeuristicRegion region(map.bounds(), I(10, 10, 3), p, 0.5, "adversarial");
+  // Adversarial H: no path to the goal, yet mu_2 = 0.9 sends up to 90 % of samples there.
+  const HeuristicRegion region = adversarial_door_region(map);
   REQUIRE_FALSE(region.contains(V(4.5, 8, 0.5)));  // not the door
   REQUIRE_FALSE(region.contains(kGoal));
 
@@ -223,17 +228,6 @@ TEST_CASE("Shared contract: every planner solves the fixture queries", "[REQ-PLA
 }
 
 namespace {
-
-/// The Lemma 1 test's adversarial H on wall_with_door_map(): the start's side of the wall
-/// away from the door (x in [0, 4), y in [0, 5)); it holds no path to the goal.
-HeuristicRegion adversarial_door_region(const miner::world::Map& map) {
-  std::vector<double> p(10 * 10 * 3, 0.0);
-  const HeuristicRegion grid(map.bounds(), I(10, 10, 3), p, 0.5);
-  for (int k = 0; k < 3; ++k)
-    for (int j = 0; j < 5; ++j)
-      for (int i = 0; i < 4; ++i) p[grid.index(i, j, k)] = 1.0;
-  return HeuristicRegion(map.bounds(), I(10, 10, 3), p, 0.5, "adversarial");
-}
 
 /// Iterations to the target cost (+inf on a miss within the budget).
 double iterations_to_target(const PlanningProblem& problem, PlannerKind kind, bool safeguard, std::uint64_t stream,

@@ -121,9 +121,7 @@ class RrtStar {
   long best_vertex_ = -1;
   // Guided RRT* beacons: interior vertices of the current solution, with cost-to-come.
   std::vector<std::pair<Eigen::Vector3d, double>> beacons_;
-  // MINER safeguard (REQ-PLAN-020): samples drawn from H, the trust from the best path,
-  // and tau_t itself.
-  std::size_t region_tries_ = 0;
+  // MINER safeguard (REQ-PLAN-020): the trust from the best path, and tau_t itself.
   double path_trust_ = 1.0;
   double trust_ = 1.0;
   // Progress along H: hops through H's cells from each cell to x_goal's cell, the fewest
@@ -167,7 +165,7 @@ Eigen::Vector3d RrtStar::sample() {
     case PlannerKind::kMiner: {
       const double mu = (solved ? options_.mu_1 : options_.mu_2) * trust_;
       if (rng_.uniform01() < mu) {
-        ++region_tries_;
+        ++result_.region_samples;
         return region_->sample(rng_);
       }
       return sample_uniform();
@@ -340,7 +338,6 @@ PlanResult RrtStar::run() {
 
   result_.iterations = iteration;
   result_.nodes = positions_.size() - 1;
-  result_.region_samples = region_tries_;
   result_.region_trust = trust_;
   result_.time_ms = elapsed_ms(t0);
   if (best_vertex_ >= 0) {

@@ -280,8 +280,11 @@ std::map<std::string, std::string> results_figures(const PaperBenchResult& r) {
       report::BoxGroup a{planner, {}}, b{planner, {}};
       for (const auto& run : fr.runs) {
         if (run.planner != planner) continue;
+        // A run that never got there is shown as a miss, not dropped (issue 17 item 3).
         if (run.result.first) a.values.push_back(run.result.first->time_ms);
+        else ++a.missed;
         if (run.result.target) b.values.push_back(run.result.target->time_ms);
+        else ++b.missed;
       }
       first.push_back(a);
       target.push_back(b);

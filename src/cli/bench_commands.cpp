@@ -13,9 +13,11 @@
 #include "bench/frontend_bench.hpp"
 #include "bench/heuristic_bench.hpp"
 #include "bench/paper_bench.hpp"
+#include "bench/suite_bench.hpp"
 #include "miner/core/progress.hpp"
 #include "cli/cli.hpp"
 #include "miner/core/shard.hpp"
+#include "miner/core/error.hpp"
 #include "miner/core/json_io.hpp"
 
 namespace miner::cli {
@@ -219,6 +221,59 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
     write_folder_atomic(figures.string(), files);
     write_file_atomic(results.string(), bench::results_markdown(r, link));
     if (p->json) out << dump_json(bench::to_json(r));
+    else out << "wrote " << results.string() << " and " << files.size() << " box plots in " << figures.string() << "\n";
+  });
+
+  struct SuiteOptions {
+    bench::SuiteBenchOptions bench;
+    std::string suite = "fixtures/bench/suite.json";
+    std::string results = "docs/suite.md";
+    std::string figures;  // empty: <results folder>/suite
+    bool json = false;
+    bool quiet = false;
+  };
+  auto su = std::make_shared<SuiteOptions>();
+  CLI::App* sc = bench_cmd->add_subcommand(
+      "suite", "Table I over a suite of map families at the paper's difficulty, steering step swept -> docs/suite.md");
+  sc->add_option("--suite", su->suite, "suite file (miner-bench-suite-v1: maps, steps, band)")->capture_default_str();
+  sc->add_option("--planners", su->bench.planners, "planners")->delimiter(',')->capture_default_str();
+  sc->add_option("--runs", su->bench.runs, "runs per planner, map and steering step")->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  sc->add_option("--seed", su->bench.seed, "seed of every campaign")->capture_default_str();
+  sc->add_option("--time-limit", su->bench.time_limit_s, "seconds per run")->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  sc->add_option("--iterations", su->bench.max_iterations, "iteration budget per run")->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  sc->add_option("--weights", su->bench.weights, "sGAN weights (default: the shipped ones)");
+  sc->add_option("--results", su->results, "the Markdown file to write")->capture_default_str();
+  sc->add_option("--figures", su->figures, "folder for the box plots (default: <results folder>/suite)");
+  sc->add_flag("--json", su->json, "print every figure as JSON");
+  sc->add_flag("--quiet", su->quiet, "no progress on stderr");
+  sc->callback([su, &out] {
+    namespace fs = std::filesystem;
+    su->bench.suite = bench::load_suite(su->suite);
+    su->bench.suite_file = su->suite;
+    const fs::path results(su->results);
+    const fs::path figures = su->figures.empty() ? results.parent_path() / "suite" : fs::path(su->figures);
+    // The outputs' folders are checked before the campaigns, not after them.
+    const fs::path results_dir = results.parent_path().empty() ? fs::path(".") : results.parent_path();
+    if (!fs::is_directory(results_dir)) throw Error("--results: folder " + results_dir.string() + " does not exist");
+    std::ostringstream command;
+    command << "miner bench suite --suite " << su->suite << " --runs " << su->bench.runs << " --seed "
+            << su->bench.seed << " --time-limit " << su->bench.time_limit_s << " --iterations "
+            << su->bench.max_iterations;
+    if (!su->bench.weights.empty()) command << " --weights " << su->bench.weights;
+    if (su->bench.planners != bench::SuiteBenchOptions{}.planners) {
+      command << " --planners ";
+      for (std::size_t i = 0; i < su->bench.planners.size(); ++i) command << (i ? "," : "") << su->bench.planners[i];
+    }
+    const auto r = bench::run_suite_bench(su->bench, command.str(), su->quiet ? nullptr : terminal_stream());
+    const std::string link = fs::relative(fs::absolute(figures), fs::absolute(results).parent_path()).generic_string();
+    std::vector<std::pair<std::string, std::string>> files;
+    for (const auto& [name, svg] : bench::suite_figures(r)) files.emplace_back(name, svg);
+    write_folder_atomic(figures.string(), files);
+    write_file_atomic(results.string(), bench::suite_markdown(r, link));
+    if (su->json) out << dump_json(bench::to_json(r));
     else out << "wrote " << results.string() << " and " << files.size() << " box plots in " << figures.string() << "\n";
   });
 }

@@ -1,5 +1,6 @@
 #include "miner/core/json_io.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -51,6 +52,17 @@ JsonField JsonField::at(const std::string& key) const {
   const std::string child = path_.empty() ? key : path_ + "." + key;
   if (it == value_->end()) throw Error(origin_ + ": " + child + ": missing required field");
   return JsonField(*it, child, origin_);
+}
+
+void JsonField::only_keys(const std::vector<std::string>& known) const {
+  if (!value_->is_object()) fail(std::string("expected an object, got ") + type_name(*value_));
+  for (auto it = value_->begin(); it != value_->end(); ++it) {
+    if (std::find(known.begin(), known.end(), it.key()) != known.end()) continue;
+    std::string list;
+    for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
+    const std::string child = path_.empty() ? it.key() : path_ + "." + it.key();
+    throw Error(origin_ + ": " + child + ": unknown key (known: " + list + ")");
+  }
 }
 
 std::size_t JsonField::array_size() const {

@@ -45,6 +45,9 @@ class JsonField {
   int integer() const;                  ///< an integral number
   std::string string() const;
   Eigen::Vector3d vec3() const;         ///< array of 3 finite numbers
+  /// An object whose keys are all in `known` (REQ-CORE-003: no ignored unknown key);
+  /// otherwise throws naming the first unknown key and listing the known ones.
+  void only_keys(const std::vector<std::string>& known) const;
 
   /// Throws Error("<origin>: <path>: <message>").
   [[noreturn]] void fail(const std::string& message) const;

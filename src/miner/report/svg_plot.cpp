@@ -174,25 +174,37 @@ std::string svg_box_plot(const PlotAxes& axes, const std::vector<BoxGroup>& grou
   const Frame f{axes, 0.0, n, yt.front(), yt.back()};
   std::string s = open_svg(axes) + draw_axes(f, {}, yt, log_scale);
   const double slot = (axes.width - kLeft - kRight) / n;
+  const double top = f.sy(f.y1);  // where a missed run (+inf) is drawn
   for (std::size_t gi = 0; gi < groups.size(); ++gi) {
+    const BoxGroup& g = groups[gi];
     const double cx = f.sx(static_cast<double>(gi) + 0.5);
+    const std::size_t runs = g.values.size() + static_cast<std::size_t>(std::max(g.missed, 0));
     s += "<text x=\"" + fmt(cx) + "\" y=\"" + fmt(axes.height - kBottom + 14) +
-         "\" text-anchor=\"middle\" font-size=\"10\">" + html_escape(groups[gi].name) + "</text>\n";
+         "\" text-anchor=\"middle\" font-size=\"10\">" + html_escape(g.name) + "</text>\n";
+    s += "<text x=\"" + fmt(cx) + "\" y=\"" + fmt(axes.height - kBottom + 26) +
+         "\" text-anchor=\"middle\" font-size=\"9\">n=" + std::to_string(runs) +
+         (g.missed > 0 ? ", " + std::to_string(g.missed) + " missed" : std::string()) + "</text>\n";
     std::vector<double> v;
-    for (double x : groups[gi].values)
+    for (double x : g.values)
       if (std::isfinite(tr(x))) v.push_back(tr(x));
+    const std::size_t finite = v.size();
+    for (int k = 0; k < g.missed; ++k) v.push_back(std::numeric_limits<double>::infinity());
     if (v.empty()) {
       s += "<text x=\"" + fmt(cx) + "\" y=\"" + fmt(f.sy((f.y0 + f.y1) / 2)) + "\" text-anchor=\"middle\">n/a</text>\n";
       continue;
     }
     std::sort(v.begin(), v.end());
-    // Quartiles by linear interpolation between order statistics (Hyndman-Fan type 7).
+    // Quartiles by linear interpolation between order statistics (Hyndman-Fan type 7);
+    // one that touches a miss is +inf (drawn at the top edge).
     auto q = [&](double p) {
       const double h = (static_cast<double>(v.size()) - 1.0) * p;
       const auto lo = static_cast<std::size_t>(std::floor(h));
       const std::size_t hi = std::min(lo + 1, v.size() - 1);
-      return v[lo] + (h - static_cast<double>(lo)) * (v[hi] - v[lo]);
+      const double frac = h - static_cast<double>(lo);
+      if (!std::isfinite(v[lo]) || (frac > 0.0 && !std::isfinite(v[hi]))) return std::numeric_limits<double>::infinity();
+      return v[lo] + frac * (v[hi] - v[lo]);
     };
+    const auto y = [&](double value) { return std::isfinite(value) ? f.sy(value) : top; };
     const double q1 = q(0.25), med = q(0.5), q3 = q(0.75), iqr = q3 - q1;
     double wlo = med, whi = med;
     for (double x : v)
@@ -200,15 +212,18 @@ std::string svg_box_plot(const PlotAxes& axes, const std::vector<BoxGroup>& grou
     for (auto it = v.rbegin(); it != v.rend(); ++it)
       if (*it <= q3 + 1.5 * iqr) { whi = *it; break; }
     const double hw = std::min(slot * 0.3, 24.0);
-    s += "<line x1=\"" + fmt(cx) + "\" x2=\"" + fmt(cx) + "\" y1=\"" + fmt(f.sy(wlo)) + "\" y2=\"" + fmt(f.sy(whi)) +
+    s += "<line x1=\"" + fmt(cx) + "\" x2=\"" + fmt(cx) + "\" y1=\"" + fmt(y(wlo)) + "\" y2=\"" + fmt(y(whi)) +
          "\" stroke=\"#333\"/>\n";
-    s += "<rect x=\"" + fmt(cx - hw) + "\" y=\"" + fmt(f.sy(q3)) + "\" width=\"" + fmt(2 * hw) + "\" height=\"" +
-         fmt(std::max(f.sy(q1) - f.sy(q3), 0.5)) + "\" fill=\"#9ecae1\" stroke=\"#333\"/>\n";
-    s += "<line x1=\"" + fmt(cx - hw) + "\" x2=\"" + fmt(cx + hw) + "\" y1=\"" + fmt(f.sy(med)) + "\" y2=\"" +
-         fmt(f.sy(med)) + "\" stroke=\"#d62728\" stroke-width=\"2\"/>\n";
-    for (double x : v)
-      if (x < wlo || x > whi)
-        s += "<circle cx=\"" + fmt(cx) + "\" cy=\"" + fmt(f.sy(x)) + "\" r=\"2\" fill=\"none\" stroke=\"#555\"/>\n";
+    s += "<rect x=\"" + fmt(cx - hw) + "\" y=\"" + fmt(y(q3)) + "\" width=\"" + fmt(2 * hw) + "\" height=\"" +
+         fmt(std::max(y(q1) - y(q3), 0.5)) + "\" fill=\"#9ecae1\" stroke=\"#333\"/>\n";
+    s += "<line x1=\"" + fmt(cx - hw) + "\" x2=\"" + fmt(cx + hw) + "\" y1=\"" + fmt(y(med)) + "\" y2=\"" +
+         fmt(y(med)) + "\" stroke=\"#d62728\" stroke-width=\"2\"/>\n";
+    for (std::size_t k = 0; k < finite; ++k)
+      if (v[k] < wlo || v[k] > whi)
+        s += "<circle cx=\"" + fmt(cx) + "\" cy=\"" + fmt(f.sy(v[k])) + "\" r=\"2\" fill=\"none\" stroke=\"#555\"/>\n";
+    if (g.missed > 0)
+      s += "<text class=\"miss\" x=\"" + fmt(cx) + "\" y=\"" + fmt(top + 4) +
+           "\" text-anchor=\"middle\" fill=\"#d62728\" font-size=\"12\">&#215;</text>\n";
   }
   return s + "</svg>\n";
 }

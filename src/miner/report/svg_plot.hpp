@@ -24,10 +24,15 @@ struct PlotAxes {
 std::string svg_line_plot(const PlotAxes& axes, const std::vector<Series>& series);
 
 /// One box per group (median, quartiles, whiskers at the extreme values within 1.5 IQR,
-/// outliers as dots), like the paper's Fig. Map1-3. Empty groups are drawn as "n/a".
+/// outliers as dots), like the paper's Fig. Map1-3. Every box is labelled with its n.
+/// `missed` runs (a stage never reached) are shown, not dropped: they count as +inf in
+/// the quartiles, sit as crosses on the top edge of the plot, and the label says how many;
+/// a quartile or whisker that lands on a miss reaches the top edge. A group with neither
+/// values nor misses is drawn as "n/a".
 struct BoxGroup {
   std::string name;
   std::vector<double> values;
+  int missed = 0;
 };
 std::string svg_box_plot(const PlotAxes& axes, const std::vector<BoxGroup>& groups, bool log_scale = false);
 

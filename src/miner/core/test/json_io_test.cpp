@@ -93,6 +93,17 @@ TEST_CASE("Atomic write into a missing folder fails and leaves the old file inta
   CHECK(std::filesystem::is_directory(blocked + "/child"));
 }
 
+TEST_CASE("only_keys refuses an unknown key, naming it and the known ones", "[REQ-CORE-003]") {
+  const Json doc = miner::parse_json(R"({"a": 1, "b": {"c": 2, "controler": 3}})", "k.json");
+  const JsonField root(doc, "", "k.json");
+  CHECK_NOTHROW(root.only_keys({"a", "b"}));
+  CHECK_NOTHROW(root.only_keys({"b", "a", "z"}));
+  CHECK_THROWS_WITH(root.only_keys({"a"}), Contains("k.json: b: unknown key (known: a)"));
+  CHECK_THROWS_WITH(root.at("b").only_keys({"c", "controller"}),
+                    Contains("k.json: b.controler: unknown key (known: c, controller)"));
+  CHECK_THROWS_WITH(root.at("a").only_keys({"a"}), Contains("a: expected an object, got number"));
+}
+
 TEST_CASE("dump_json writes two-space indented JSON with a trailing newline", "[REQ-CORE-003]") {
   CHECK(miner::dump_json(Json{{"a", 1}}) == "{\n  \"a\": 1\n}\n");
 }

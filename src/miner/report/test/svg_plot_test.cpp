@@ -58,6 +58,30 @@ TEST_CASE("box plots draw median, quartiles, whiskers and outliers", "[REQ-REPOR
   CHECK(svg == svg_box_plot({"box", "", "value"}, {g, BoxGroup{"none", {}}}));
   const std::string log_svg = svg_box_plot({"log", "", "ms"}, {BoxGroup{"x", {0.1, 1, 10, 100}}}, true);
   CHECK_THAT(log_svg, Contains(">100<") && Contains(">0.1<"));
+  CHECK_THAT(svg, Contains(">n=10</text>"));
+}
+
+TEST_CASE("box plots show missed runs instead of dropping them", "[REQ-REPORT-004]") {
+  // 3 values and 2 misses: n = 5; type-7 quartiles over {1, 2, 3, inf, inf} are 2 and inf,
+  // so the box reaches the top edge; without the misses it would end at 2.5.
+  const BoxGroup with{"p", {1, 2, 3}, 2};
+  const std::string svg = svg_box_plot({"t", "", "ms"}, {with});
+  CHECK_THAT(svg, Contains(">n=5, 2 missed</text>"));
+  CHECK(count(svg, "class=\"miss\"") == 1);
+  const std::string dropped = svg_box_plot({"t", "", "ms"}, {BoxGroup{"p", {1, 2, 3}}});
+  CHECK_THAT(dropped, Contains(">n=3</text>"));
+  CHECK(count(dropped, "class=\"miss\"") == 0);
+  // The box's top (its y) differs: with misses it is the plot's top edge (kTop = 26).
+  const auto box_y = [](const std::string& s) {
+    const auto at = s.find("fill=\"#9ecae1\"");
+    const auto rect = s.rfind("<rect x=", at);
+    const auto y = s.find(" y=\"", rect) + 4;
+    return std::stod(s.substr(y, s.find('"', y) - y));
+  };
+  CHECK(box_y(svg) == Approx(26.0));
+  CHECK(box_y(dropped) > 26.0 + 1.0);
+  // Only misses: still drawn (not "n/a").
+  CHECK_THAT(svg_box_plot({"t", "", "ms"}, {BoxGroup{"m", {}, 3}}), !Contains(">n/a<") && Contains(">n=3, 3 missed<"));
 }
 
 TEST_CASE("html_escape escapes the five special characters", "[REQ-REPORT-004]") {

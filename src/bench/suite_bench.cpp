@@ -1,0 +1,370 @@
+#include "bench/suite_bench.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <ostream>
+#include <sstream>
+
+#include "bench/campaign_stats.hpp"
+#include "bench/ompl_planners.hpp"
+#include "miner/core/error.hpp"
+#include "miner/core/json_io.hpp"
+#include "miner/report/svg_plot.hpp"
+#include "miner/world/map.hpp"
+
+namespace miner::bench {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+constexpr const char* kSuiteFormat = "miner-bench-suite-v1";
+/// `miner` samples the A*-dilated region built from the A* path that defines the target: an
+/// upper bound, never in a headline.
+constexpr const char* kOraclePlanner = "miner";
+
+std::string f(double v, int digits) {
+  if (!std::isfinite(v)) return "—";
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
+  return buf;
+}
+
+std::string git_commit() {
+  std::string out;
+  if (FILE* p = ::popen("git describe --always --dirty 2>/dev/null", "r")) {
+    char buf[128];
+    while (std::fgets(buf, sizeof buf, p)) out += buf;
+    ::pclose(p);
+  }
+  while (!out.empty() && (out.back() == '\n' || out.back() == '\r')) out.pop_back();
+  return out.empty() ? "unknown" : out;
+}
+
+const PlannerSummary* find_summary(const FrontendBenchResult& r, const std::string& planner) {
+  for (const auto& s : r.summaries)
+    if (s.planner == planner) return &s;
+  return nullptr;
+}
+
+/// The runs' values of one stage (`target` or first solution), +inf for a miss.
+std::vector<double> stage_values(const FrontendBenchResult& r, const std::string& planner, bool target, bool time) {
+  std::vector<double> v;
+  for (const auto& run : r.runs) {
+    if (run.planner != planner) continue;
+    const auto& stage = target ? run.result.target : run.result.first;
+    if (!stage) v.push_back(std::numeric_limits<double>::infinity());
+    else v.push_back(time ? stage->time_ms : static_cast<double>(stage->iteration));
+  }
+  return v;
+}
+
+/// "mean ± sd" over the runs that got there, and "median [q1, q3]" over all runs with a
+/// miss as +inf ("miss" where a quantile lands on one).
+std::string mean_sd(const std::vector<double>& v, int digits) {
+  std::vector<double> reached;
+  for (double x : v)
+    if (std::isfinite(x)) reached.push_back(x);
+  if (reached.empty()) return "—";
+  return f(mean(reached), digits) + " ± " + f(stddev(reached), digits);
+}
+std::string median_iqr(const std::vector<double>& v, int digits) {
+  if (v.empty()) return "—";
+  const auto q = [&](double p) {
+    const double x = quantile(v, p);
+    return std::isfinite(x) ? f(x, digits) : std::string("miss");
+  };
+  return q(0.5) + " [" + q(0.25) + ", " + q(0.75) + "]";
+}
+int reached(const std::vector<double>& v) {
+  return static_cast<int>(std::count_if(v.begin(), v.end(), [](double x) { return std::isfinite(x); }));
+}
+
+std::string planner_label(const std::string& planner) {
+  if (planner == kOraclePlanner) return "`miner` (A* oracle region, upper bound)";
+  return "`" + planner + "`";
+}
+
+double finite_or_inf(double v) { return std::isfinite(v) ? v : std::numeric_limits<double>::infinity(); }
+
+/// Generated headline of one campaign: the fastest planner to the target (median time,
+/// misses as +inf) among every planner except the oracle, miner-sgan's ratio to it, and
+/// our RRT* / Informed RRT* against OMPL's (issue 17 item 2).
+std::string cell_headline(const FrontendBenchResult& fr, const std::vector<std::string>& planners) {
+  std::ostringstream h;
+  std::string best;
+  double best_v = std::numeric_limits<double>::infinity();
+  for (const auto& p : planners) {
+    if (p == kOraclePlanner) continue;
+    const PlannerSummary* s = find_summary(fr, p);
+    if (s && finite_or_inf(s->target_time_ms) < best_v) best_v = s->target_time_ms, best = p;
+  }
+  if (best.empty()) {
+    h << "No planner (oracle aside) reached the target in half its runs.";
+  } else {
+    h << "Fastest to the target (median, oracle aside): `" << best << "` " << f(best_v, 1) << " ms.";
+    if (const PlannerSummary* s = find_summary(fr, kMinerSgan); s && best != kMinerSgan)
+      h << " `miner-sgan`: " << (std::isfinite(s->target_time_ms) ? f(s->target_time_ms / best_v, 2) + "x the fastest"
+                                                                      : std::string("fewer than half its runs reached it"))
+        << ".";
+  }
+  for (const auto& [ours, theirs] : {std::pair<const char*, const char*>{"rrtstar", "ompl:RRTstar"},
+                                     {"informed", "ompl:InformedRRTstar"}}) {
+    const PlannerSummary* a = find_summary(fr, ours);
+    const PlannerSummary* b = find_summary(fr, theirs);
+    if (!a || !b) continue;
+    const double ta = finite_or_inf(a->target_time_ms), tb = finite_or_inf(b->target_time_ms);
+    h << " `" << ours << "` vs `" << theirs << "`: ";
+    if (!std::isfinite(ta) && !std::isfinite(tb)) h << "neither reached the target in half its runs;";
+    else h << f(a->target_time_ms, 1) << " vs " << f(b->target_time_ms, 1) << " ms (" << (ta <= tb ? "no slower" : "**slower**")
+           << ");";
+  }
+  std::string s = h.str();
+  if (!s.empty() && s.back() == ';') s.back() = '.';
+  return s;
+}
+
+}  // namespace
+
+SuiteDefinition load_suite(const std::string& path) {
+  const Json doc = read_json_file(path);
+  const JsonField root(doc, "", path);
+  root.only_keys({"format", "description", "steps", "band", "maps"});
+  if (root.at("format").string() != kSuiteFormat)
+    root.at("format").fail(std::string("expected \"") + kSuiteFormat + "\", got \"" + root.at("format").string() + "\"");
+  if (root.has("description")) (void)root.at("description").string();
+  SuiteDefinition s;
+  const JsonField steps = root.at("steps");
+  if (steps.array_size() == 0) steps.fail("needs at least one steering step");
+  for (std::size_t i = 0; i < steps.array_size(); ++i) {
+    const double x = steps.at(i).positive_number();
+    if (x > 1.0) steps.at(i).fail("a steering step is a fraction of the map's diagonal in (0, 1], got " + f(x, 3));
+    if (std::find(s.step_fractions.begin(), s.step_fractions.end(), x) != s.step_fractions.end())
+      steps.at(i).fail("repeated steering step " + f(x, 3));
+    s.step_fractions.push_back(x);
+  }
+  if (root.has("band")) {
+    const JsonField band = root.at("band");
+    if (band.array_size() != 2) band.fail("expected [lo, hi] iterations");
+    s.band_lo = band.at(std::size_t{0}).positive_number();
+    s.band_hi = band.at(std::size_t{1}).positive_number();
+    if (s.band_hi < s.band_lo) band.fail("hi is below lo");
+  }
+  const JsonField maps = root.at("maps");
+  if (maps.array_size() == 0) maps.fail("needs at least one map");
+  const auto presets = world::generator_preset_names();
+  for (std::size_t i = 0; i < maps.array_size(); ++i) {
+    const JsonField m = maps.at(i);
+    m.only_keys({"name", "preset", "seed", "obstacles", "size", "resolution"});
+    SuiteMap sm;
+    sm.name = m.at("name").string();
+    if (sm.name.empty() || sm.name.find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789-_.") != std::string::npos)
+      m.at("name").fail("a name is lower-case letters, digits, '-', '_' and '.' (it names the figure files)");
+    for (const auto& other : s.maps)
+      if (other.name == sm.name) m.at("name").fail("repeated map name \"" + sm.name + "\"");
+    sm.preset = m.at("preset").string();
+    if (std::find(presets.begin(), presets.end(), sm.preset) == presets.end()) {
+      std::string list;
+      for (const auto& p : presets) list += (list.empty() ? "" : ", ") + p;
+      m.at("preset").fail("unknown preset \"" + sm.preset + "\" (known: " + list + ")");
+    }
+    const int seed = m.at("seed").integer();
+    if (seed < 0) m.at("seed").fail("must be >= 0");
+    sm.seed = static_cast<std::uint64_t>(seed);
+    if (m.has("obstacles")) {
+      const int n = m.at("obstacles").integer();
+      if (n < 0 || n > 100000) m.at("obstacles").fail("must be in [0, 100000]");
+      sm.overrides.obstacles = n;
+    }
+    if (m.has("size")) sm.overrides.size = m.at("size").vec3();
+    if (m.has("resolution")) sm.overrides.resolution = m.at("resolution").positive_number();
+    s.maps.push_back(sm);
+  }
+  return s;
+}
+
+bool in_paper_band(const SuiteCell& cell, const SuiteDefinition& suite) {
+  const PlannerSummary* s = find_summary(cell.result, "rrtstar");
+  return s && std::isfinite(s->first_iterations) && s->first_iterations >= suite.band_lo &&
+         s->first_iterations <= suite.band_hi;
+}
+
+SuiteBenchResult run_suite_bench(const SuiteBenchOptions& o, const std::string& command, std::ostream* progress) {
+  if (o.suite.maps.empty() || o.suite.step_fractions.empty()) throw Error("bench suite: the suite has no map or no step");
+  if (o.runs < 1) throw Error("bench suite: --runs must be >= 1");
+  const auto t0 = Clock::now();
+  SuiteBenchResult out;
+  out.options = o;
+  out.command = command;
+  out.commit = git_commit();
+  // Generate every map first: a bad recipe fails before minutes of benchmarking.
+  std::vector<world::Map> maps;
+  for (const auto& m : o.suite.maps) {
+    try {
+      maps.push_back(world::generate_map(world::generator_preset(m.preset), m.seed, m.overrides));
+    } catch (const Error& e) {
+      throw Error("bench suite: map \"" + m.name + "\": " + e.what());
+    }
+  }
+  for (std::size_t i = 0; i < maps.size(); ++i) {
+    const world::Map& map = maps[i];
+    const auto& q = *map.query();
+    const double diagonal = map.bounds().extent().norm();
+    for (const double fraction : o.suite.step_fractions) {
+      if (progress) *progress << "suite: " << o.suite.maps[i].name << ", eta = " << fraction << " x diagonal\n";
+      FrontendBenchOptions fo;
+      fo.planners = o.planners;
+      fo.runs = o.runs;
+      fo.seed = o.seed;
+      fo.time_limit_s = o.time_limit_s;
+      fo.max_iterations = o.max_iterations;
+      fo.weights_file = o.weights;
+      fo.throughput_iterations = 0;
+      fo.planner_options.steer_step = fraction * diagonal;
+      SuiteCell cell;
+      cell.map = o.suite.maps[i].name;
+      cell.preset = o.suite.maps[i].preset;
+      cell.extent = map.bounds().extent();
+      cell.resolution = map.resolution();
+      cell.step_fraction = fraction;
+      cell.result = run_frontend_bench(map, cell.map, q.start, q.goal, q.robot_radius, fo, progress);
+      out.cells.push_back(std::move(cell));
+    }
+  }
+  out.total_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  return out;
+}
+
+std::string suite_markdown(const SuiteBenchResult& r, const std::string& figure_dir) {
+  const auto& o = r.options;
+  const auto& suite = o.suite;
+  std::ostringstream md;
+  md << "# Benchmark suite: map families at the paper's difficulty, steering step swept\n\n"
+     << "Generated by `" << r.command << "` at commit `" << r.commit << "` (" << f(r.total_s, 0)
+     << " s), suite `" << r.options.suite_file << "`. Every planner runs " << o.runs
+     << " times per map and eta (n = " << o.runs << " in every row and plot), interleaved run by run; ours stop at "
+     << o.max_iterations << " iterations, OMPL's RRTstar and InformedRRTstar at the same count or " << f(o.time_limit_s, 1)
+     << " s, OMPL's other planners at " << f(o.time_limit_s, 1)
+     << " s. Iterations, nodes and costs are deterministic for the seed (OMPL's included, REQ-PLAN-017); times are wall "
+        "clock on this machine and vary. One goal rule for all planners (REQ-PLAN-018): a path ends exactly at x_goal "
+        "and costs its whole length. Target = the A* path's length on the map's grid. `miner-sgan` includes its "
+        "region query (encode, inference, filter) in every time; `miner` samples the A*-dilated region built from the "
+        "path that defines the target and is an upper bound, never a result. A missed stage counts as +inf in medians "
+        "and quartiles (\"miss\") and is left out of mean ± sd, which is over the runs that got there.\n\n";
+
+  md << "## Difficulty: RRT*'s first solution against the paper's Table I\n\n"
+     << "The paper's RRT* found its first solution after " << f(suite.band_lo, 0) << "-" << f(suite.band_hi, 0)
+     << " iterations (Table I, about 740-1730 over its three maps). Per map and eta (as a fraction of the map's "
+        "diagonal): `rrtstar`'s median [IQR] first-solution iterations; **in band** marks a median inside "
+        "the paper's range.\n\n| map | preset | extent (m) | resolution (m) | A* cost (m) | straight line (m) |";
+  for (double s : suite.step_fractions) md << " eta = " << f(s, 3) << " x diag |";
+  md << "\n|---|---|---|---|---|---|";
+  for (std::size_t k = 0; k < suite.step_fractions.size(); ++k) md << "---|";
+  md << "\n";
+  int in_band = 0;
+  const std::size_t per_map = suite.step_fractions.size();
+  for (std::size_t i = 0; i < r.cells.size(); i += per_map) {
+    const SuiteCell& c0 = r.cells[i];
+    md << "| " << c0.map << " | " << c0.preset << " | " << f(c0.extent.x(), 1) << " x " << f(c0.extent.y(), 1) << " x "
+       << f(c0.extent.z(), 1) << " | " << f(c0.resolution, 2) << " | " << f(c0.result.reference_cost, 1) << " | "
+       << f(c0.result.lower_bound, 1) << " |";
+    for (std::size_t k = 0; k < per_map && i + k < r.cells.size(); ++k) {
+      const SuiteCell& c = r.cells[i + k];
+      const auto v = stage_values(c.result, "rrtstar", false, false);
+      const bool band = in_paper_band(c, suite);
+      in_band += band ? 1 : 0;
+      md << " " << (v.empty() ? std::string("(rrtstar not run)") : median_iqr(v, 0)) << (band ? " **in band**" : "")
+         << " (eta " << f(c.result.steer_step, 2) << " m) |";
+    }
+    md << "\n";
+  }
+  md << "\n**" << in_band << " of " << r.cells.size()
+     << " campaigns are at the paper's difficulty** (generated from the table above).\n\n";
+
+  // Step sweep: median time to the target per planner and eta, per map.
+  md << "## Steering step sweep: median time to the target (ms) [reached/n]\n\n";
+  for (std::size_t i = 0; i < r.cells.size(); i += per_map) {
+    md << "### " << r.cells[i].map << "\n\n| planner |";
+    for (std::size_t k = 0; k < per_map; ++k) md << " eta = " << f(suite.step_fractions[k], 3) << " x diag |";
+    md << "\n|---|";
+    for (std::size_t k = 0; k < per_map; ++k) md << "---|";
+    md << "\n";
+    for (const auto& p : o.planners) {
+      md << "| " << planner_label(p) << " |";
+      for (std::size_t k = 0; k < per_map && i + k < r.cells.size(); ++k) {
+        const auto v = stage_values(r.cells[i + k].result, p, true, true);
+        md << " " << (v.empty() ? std::string("—") : (std::isfinite(median(v)) ? f(median(v), 1) : std::string("miss")))
+           << " [" << reached(v) << "/" << v.size() << "] |";
+      }
+      md << "\n";
+    }
+    md << "\n";
+  }
+
+  md << "## Every campaign\n\n"
+     << "Per planner: first solution (iterations, time) and the target (iterations, time), each as mean ± sd over "
+        "the runs that got there and median [IQR] over all n runs.\n\n";
+  for (const SuiteCell& c : r.cells) {
+    const auto& fr = c.result;
+    md << "### " << c.map << ", eta = " << f(c.step_fraction, 3) << " x diagonal (" << f(fr.steer_step, 2)
+       << " m)" << (in_paper_band(c, suite) ? ", at the paper's difficulty" : "") << "\n\n"
+       << "A* cost " << f(fr.reference_cost, 2) << " m, target " << f(fr.target_cost, 2) << " m, straight line "
+       << f(fr.lower_bound, 2) << " m, goal radius " << f(fr.goal_radius, 2) << " m, robot radius "
+       << f(fr.robot_radius, 2) << " m.\n\n"
+       << "| planner | n | solved | first iterations mean ± sd | first iterations median [IQR] | first time (ms) "
+          "median [IQR] | target reached | target iterations median [IQR] | target time (ms) mean ± sd | target "
+          "time (ms) median [IQR] |\n|---|---|---|---|---|---|---|---|---|---|\n";
+    for (const auto& p : o.planners) {
+      const PlannerSummary* s = find_summary(fr, p);
+      if (!s) continue;
+      const auto fi = stage_values(fr, p, false, false), ft = stage_values(fr, p, false, true);
+      const auto ti = stage_values(fr, p, true, false), tt = stage_values(fr, p, true, true);
+      md << "| " << planner_label(p) << " | " << s->runs << " | " << reached(fi) << "/" << s->runs << " | "
+         << mean_sd(fi, 0) << " | " << median_iqr(fi, 0) << " | " << median_iqr(ft, 2) << " | " << reached(tt) << "/"
+         << s->runs << " | " << median_iqr(ti, 0) << " | " << mean_sd(tt, 2) << " | " << median_iqr(tt, 2) << " |\n";
+    }
+    md << "\n" << cell_headline(fr, o.planners) << "\n\n";
+    const std::string fig = c.map + "-" + f(c.step_fraction, 3) + "-target.svg";
+    md << "![" << c.map << " eta " << f(c.step_fraction, 3) << "](" << figure_dir << "/" << fig << ")\n\n";
+  }
+  return md.str();
+}
+
+std::map<std::string, std::string> suite_figures(const SuiteBenchResult& r) {
+  std::map<std::string, std::string> figures;
+  for (const SuiteCell& c : r.cells) {
+    std::vector<report::BoxGroup> groups;
+    for (const auto& p : r.options.planners) {
+      report::BoxGroup g{p, {}, 0};
+      for (double v : stage_values(c.result, p, true, true)) {
+        if (std::isfinite(v)) g.values.push_back(v);
+        else ++g.missed;
+      }
+      groups.push_back(std::move(g));
+    }
+    const int width = 110 * static_cast<int>(std::max<std::size_t>(groups.size(), 4));
+    figures[c.map + "-" + f(c.step_fraction, 3) + "-target.svg"] = report::svg_box_plot(
+        {c.map + ", eta " + f(c.step_fraction, 3) + " x diagonal: time to the target", "", "ms (log)", width, 300},
+        groups, true);
+  }
+  return figures;
+}
+
+nlohmann::json to_json(const SuiteBenchResult& r) {
+  nlohmann::json j{{"commit", r.commit}, {"command", r.command}, {"total_s", r.total_s}, {"suite", r.options.suite_file},
+                   {"band", {r.options.suite.band_lo, r.options.suite.band_hi}}};
+  j["cells"] = nlohmann::json::array();
+  for (const SuiteCell& c : r.cells) {
+    nlohmann::json cell = to_json(c.result);
+    cell["suite_map"] = c.map;
+    cell["preset"] = c.preset;
+    cell["step_fraction"] = c.step_fraction;
+    cell["in_paper_band"] = in_paper_band(c, r.options.suite);
+    j["cells"].push_back(std::move(cell));
+  }
+  return j;
+}
+
+}  // namespace miner::bench

@@ -1,0 +1,157 @@
+// `miner bench suite` (REQ-REPORT-008): the suite file is read strictly; every (map, eta)
+// campaign runs every planner with the step the suite asks for; the difficulty mark, the
+// spread and the misses in the tables and plots come from the runs.
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <regex>
+
+#include <unistd.h>
+
+#include "bench/ompl_planners.hpp"
+#include "bench/suite_bench.hpp"
+#include "miner/core/error.hpp"
+#include "miner/core/json_io.hpp"
+
+using Catch::Matchers::Contains;
+
+namespace {
+
+std::string write_suite(const std::string& name, const std::string& text) {
+  const auto d = std::filesystem::temp_directory_path() / ("miner_suite_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(d);
+  const auto p = (d / name).string();
+  std::ofstream(p) << text;
+  return p;
+}
+
+const char* kTiny = R"({"format": "miner-bench-suite-v1",
+  "steps": [0.1, 0.4],
+  "band": [1, 1000000],
+  "maps": [{"name": "tiny", "preset": "cluttered", "seed": 3, "size": [12, 12, 6], "obstacles": 12}]})";
+
+miner::bench::SuiteBenchOptions tiny_options(const miner::bench::SuiteDefinition& suite) {
+  miner::bench::SuiteBenchOptions o;
+  o.suite = suite;
+  o.suite_file = "tiny.json";
+  o.planners = {"rrtstar", "informed"};
+  if (miner::bench::ompl_available()) o.planners.push_back("ompl:RRTstar");
+  o.runs = 4;
+  o.max_iterations = 1500;
+  o.time_limit_s = 0.5;
+  return o;
+}
+
+/// The run records without their wall-clock fields.
+miner::Json untimed(miner::Json j) {
+  for (auto& cell : j["cells"]) {
+    cell.erase("total_s");
+    cell.erase("region");
+    cell.erase("planners");  // summaries hold medians of times
+    for (auto& run : cell["run_records"]) {
+      run.erase("time_ms");
+      for (const char* stage : {"first", "target"})
+        if (run.contains(stage) && run[stage].is_object()) run[stage].erase("time_ms");
+    }
+  }
+  j.erase("total_s");
+  return j;
+}
+
+}  // namespace
+
+TEST_CASE("A suite file is read strictly", "[REQ-REPORT-008]") {
+  using miner::bench::load_suite;
+  const auto s = load_suite(write_suite("ok.json", kTiny));
+  REQUIRE(s.maps.size() == 1);
+  CHECK(s.maps[0].preset == "cluttered");
+  CHECK(s.maps[0].overrides.obstacles == 12);
+  CHECK(s.step_fractions == std::vector<double>{0.1, 0.4});
+  const auto bad = [](const std::string& name, const std::string& from, const std::string& to) {
+    std::string text = kTiny;
+    const auto at = text.find(from);
+    REQUIRE(at != std::string::npos);
+    text.replace(at, from.size(), to);
+    return write_suite(name, text);
+  };
+  CHECK_THROWS_WITH(load_suite(bad("key.json", "\"obstacles\"", "\"obstacle\"")),
+                    Contains("maps[0].obstacle: unknown key"));
+  CHECK_THROWS_WITH(load_suite(bad("top.json", "\"band\"", "\"bands\"")), Contains("bands: unknown key"));
+  CHECK_THROWS_WITH(load_suite(bad("fmt.json", "suite-v1", "suite-v2")), Contains("format: expected"));
+  CHECK_THROWS_WITH(load_suite(bad("step.json", "0.4]", "1.5]")), Contains("steps[1]: a steering step is a fraction"));
+  CHECK_THROWS_WITH(load_suite(bad("rep.json", "0.4]", "0.1]")), Contains("steps[1]: repeated steering step"));
+  CHECK_THROWS_WITH(load_suite(bad("preset.json", "\"cluttered\"", "\"clutered\"")),
+                    Contains("maps[0].preset: unknown preset \"clutered\""));
+  CHECK_THROWS_WITH(load_suite(bad("band.json", "[1, 1000000]", "[10, 1]")), Contains("band: hi is below lo"));
+  CHECK_THROWS_WITH(load_suite(bad("name.json", "\"tiny\"", "\"a/b\"")), Contains("maps[0].name: a name is"));
+  CHECK_THROWS_WITH(load_suite("/nonexistent/suite.json"), Contains("/nonexistent/suite.json"));
+}
+
+TEST_CASE("The suite runs every planner at every step and reports spread, n and misses", "[REQ-REPORT-008]") {
+  using namespace miner::bench;
+  auto suite = load_suite(write_suite("run.json", kTiny));
+  const auto o = tiny_options(suite);
+  const auto r = run_suite_bench(o, "test", nullptr);
+  REQUIRE(r.cells.size() == 2);
+  for (std::size_t k = 0; k < 2; ++k) {
+    const auto& c = r.cells[k];
+    CHECK(c.step_fraction == suite.step_fractions[k]);
+    // eta = fraction x the diagonal of the generated map's bounds.
+    CHECK(c.result.steer_step == Approx(suite.step_fractions[k] * c.extent.norm()).epsilon(1e-12));
+    REQUIRE(c.result.summaries.size() == o.planners.size());
+    for (const auto& s : c.result.summaries) CHECK(s.runs == o.runs);
+  }
+  // A bigger step makes the first solution come sooner for RRT* (same streams).
+  const auto first = [&](std::size_t k) -> double {
+    for (const auto& s : r.cells[k].result.summaries)
+      if (s.planner == "rrtstar") return s.first_iterations;
+    return NAN;
+  };
+  CHECK(first(1) <= first(0));
+
+  const std::string md = suite_markdown(r, "suite");
+  // The band mark follows the measured median: [1, 1e6] holds it...
+  CHECK(in_paper_band(r.cells[0], r.options.suite));
+  CHECK_THAT(md, Contains("**2 of 2 campaigns are at the paper's difficulty**"));
+  // ... and a band just above it does not.
+  auto strict = r;
+  strict.options.suite.band_lo = first(0) + 1;
+  strict.options.suite.band_hi = first(0) + 2;
+  CHECK_FALSE(in_paper_band(strict.cells[0], strict.options.suite));
+  CHECK_THAT(suite_markdown(strict, "suite"), Contains("**0 of 2 campaigns"));
+  // Every planner has a row with n and the reached counts in every campaign table.
+  for (const auto& p : o.planners) {
+    const std::regex row("\\| `" + std::regex_replace(p, std::regex("[*:]"), "\\$&") + "` \\| 4 \\| [0-4]/4 \\|");
+    CHECK(std::distance(std::sregex_iterator(md.begin(), md.end(), row), std::sregex_iterator()) == 2);
+  }
+  CHECK_THAT(md, Contains("median [IQR]") && Contains("mean ± sd") && Contains("Steering step sweep"));
+
+  // A campaign where the target is out of reach: misses are shown, in the tables and plots.
+  auto missing = r;
+  for (auto& run : missing.cells[0].result.runs) run.result.target.reset();
+  const std::string md_miss = suite_markdown(missing, "suite");
+  CHECK_THAT(md_miss, Contains("miss [miss, miss]") && Contains("[0/4]"));
+  const auto figures = suite_figures(missing);
+  REQUIRE(figures.size() == 2);
+  const std::string& svg = figures.begin()->first.find("0.100") != std::string::npos ? figures.begin()->second
+                                                                                      : figures.rbegin()->second;
+  CHECK_THAT(svg, Contains("n=4, 4 missed"));
+
+  // Same seed, same records (time fields aside), OMPL's included.
+  const auto again = run_suite_bench(o, "test", nullptr);
+  CHECK(untimed(to_json(again)) == untimed(to_json(r)));
+}
+
+TEST_CASE("A suite map that cannot be generated is refused before any campaign", "[REQ-REPORT-008]") {
+  using namespace miner::bench;
+  SuiteDefinition s;
+  s.step_fractions = {0.1};
+  SuiteMap m;
+  m.name = "bad";
+  m.preset = "cluttered";
+  m.overrides.size = Eigen::Vector3d(0.5, 0.5, 0.5);  // too small to hold a query
+  s.maps = {m};
+  auto o = tiny_options(s);
+  CHECK_THROWS_WITH(run_suite_bench(o, "test", nullptr), Contains("map \"bad\""));
+}

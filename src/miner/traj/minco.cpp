@@ -1,5 +1,6 @@
 #include "miner/traj/minco.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -363,10 +364,113 @@ void validate(const MincoProblem& p) {
   }
 }
 
+namespace {
+
+std::string sci(double v) {
+  std::ostringstream os;
+  os.precision(3);
+  os << v;
+  return os.str();
+}
+
+}  // namespace
+
+AnswerCheck measure_answer(const MincoProblem& p, const PolynomialTrajectory& tr) {
+  AnswerCheck out;
+  const int s = p.order, M = static_cast<int>(p.durations.size());
+  out.position_scale = std::max(p.points.cwiseAbs().maxCoeff(),
+                                (p.points.colwise().maxCoeff() - p.points.colwise().minCoeff()).maxCoeff());
+  if (!tr.coefficients().allFinite() || tr.segments() != M || tr.coefficients().rows() != 2 * s * M) {
+    out.finite = false;
+    return out;
+  }
+  // Per segment and derivative k, the size of the terms it is computed from,
+  // S_ik = sum_j |c_ij| j!/(j-k)! T_i^(j-k) (largest axis): its rounding error is relative to
+  // that (per-segment scaling: a residual at a junction of a 1e-6 s and a 1 s segment is
+  // measured against each side's own scale, not against the other's).
+  const int N = 2 * s;
+  std::vector<double> S(static_cast<std::size_t>(M * N), 0.0);
+  for (int i = 0; i < M; ++i) {
+    const double T = p.durations[static_cast<std::size_t>(i)];
+    const auto c = tr.segment_coefficients(i);
+    for (int k = 0; k < N; ++k) {
+      Eigen::Array3d sum = Eigen::Array3d::Zero();
+      double tp = 1.0;
+      for (int j = k; j < N; ++j, tp *= T) sum += c.row(j).transpose().array().abs() * (falling_factorial(j, k) * tp);
+      S[static_cast<std::size_t>(i * N + k)] = sum.maxCoeff();
+    }
+    out.term_scale = std::max(out.term_scale, S[static_cast<std::size_t>(i * N)]);
+  }
+  const auto scale = [&](int i, int k) { return S[static_cast<std::size_t>(i * N + k)]; };
+  const auto residual = [&](const Eigen::Vector3d& r, double sc) {
+    const double v = r.cwiseAbs().maxCoeff();
+    return v == 0.0 ? 0.0 : sc > 0.0 ? v / sc : HUGE_VAL;
+  };
+  for (int k = 0; k < s; ++k) {
+    const Eigen::Vector3d h = p.head.row(k).transpose(), t = p.tail.row(k).transpose();
+    out.constraint = std::max(out.constraint, residual(tr.evaluate_segment(0, 0.0, k) - h, scale(0, k) + h.cwiseAbs().maxCoeff()));
+    out.constraint = std::max(out.constraint, residual(tr.evaluate_segment(M - 1, p.durations.back(), k) - t,
+                                                       scale(M - 1, k) + t.cwiseAbs().maxCoeff()));
+  }
+  for (int i = 0; i < M; ++i) {
+    const Eigen::Vector3d a = p.points.row(i).transpose(), b = p.points.row(i + 1).transpose();
+    const Eigen::Vector3d ea = tr.evaluate_segment(i, 0.0) - a, eb = tr.evaluate_segment(i, p.durations[i]) - b;
+    out.constraint = std::max({out.constraint, residual(ea, scale(i, 0)), residual(eb, scale(i, 0))});
+    const double miss = std::max(ea.cwiseAbs().maxCoeff(), eb.cwiseAbs().maxCoeff()) / out.position_scale;
+    if (out.worst_segment < 0 || miss > out.interpolation) {
+      out.interpolation = miss;
+      out.worst_segment = i;
+    }
+    if (i + 1 < M)
+      for (int k = 0; k <= 2 * s - 2; ++k) {
+        double& worst = k < s ? out.constraint : out.optimality;
+        worst = std::max(worst, residual(tr.evaluate_segment(i, p.durations[i], k) - tr.evaluate_segment(i + 1, 0.0, k),
+                                         std::max(scale(i, k), scale(i + 1, k))));
+      }
+  }
+  return out;
+}
+
+void check_answer(const MincoProblem& p, const PolynomialTrajectory& tr) {
+  const AnswerCheck c = measure_answer(p, tr);
+  const auto [tmin, tmax] = std::minmax_element(p.durations.begin(), p.durations.end());
+  // The mean speed each duration asks of its segment: durations that do not fit the
+  // segment lengths are the usual cause of an answer that cannot be carried.
+  double vmin = HUGE_VAL, vmax = 0.0;
+  for (std::size_t i = 0; i < p.durations.size(); ++i) {
+    const double v = (p.points.row(static_cast<Eigen::Index>(i) + 1) - p.points.row(static_cast<Eigen::Index>(i))).norm() /
+                     p.durations[i];
+    vmin = std::min(vmin, v);
+    vmax = std::max(vmax, v);
+  }
+  const std::string cause = "durations span " + sci(*tmin) + " to " + sci(*tmax) + " s (ratio " +
+                            sci(*tmax / *tmin) + ") and ask mean speeds of " + sci(vmin) + " to " + sci(vmax) +
+                            " m/s of the segments";
+  if (!c.finite)
+    throw Error("traj: the answer is not finite: the problem is beyond double precision (" + cause +
+                "); give durations in proportion to the segment lengths (or drop \"durations\" and give \"limits\")");
+  if (c.constraint > kAnswerConstraint)
+    throw Error("traj: the answer cannot be trusted: a constraint (waypoint, head, tail or continuity of derivatives "
+                "0..s-1) holds only to " + sci(c.constraint) + " relative (bound " + sci(kAnswerConstraint) + "; " +
+                cause + ")");
+  if (c.interpolation > kAnswerInterpolation)
+    throw Error("traj: the answer cannot be trusted: segment " + std::to_string(c.worst_segment) +
+                " meets its waypoints only to " + sci(c.interpolation * c.position_scale) + " m (bound " +
+                sci(kAnswerInterpolation) + " x " + sci(c.position_scale) + " m): the optimal trajectory swings to " +
+                sci(c.term_scale) + " m between waypoints " + sci(c.position_scale) +
+                " m apart, beyond what double precision carries: the " + cause +
+                ", and a short segment forces derivatives that its long neighbours must undo; give durations in proportion to the segment lengths (or drop \"durations\" and give \"limits\")");
+  if (c.optimality > kAnswerOptimality)
+    throw Error("traj: the answer cannot be trusted: the optimality conditions (continuity of derivatives s..2s-2) "
+                "hold only to " + sci(c.optimality) + " relative (bound " + sci(kAnswerOptimality) + "; " + cause +
+                "); give durations closer to each other");
+}
+
 PolynomialTrajectory solve_minco(const MincoProblem& problem) {
   validate(problem);
   PolynomialTrajectory out;
   MincoSolver().solve(problem, out);
+  check_answer(problem, out);
   return out;
 }
 

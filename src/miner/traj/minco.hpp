@@ -74,7 +74,42 @@ class MincoSolver {
   std::unique_ptr<Workspace> ws_;
 };
 
-/// validate() + MincoSolver().solve().
+/// The a-posteriori check of an answer (REQ-TRAJ-010), in O(M). Residuals of the conditions
+/// of A c = b, each for derivative k relative to its segment's own scale
+/// S_ik = sum_j |c_ij| j!/(j-k)! T_i^(j-k) (per-segment scaling), split in two:
+///  - constraint: head and tail derivatives 0..s-1, both ends of every segment at its
+///    waypoints, continuity of derivatives 0..s-1 at interior waypoints (what flight uses);
+///  - optimality: continuity of derivatives s..2s-2 (the optimality conditions);
+/// and interpolation: the largest distance (max norm) of a segment end from its waypoint,
+/// relative to the problem's position scale L = max(largest |coordinate|, extent of the
+/// points): what a user of the waypoints sees.
+struct AnswerCheck {
+  bool finite = true;
+  double constraint = 0.0;
+  double optimality = 0.0;
+  double interpolation = 0.0;
+  int worst_segment = -1;        ///< segment of the largest interpolation error
+  double position_scale = 0.0;   ///< L (m)
+  double term_scale = 0.0;       ///< largest S_i0 (m): how far the trajectory swings
+};
+AnswerCheck measure_answer(const MincoProblem& problem, const PolynomialTrajectory& answer);
+
+/// Bounds of check_answer(). kAnswerConstraint: a stable evaluation leaves a few eps of S_ik;
+/// 1e-9 keeps a margin for long sums and refuses any wrong answer (those are O(1)).
+/// kAnswerOptimality: the jumps of derivatives s..2s-2 carry the solve's own error, which
+/// grows with the spread of the durations (docs/traj.md); 1e-6 of S_ik changes the cost by
+/// ~1e-12 relative. kAnswerInterpolation: issue 21's "waypoints met to 1e-9 relative".
+inline constexpr double kAnswerConstraint = 1e-9;
+inline constexpr double kAnswerOptimality = 1e-6;
+inline constexpr double kAnswerInterpolation = 1e-9;
+
+/// Throws miner::Error naming the cause when the answer cannot be trusted: a non-finite
+/// coefficient, a residual above its bound, or a waypoint missed by more than
+/// kAnswerInterpolation x L (the usual cause: a short segment between long ones, so the
+/// optimum swings far between waypoints and double precision cannot carry it).
+void check_answer(const MincoProblem& problem, const PolynomialTrajectory& answer);
+
+/// validate() + MincoSolver().solve() + check_answer().
 PolynomialTrajectory solve_minco(const MincoProblem& problem);
 
 }  // namespace miner::traj

@@ -153,3 +153,56 @@ TEST_CASE("The Table II baselines solve the same problem to the same coefficient
     CHECK((solve_closed_form(p) - c).norm() <= 1e-7 * c.norm());
   }
 }
+
+TEST_CASE("Every answer is checked: a trajectory that cannot meet its waypoints is refused naming the cause", "[REQ-TRAJ-010]") {
+  // 1 m in 1e-6 s next to a 1 s segment: the optimum swings ~1e12 m, so monomial
+  // coefficients in double precision miss the last waypoint by ~1e-4 m.
+  Eigen::MatrixX3d pts(3, 3);
+  pts << 0, 0, 0, 1, 0, 0, 2, 1, 0;
+  CHECK_THROWS_WITH(solve_minco(rest_to_rest(3, pts, {1e-6, 1.0})),
+                    Contains("segment 1 meets its waypoints only to") && Contains("swings to") &&
+                        Contains("durations span 1e-06 to 1 s (ratio 1e+06)"));
+  CHECK_THROWS_WITH(solve_minco(rest_to_rest(4, pts, {1e6, 1.0})), Contains("segment 0 meets its waypoints"));
+  // A spread of 1e2 is carried: waypoints met to 1e-9 x L, every condition to 1e-10.
+  const auto p = rest_to_rest(3, pts, {1e-2, 1.0});
+  const auto t = solve_minco(p);
+  const auto c = measure_answer(p, t);
+  CHECK(c.finite);
+  CHECK(c.interpolation <= kAnswerInterpolation);
+  CHECK(c.constraint <= kAnswerConstraint);
+  CHECK(c.optimality <= kAnswerOptimality);
+  CHECK(c.position_scale == 2.0);
+}
+
+TEST_CASE("The answer check refuses a wrong, non-finite or inaccurate answer", "[REQ-TRAJ-010]") {
+  Eigen::MatrixX3d pts(4, 3);
+  pts << 0, 0, 0, 1, 2, 0, 3, 1, 1, 4, 4, 2;
+  const auto p = rest_to_rest(4, pts, {1.0, 2.0, 0.5});
+  const auto good = solve_minco(p);
+  const auto base = measure_answer(p, good);
+  CHECK(base.constraint < 1e-13);  // a few eps
+  CHECK(base.optimality < 1e-11);
+  CHECK_NOTHROW(check_answer(p, good));
+  // A coefficient off by 1e-6 (relative): a continuity or waypoint condition breaks.
+  auto off = good;
+  off.mutable_coefficients()(13, 1) *= 1.0 + 1e-6;
+  CHECK(measure_answer(p, off).constraint > kAnswerConstraint);
+  CHECK_THROWS_WITH(check_answer(p, off), Contains("a constraint (waypoint, head, tail or continuity"));
+  // The top coefficient of a snap segment off by 1e-4: the 6th derivative jumps (optimality).
+  auto jump = good;
+  jump.mutable_coefficients()(7, 2) += 1e-4 * std::abs(jump.mutable_coefficients()(7, 2)) + 1e-4;
+  CHECK_THROWS_WITH(check_answer(p, jump), Contains("a constraint") || Contains("the optimality conditions"));
+  // Off by 1e-12 relative only: still within the bounds (the check does not refuse round-off).
+  auto tiny = good;
+  tiny.mutable_coefficients()(13, 1) *= 1.0 + 1e-12;
+  CHECK_NOTHROW(check_answer(p, tiny));
+  // A NaN coefficient.
+  auto nan = good;
+  nan.mutable_coefficients()(5, 0) = std::nan("");
+  CHECK_FALSE(measure_answer(p, nan).finite);
+  CHECK_THROWS_WITH(check_answer(p, nan), Contains("the answer is not finite"));
+  // The snap at the start differs from the head's: refused too.
+  auto moved = p;
+  moved.head.row(3) << 1e-3, 0, 0;
+  CHECK_THROWS_WITH(check_answer(moved, good), Contains("a constraint"));
+}

@@ -64,6 +64,35 @@ inline double stddev(const std::vector<double>& v) {
   return std::sqrt(ss / static_cast<double>(f.size() - 1));
 }
 
+/// Two-sided p-value of the Mann-Whitney U test that two samples come from one
+/// distribution (normal approximation with the tie correction and a continuity correction of
+/// 1/2, as scipy.stats.mannwhitneyu's asymptotic method). +inf entries (a missed stage) take
+/// part as ties above every finite value. NaN when a sample is empty or holds NaN; 1 when all
+/// values tie.
+inline double mann_whitney_p(const std::vector<double>& a, const std::vector<double>& b) {
+  if (a.empty() || b.empty() || any_unknown(a) || any_unknown(b)) return NAN;
+  std::vector<std::pair<double, int>> all;
+  for (double x : a) all.emplace_back(x, 0);
+  for (double x : b) all.emplace_back(x, 1);
+  std::sort(all.begin(), all.end(), [](const auto& l, const auto& r) { return l.first < r.first; });
+  const double n = static_cast<double>(all.size()), na = static_cast<double>(a.size()), nb = static_cast<double>(b.size());
+  double rank_a = 0.0, ties = 0.0;
+  for (std::size_t i = 0; i < all.size();) {
+    std::size_t j = i;
+    while (j < all.size() && all[j].first == all[i].first) ++j;  // +inf == +inf: one tie group
+    const double t = static_cast<double>(j - i), mid = 0.5 * static_cast<double>(i + 1 + j);  // average rank
+    for (std::size_t k = i; k < j; ++k)
+      if (all[k].second == 0) rank_a += mid;
+    ties += t * t * t - t;
+    i = j;
+  }
+  const double U = rank_a - na * (na + 1.0) / 2.0, mu = na * nb / 2.0;
+  const double var = na * nb / 12.0 * ((n + 1.0) - ties / (n * (n - 1.0)));
+  if (!(var > 0.0)) return 1.0;
+  const double z = std::max(0.0, std::abs(U - mu) - 0.5) / std::sqrt(var);
+  return std::min(1.0, std::erfc(z / std::sqrt(2.0)));
+}
+
 inline nlohmann::json num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
 
 }  // namespace miner::bench

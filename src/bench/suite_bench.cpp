@@ -89,6 +89,34 @@ std::string planner_label(const std::string& planner) {
 
 double finite_or_inf(double v) { return std::isfinite(v) ? v : std::numeric_limits<double>::infinity(); }
 
+/// Our planners and their OMPL counterparts (issue 17 item 2).
+const std::pair<const char*, const char*> kCounterparts[] = {{"rrtstar", "ompl:RRTstar"},
+                                                             {"informed", "ompl:InformedRRTstar"}};
+/// Two-sided significance level of "slower" in the headlines.
+constexpr double kSignificance = 0.05;
+
+struct Comparison {
+  bool run = false;  ///< both planners are in the campaign
+  double ours_ms = NAN, theirs_ms = NAN, ours_it = NAN, theirs_it = NAN, p = NAN;
+  bool slower = false;       ///< our median time to the target is above theirs (misses as +inf)
+  bool significant = false;  ///< and the Mann-Whitney test on the times says so at kSignificance
+};
+
+Comparison compare(const FrontendBenchResult& fr, const std::string& ours, const std::string& theirs) {
+  Comparison c;
+  const auto a = stage_values(fr, ours, true, true), b = stage_values(fr, theirs, true, true);
+  if (a.empty() || b.empty()) return c;
+  c.run = true;
+  c.ours_ms = median(a);
+  c.theirs_ms = median(b);
+  c.ours_it = median(stage_values(fr, ours, true, false));
+  c.theirs_it = median(stage_values(fr, theirs, true, false));
+  c.p = mann_whitney_p(a, b);
+  c.slower = finite_or_inf(c.ours_ms) > finite_or_inf(c.theirs_ms);
+  c.significant = c.slower && c.p < kSignificance;
+  return c;
+}
+
 /// Generated headline of one campaign: the fastest planner to the target (median time,
 /// misses as +inf) among every planner except the oracle, miner-sgan's ratio to it, and
 /// our RRT* / Informed RRT* against OMPL's (issue 17 item 2).
@@ -110,20 +138,87 @@ std::string cell_headline(const FrontendBenchResult& fr, const std::vector<std::
                                                                       : std::string("fewer than half its runs reached it"))
         << ".";
   }
-  for (const auto& [ours, theirs] : {std::pair<const char*, const char*>{"rrtstar", "ompl:RRTstar"},
-                                     {"informed", "ompl:InformedRRTstar"}}) {
-    const PlannerSummary* a = find_summary(fr, ours);
-    const PlannerSummary* b = find_summary(fr, theirs);
-    if (!a || !b) continue;
-    const double ta = finite_or_inf(a->target_time_ms), tb = finite_or_inf(b->target_time_ms);
-    h << " `" << ours << "` vs `" << theirs << "`: ";
-    if (!std::isfinite(ta) && !std::isfinite(tb)) h << "neither reached the target in half its runs;";
-    else h << f(a->target_time_ms, 1) << " vs " << f(b->target_time_ms, 1) << " ms (" << (ta <= tb ? "no slower" : "**slower**")
-           << ");";
+  for (const auto& [ours, theirs] : kCounterparts) {
+    const Comparison c = compare(fr, ours, theirs);
+    if (!c.run) continue;
+    h << " `" << ours << "` vs `" << theirs << "` to the target: " << f(c.ours_ms, 1) << " vs " << f(c.theirs_ms, 1)
+      << " ms, " << f(c.ours_it, 0) << " vs " << f(c.theirs_it, 0) << " iterations ("
+      << (c.slower ? (c.significant ? "**slower**" : "slower, not significantly") : "no slower")
+      << ", Mann-Whitney p = " << f(c.p, 2) << " on the times);";
   }
   std::string s = h.str();
   if (!s.empty() && s.back() == ';') s.back() = '.';
   return s;
+}
+
+/// The suite's headline, generated from every campaign: who is fastest to the target how
+/// often (every planner run except the oracle), miner-sgan against the fastest other
+/// planner and against issue 16's bar (5x faster than every other planner), and our RRT* and
+/// Informed RRT* against OMPL's.
+std::string suite_headline(const SuiteBenchResult& r) {
+  std::map<std::string, int> fastest;
+  int sgan_fastest = 0, sgan_five = 0, sgan_run = 0;
+  double worst_ratio = 0.0, best_ratio = std::numeric_limits<double>::infinity();
+  std::map<std::string, std::pair<int, int>> slower;  // ours -> (slower, significantly)
+  for (const SuiteCell& c : r.cells) {
+    std::string best;
+    double best_v = std::numeric_limits<double>::infinity(), other_best = best_v;
+    for (const auto& p : r.options.planners) {
+      if (p == kOraclePlanner) continue;
+      const PlannerSummary* s = find_summary(c.result, p);
+      if (!s) continue;
+      const double v = finite_or_inf(s->target_time_ms);
+      if (v < best_v) best_v = v, best = p;
+      if (p != kMinerSgan) other_best = std::min(other_best, v);
+    }
+    ++fastest[best.empty() ? std::string("(none in half its runs)") : best];
+    if (const PlannerSummary* s = find_summary(c.result, kMinerSgan)) {
+      ++sgan_run;
+      const double mine = finite_or_inf(s->target_time_ms);
+      if (best == kMinerSgan) ++sgan_fastest;
+      if (std::isfinite(mine) && mine * 5.0 <= other_best) ++sgan_five;
+      const double ratio = mine / other_best;  // > 1: slower than the fastest other planner
+      if (!std::isnan(ratio)) {
+        worst_ratio = std::max(worst_ratio, ratio);
+        best_ratio = std::min(best_ratio, ratio);
+      }
+    }
+    for (const auto& [ours, theirs] : kCounterparts) {
+      const Comparison cmp = compare(c.result, ours, theirs);
+      if (!cmp.run) continue;
+      auto& [n_slower, n_significant] = slower[ours];
+      n_slower += cmp.slower ? 1 : 0;
+      n_significant += cmp.significant ? 1 : 0;
+    }
+  }
+  std::ostringstream h;
+  const std::size_t n = r.cells.size();
+  std::size_t set = 0;
+  for (const auto& p : r.options.planners) set += p == kOraclePlanner ? 0 : 1;
+  h << "## Headline (generated from the " << n << " campaigns below; comparison set: the " << set
+    << " planners run, the oracle aside)\n\n- Fastest to the target (median time, misses as +inf):";
+  bool first = true;
+  for (const auto& [p, k] : fastest) h << (first ? " " : ", ") << "`" << p << "` in " << k, first = false;
+  h << " of " << n << " campaigns.\n";
+  if (sgan_run > 0) {
+    h << "- `miner-sgan` (sGAN region, its query time included) is the fastest in " << sgan_fastest << " of " << sgan_run
+      << " and at least 5x faster than every other planner (issue 16's bar) in " << sgan_five << " of " << sgan_run
+      << "; its median time to the target is " << f(best_ratio, 2) << "x to " << f(worst_ratio, 2)
+      << "x the fastest other planner's. The paper's claim (MINER reaches the target before every baseline) "
+         "reproduces in "
+      << sgan_fastest << " of " << sgan_run << " campaigns and does **not** in the other " << (sgan_run - sgan_fastest)
+      << ".\n";
+  }
+  for (const auto& [ours, theirs] : kCounterparts) {
+    const auto it = slower.find(ours);
+    if (it == slower.end()) continue;
+    h << "- `" << ours << "` against `" << theirs << "`: slower to the target (median) in " << it->second.first << " of " << n
+      << " campaigns, significantly (Mann-Whitney on the times, p < " << f(kSignificance, 2) << ") in "
+      << it->second.second << ".\n";
+  }
+  std::string out = h.str();
+  if (!out.empty() && out.back() == '\n') out.pop_back();
+  return out;
 }
 
 }  // namespace
@@ -253,6 +348,8 @@ std::string suite_markdown(const SuiteBenchResult& r, const std::string& figure_
         "region query (encode, inference, filter) in every time; `miner` samples the A*-dilated region built from the "
         "path that defines the target and is an upper bound, never a result. A missed stage counts as +inf in medians "
         "and quartiles (\"miss\") and is left out of mean ± sd, which is over the runs that got there.\n\n";
+
+  md << suite_headline(r) << "\n\n";
 
   md << "## Difficulty: RRT*'s first solution against the paper's Table I\n\n"
      << "The paper's RRT* found its first solution after " << f(suite.band_lo, 0) << "-" << f(suite.band_hi, 0)

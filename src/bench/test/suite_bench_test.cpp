@@ -5,10 +5,12 @@
 
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <regex>
 
 #include <unistd.h>
 
+#include "bench/campaign_stats.hpp"
 #include "bench/ompl_planners.hpp"
 #include "bench/suite_bench.hpp"
 #include "miner/core/error.hpp"
@@ -126,6 +128,17 @@ TEST_CASE("The suite runs every planner at every step and reports spread, n and 
     CHECK(std::distance(std::sregex_iterator(md.begin(), md.end(), row), std::sregex_iterator()) == 2);
   }
   CHECK_THAT(md, Contains("median [IQR]") && Contains("mean ± sd") && Contains("Steering step sweep"));
+  // The headline counts come from the campaigns: each campaign has one fastest planner.
+  const std::regex fastest("Fastest to the target \\(median time, misses as \\+inf\\):(.*) of 2 campaigns");
+  std::smatch m;
+  REQUIRE(std::regex_search(md, m, fastest));
+  int total = 0;
+  const std::string counts = m[1];
+  const std::regex in(" in ([0-9]+)");
+  for (auto it = std::sregex_iterator(counts.begin(), counts.end(), in); it != std::sregex_iterator(); ++it)
+    total += std::stoi((*it)[1]);
+  CHECK(total == 2);
+  CHECK((md.find("`rrtstar` against `ompl:RRTstar`") != std::string::npos) == miner::bench::ompl_available());
 
   // A campaign where the target is out of reach: misses are shown, in the tables and plots.
   auto missing = r;
@@ -154,4 +167,21 @@ TEST_CASE("A suite map that cannot be generated is refused before any campaign",
   s.maps = {m};
   auto o = tiny_options(s);
   CHECK_THROWS_WITH(run_suite_bench(o, "test", nullptr), Contains("map \"bad\""));
+}
+
+TEST_CASE("The Mann-Whitney test of the headlines matches the textbook values", "[REQ-REPORT-008]") {
+  using miner::bench::mann_whitney_p;
+  const double inf = std::numeric_limits<double>::infinity();
+  // Fully separated samples of 5 and 5: U = 0, z = (12.5 - 0.5) / sqrt(22.917): p = 0.01219
+  // (scipy.stats.mannwhitneyu(..., method="asymptotic") gives 0.012185).
+  CHECK(mann_whitney_p({1, 2, 3, 4, 5}, {6, 7, 8, 9, 10}) == Approx(0.012185).epsilon(1e-3));
+  CHECK(mann_whitney_p({6, 7, 8, 9, 10}, {1, 2, 3, 4, 5}) == Approx(0.012185).epsilon(1e-3));
+  // Interleaved samples: no evidence.
+  CHECK(mann_whitney_p({1, 3, 5, 7}, {2, 4, 6, 8}) > 0.5);
+  // Misses rank above every time and tie among themselves: {1,2,3,inf,inf} vs {4,5,6,7,8}
+  // has ranks 1, 2, 3, 9.5, 9.5: U = 25 - 15 = 10, z = (12.5 - 10 - 0.5) / sqrt(25/12 (11 - 6/90)),
+  // p = 0.6753.
+  CHECK(mann_whitney_p({1, 2, 3, inf, inf}, {4, 5, 6, 7, 8}) == Approx(0.6753).epsilon(2e-3));
+  CHECK(mann_whitney_p({1, 1}, {1, 1}) == 1.0);
+  CHECK(std::isnan(mann_whitney_p({}, {1})));
 }

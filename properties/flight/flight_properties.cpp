@@ -7,6 +7,7 @@
 #include "miner/flight/closed_loop.hpp"
 #include "miner/testing/flight_scenarios.hpp"
 #include "miner/testing/property.hpp"
+#include "miner/traj/time_allocation.hpp"
 
 using miner::testing::open_room_scenario;
 using miner::testing::property;
@@ -58,7 +59,7 @@ TEST_CASE("Tracking error stays under the derived bound on random feasible traje
     // Re-time so the tighter of the two limits is met with equality (build_reference
     // only ever stretches): the property covers trajectories at their limits.
     const double k = std::max(ref.max_speed / v_max, std::sqrt(ref.max_acceleration / a_max));
-    flight::scale_time(ref.trajectory, k);
+    miner::traj::scale_time(ref.trajectory, k);
     const auto [v, a] = flight::trajectory_extremes(ref.trajectory, 1e-3);
     RC_ASSERT(v <= v_max * (1 + 1e-6));
     RC_ASSERT(a <= a_max * (1 + 1e-6));

@@ -15,6 +15,7 @@
 #include "miner/traj/baselines.hpp"
 #include "miner/traj/minco.hpp"
 #include "miner/traj/optimality_system.hpp"
+#include "miner/traj/time_allocation.hpp"
 #include "miner/traj/trapezoidal_allocation.hpp"
 
 using namespace miner::traj;
@@ -422,6 +423,43 @@ TEST_CASE("Scaling all durations by k scales the rest-to-rest cost by k^(1-2s)",
     for (auto& d : q.durations) d *= k;
     const double expected = std::pow(k, 1 - 2 * p.order) * solve_minco(p).cost();
     RC_ASSERT(std::fabs(solve_minco(q).cost() - expected) <= 1e-9 * expected);
+  });
+}
+
+TEST_CASE("Optimised allocation is never above the trapezoid's objective, holds the limits and is locally optimal", "[REQ-TRAJ-011]") {
+  property("F(optimised) <= F(trapezoid), peaks <= limits, no log-T step lowers F", [](std::uint64_t seed) {
+    Rng rng(seed, 4);
+    // Paths of 1..8 segments from 0.5 m to 20 m (maps from a room to a 100 m sim map), rest
+    // to rest, limits and rho over two orders of magnitude.
+    MincoProblem p = random_problem(seed, {0.5, 2.0, true});  // rest to rest (REQ-TRAJ-011)
+    const int M = std::min<int>(static_cast<int>(p.durations.size()), 8);
+    p.points.conservativeResize(M + 1, 3);
+    p.durations.resize(static_cast<std::size_t>(M));
+    for (int i = 1; i <= M; ++i) {
+      Eigen::Vector3d d(rng.normal(), rng.normal(), rng.normal());
+      p.points.row(i) = p.points.row(i - 1) + (rng.uniform(0.5, 20.0) / d.norm()) * d.transpose();
+    }
+    p.head.row(0) = p.points.row(0);
+    p.tail.row(0) = p.points.row(M);
+    AllocationOptions o;
+    o.limits = Limits{rng.uniform(0.5, 5.0), rng.uniform(0.5, 5.0)};
+    o.rho = std::pow(10.0, rng.uniform(-1.0, 1.0));
+    AllocationResult r;
+    try {
+      r = optimise_allocation(p, o);
+    } catch (const miner::Error& e) {
+      RC_FAIL(std::string("refused: ") + e.what());
+    }
+    RC_ASSERT(r.objective <= r.start_objective);
+    RC_ASSERT(r.max_speed <= o.limits.v_max);
+    RC_ASSERT(r.max_acceleration <= o.limits.a_max);
+    RC_ASSERT(std::abs(r.objective - feasible_objective(p, r.durations, o).first) <= 1e-9 * r.objective);
+    for (std::size_t i = 0; i < r.durations.size(); ++i)
+      for (double h : {1e-3, -1e-3}) {
+        auto T = r.durations;
+        T[i] *= std::exp(h);
+        RC_ASSERT(feasible_objective(p, T, o).first >= r.objective * (1.0 - 1e-9));
+      }
   });
 }
 

@@ -1,4 +1,5 @@
 // `miner traj solve` (REQ-TRAJ-006).
+#include <optional>
 #include <ostream>
 
 #include <CLI/CLI.hpp>
@@ -13,11 +14,16 @@ namespace {
 struct SolveOptions {
   std::string problem;
   std::string out;
+  std::string allocate;
+  std::optional<double> rho;
 };
 
 void run_solve(const SolveOptions& o, std::ostream& out) {
-  const auto problem = traj::problem_from_json(read_json_file(o.problem), o.problem);
-  const Json answer = traj::answer_to_json(traj::solve_minco(problem));
+  const auto request = traj::request_from_json(read_json_file(o.problem), o.problem, o.allocate, o.rho);
+  const auto& problem = request.problem;
+  const Json answer = request.optimise
+                          ? traj::answer_to_json(traj::optimise_allocation(problem, *request.optimise), *request.optimise)
+                          : traj::answer_to_json(traj::solve_minco(problem));
   if (o.out.empty()) {
     out << dump_json(answer);
   } else {
@@ -35,6 +41,10 @@ void add_traj_commands(CLI::App& app, std::ostream& out) {
   CLI::App* s = traj->add_subcommand("solve", "solve a trajectory problem file (docs/traj.md)");
   s->add_option("--problem", solve->problem, "problem JSON: order, points, head, tail, durations or limits")->required();
   s->add_option("--out", solve->out, "write the answer JSON here (default: stdout)");
+  s->add_option("--allocate", solve->allocate,
+                "durations from the limits: trapezoid (default) or optimise (min J + rho sum T within the limits, Ceres)")
+      ->check(CLI::IsMember({"trapezoid", "optimise"}));
+  s->add_option("--rho", solve->rho, "weight of the total time with --allocate optimise (default 1, or the file's)");
   s->callback([solve, &out] { run_solve(*solve, out); });
 }
 

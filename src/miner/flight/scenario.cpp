@@ -14,6 +14,7 @@
 #include "miner/plan/rrt_star.hpp"
 #include "miner/traj/collision_repair.hpp"
 #include "miner/traj/problem_io.hpp"
+#include "miner/traj/time_allocation.hpp"
 
 namespace miner::flight {
 
@@ -220,15 +221,6 @@ void check_envelope(const Scenario& s, const traj::PolynomialTrajectory& t) {
 
 }  // namespace
 
-void scale_time(traj::PolynomialTrajectory& t, double k) {
-  if (!(k > 0.0) || !std::isfinite(k)) throw Error("scale_time: k must be positive and finite");
-  auto& c = t.mutable_coefficients();
-  const int n = 2 * t.order();
-  for (int i = 0; i < t.segments(); ++i)
-    for (int j = 0; j < n; ++j) c.row(n * i + j) /= std::pow(k, j);
-  for (double& d : t.mutable_durations()) d *= k;
-}
-
 ReferencePlan build_reference(const Scenario& s) {
   ReferencePlan r;
   // Plan and repair with the tracking margin added: a reference that grazes the inflated
@@ -299,7 +291,7 @@ ReferencePlan build_reference(const Scenario& s) {
     const double k = std::max({1.0, v / s.limits.v_max, std::sqrt(a / s.limits.a_max)});
     if (k > 1.0 + kLimitSlack) {
       r.time_scale = k * (1.0 + kLimitSlack);
-      scale_time(r.trajectory, r.time_scale);
+      traj::scale_time(r.trajectory, r.time_scale);
     }
     r.stage_ms.emplace_back("trajectory", elapsed_ms(t_traj));
   }

@@ -121,11 +121,6 @@ struct ReferencePlan {
 /// tilt or thrust than the vehicle's envelope allows.
 ReferencePlan build_reference(const Scenario& s);
 
-/// Re-times t to run k times slower: p'(t) = p(t / k), so durations scale by k,
-/// velocities by 1/k and accelerations by 1/k^2 (coefficient j divided by k^j). For a
-/// rest-to-rest MINCO solution this is again the optimum for the scaled durations.
-void scale_time(traj::PolynomialTrajectory& t, double k);
-
 /// Maximum speed and acceleration of a trajectory, sampled every `step` seconds and at
 /// every segment end.
 std::pair<double, double> trajectory_extremes(const traj::PolynomialTrajectory& t, double step);

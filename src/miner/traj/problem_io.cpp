@@ -1,5 +1,7 @@
 #include "miner/traj/problem_io.hpp"
 
+#include <cmath>
+
 #include "miner/core/error.hpp"
 
 namespace miner::traj {
@@ -16,6 +18,7 @@ Eigen::MatrixX3d rows_of(const JsonField& f) {
 MincoProblem problem_from_json(const Json& doc, const std::string& origin) {
   const JsonField root(doc, "", origin);
   if (!doc.is_object()) root.fail("expected a JSON object (a trajectory problem)");
+  root.only_keys({"order", "points", "durations", "head", "tail", "limits", "allocation", "rho"});
   MincoProblem p;
   p.order = root.at("order").integer();
   p.points = rows_of(root.at("points"));
@@ -27,6 +30,7 @@ MincoProblem problem_from_json(const Json& doc, const std::string& origin) {
   } else {
     if (!root.has("limits")) root.fail("needs \"durations\" or \"limits\" (for trapezoidal allocation)");
     const JsonField l = root.at("limits");
+    l.only_keys({"v_max", "a_max"});
     const Limits limits{l.at("v_max").number(), l.at("a_max").number()};
     try {
       validate(limits);
@@ -41,6 +45,56 @@ MincoProblem problem_from_json(const Json& doc, const std::string& origin) {
     throw Error(origin + ": " + e.what());
   }
   return p;
+}
+
+TrajectoryRequest request_from_json(const Json& doc, const std::string& origin, const std::string& allocation_override,
+                                    std::optional<double> rho_override) {
+  TrajectoryRequest r;
+  r.problem = problem_from_json(doc, origin);
+  const JsonField root(doc, "", origin);
+  std::string method = root.has("allocation") ? root.at("allocation").string() : "trapezoid";
+  if (!allocation_override.empty()) method = allocation_override;
+  if (method != "trapezoid" && method != "optimise")
+    (root.has("allocation") && allocation_override.empty() ? root.at("allocation") : root)
+        .fail("allocation: expected \"trapezoid\" or \"optimise\", got \"" + method + "\"");
+  if (method == "trapezoid") {
+    if (root.has("rho") || rho_override) root.fail("rho: only used with \"allocation\": \"optimise\"");
+    return r;
+  }
+  if (root.has("durations"))
+    root.at("durations").fail("durations are given, so there is nothing to optimise: drop them (or the optimise request)");
+  AllocationOptions o;
+  const JsonField l = root.at("limits");
+  o.limits = Limits{l.at("v_max").number(), l.at("a_max").number()};
+  if (root.has("rho")) o.rho = root.at("rho").positive_number();
+  if (rho_override) {
+    if (!std::isfinite(*rho_override) || !(*rho_override > 0.0))
+      throw Error("--rho: must be positive and finite, got " + std::to_string(*rho_override));
+    o.rho = *rho_override;
+  }
+  r.optimise = o;
+  return r;
+}
+
+Json answer_to_json(const AllocationResult& a, const AllocationOptions& o) {
+  Json j = answer_to_json(a.trajectory);
+  j["allocation"] = {{"method", "optimise"},
+                     {"rho", o.rho},
+                     {"objective", a.objective},
+                     {"trapezoid_objective", a.start_objective},
+                     {"trapezoid_stretch", a.start_scale},
+                     {"cost", a.cost},
+                     {"total_time", a.total_time},
+                     {"max_speed", a.max_speed},
+                     {"max_acceleration", a.max_acceleration},
+                     {"v_max", o.limits.v_max},
+                     {"a_max", o.limits.a_max},
+                     {"samples_per_segment", o.samples_per_segment},
+                     {"iterations", a.iterations},
+                     {"polish_evaluations", a.polish_evaluations},
+                     {"termination", a.termination},
+                     {"solve_ms", a.solve_ms}};
+  return j;
 }
 
 Json answer_to_json(const PolynomialTrajectory& t) {

@@ -1,0 +1,125 @@
+// Optimised time allocation (REQ-TRAJ-011): never worse than the trapezoid, limits held,
+// first-order conditions at the answer; and the time-scaling helpers it stands on.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+#include "miner/core/error.hpp"
+#include "miner/traj/problem_io.hpp"
+#include "miner/traj/time_allocation.hpp"
+
+using namespace miner::traj;
+using Catch::Matchers::Contains;
+
+namespace {
+/// A zig-zag path with segments from 1 m to 8 m: the trapezoid gives every segment its
+/// own bang-coast-bang time, which MINCO's smooth curve through the corners does not need.
+Eigen::MatrixX3d zigzag() {
+  Eigen::MatrixX3d p(6, 3);
+  p << 0, 0, 1, 8, 0, 1, 8, 1, 1.5, 2, 4, 1, 3, 9, 2, 10, 10, 2;
+  return p;
+}
+}  // namespace
+
+TEST_CASE("scale_time stretches durations by k, speeds by 1/k and accelerations by 1/k^2", "[REQ-TRAJ-011]") {
+  const auto t = solve_minco(rest_to_rest(3, zigzag(), trapezoidal_allocation(zigzag(), Limits{2, 1})));
+  auto s = t;
+  scale_time(s, 2.0);
+  CHECK(s.total_duration() == Approx(2.0 * t.total_duration()));
+  for (double u : {0.1, 0.37, 0.8}) {
+    const double at = u * t.total_duration();
+    CHECK((s.evaluate(2.0 * at) - t.evaluate(at)).norm() < 1e-9);
+    CHECK((s.evaluate(2.0 * at, 1) - t.evaluate(at, 1) / 2.0).norm() < 1e-9);
+    CHECK((s.evaluate(2.0 * at, 2) - t.evaluate(at, 2) / 4.0).norm() < 1e-9);
+  }
+  const auto [v, a] = sampled_extremes(t, 64);
+  const auto [v2, a2] = sampled_extremes(s, 64);
+  CHECK(v2 == Approx(v / 2.0));
+  CHECK(a2 == Approx(a / 4.0));
+  CHECK_THROWS_WITH(scale_time(s, 0.0), Contains("k must be positive"));
+}
+
+TEST_CASE("Optimised allocation lowers J + rho T below the trapezoid's and holds the limits", "[REQ-TRAJ-011]") {
+  for (int s : {3, 4})
+    for (double rho : {0.1, 1.0, 100.0}) {
+      INFO("s = " << s << ", rho = " << rho);
+      AllocationOptions o;
+      o.rho = rho;
+      o.limits = Limits{2.0, 1.0};
+      const auto r = optimise_allocation(rest_to_rest(s, zigzag(), {}), o);
+      CHECK(r.objective < r.start_objective);
+      CHECK(r.objective == Approx(r.cost + rho * r.total_time).epsilon(1e-12));
+      // The limits hold where they are checked, and nearly (sampling) at 1 ms.
+      CHECK(r.max_speed <= o.limits.v_max);
+      CHECK(r.max_acceleration <= o.limits.a_max);
+      const auto [v, a] = sampled_extremes(r.trajectory, 2000);
+      CHECK(v <= o.limits.v_max * 1.01);
+      CHECK(a <= o.limits.a_max * 1.01);
+      // The answer is the feasible objective the optimiser saw at its durations.
+      const auto [F, k] = feasible_objective(rest_to_rest(s, zigzag(), {}), r.durations, o);
+      CHECK(k == 1.0);
+      CHECK(F == Approx(r.objective).epsilon(1e-12));
+      // First-order conditions: no coordinate step of log T (made feasible) lowers F.
+      for (std::size_t i = 0; i < r.durations.size(); ++i)
+        for (double h : {1e-3, -1e-3}) {
+          auto T = r.durations;
+          T[i] *= std::exp(h);
+          CHECK(feasible_objective(rest_to_rest(s, zigzag(), {}), T, o).first >= r.objective * (1.0 - 1e-9));
+        }
+    }
+}
+
+TEST_CASE("Where no limit is active the answer is a stationary point: (dJ/dT_i + rho) T_i = 0", "[REQ-TRAJ-011]") {
+  AllocationOptions o;
+  o.rho = 0.05;  // time is cheap: slow trajectories, no limit active
+  o.limits = Limits{5.0, 5.0};
+  const auto p = rest_to_rest(3, zigzag(), {});
+  const auto r = optimise_allocation(p, o);
+  REQUIRE(r.max_speed < o.limits.v_max);
+  REQUIRE(r.max_acceleration < o.limits.a_max);
+  auto q = p;
+  q.durations = r.durations;
+  MincoSolver solver;
+  PolynomialTrajectory t;
+  solver.solve(q, t);
+  MincoGradients g;
+  solver.cost_and_gradients(q, &g);
+  for (std::size_t i = 0; i < r.durations.size(); ++i)
+    CHECK(std::abs((g.durations[static_cast<Eigen::Index>(i)] + o.rho) * r.durations[i]) <= 1e-5 * r.objective);
+}
+
+TEST_CASE("Optimised allocation refuses moving ends, naming why", "[REQ-TRAJ-011]") {
+  auto p = rest_to_rest(4, zigzag(), {});
+  p.head.row(2) << 0.5, 0, 0;
+  AllocationOptions o;
+  CHECK_THROWS_WITH(optimise_allocation(p, o), Contains("needs a problem at rest at both ends"));
+  o.rho = 0.0;
+  CHECK_THROWS_WITH(optimise_allocation(rest_to_rest(4, zigzag(), {}), o), Contains("rho: must be positive"));
+}
+
+TEST_CASE("Allocation requests in problem files are checked", "[REQ-TRAJ-011]") {
+  const auto doc = miner::parse_json(R"({"order": 3, "points": [[0,0,0],[1,0,0],[2,1,0]],
+    "head": [[0,0,0],[0,0,0],[0,0,0]], "tail": [[2,1,0],[0,0,0],[0,0,0]],
+    "limits": {"v_max": 2, "a_max": 1}, "allocation": "optimise", "rho": 3})", "p.json");
+  const auto r = request_from_json(doc, "p.json");
+  REQUIRE(r.optimise);
+  CHECK(r.optimise->rho == 3.0);
+  // The command line's --allocate trapezoid wins over the file (and then rho is refused).
+  CHECK_THROWS_WITH(request_from_json(doc, "p.json", "trapezoid", std::nullopt), Contains("rho: only used with"));
+  auto bad = doc;
+  bad["allocation"] = "optimize";
+  CHECK_THROWS_WITH(request_from_json(bad, "p.json"), Contains("allocation: expected \"trapezoid\" or \"optimise\""));
+  bad = doc;
+  bad["durations"] = {1.0, 1.0};
+  CHECK_THROWS_WITH(request_from_json(bad, "p.json"), Contains("durations are given"));
+  bad = doc;
+  bad["rhoo"] = 1;
+  CHECK_THROWS_WITH(request_from_json(bad, "p.json"), Contains("p.json: rhoo: unknown key"));
+  bad = doc;
+  bad["allocation"] = "trapezoid";
+  CHECK_THROWS_WITH(request_from_json(bad, "p.json"), Contains("rho: only used with"));
+  bad = doc;
+  bad["rho"] = -1;
+  CHECK_THROWS_WITH(request_from_json(bad, "p.json"), Contains("rho: must be positive"));
+  CHECK_THROWS_WITH(request_from_json(doc, "p.json", "", -2.0), Contains("--rho: must be positive"));
+}

@@ -1,0 +1,72 @@
+#pragma once
+/// \file
+/// Optimised time allocation (REQ-TRAJ-011): the segment durations T that minimise
+///   F(T) = J*(T) + rho * sum_i T_i        subject to  max |v| <= v_max, max |a| <= a_max,
+/// J* the MINCO optimum for those durations (paper Eq. (minco1)), solved with Ceres' line
+/// search (L-BFGS) over tau_i = log T_i (so T stays positive), from the trapezoidal
+/// allocation. The limits are kept by construction: every T the solver tries is first made
+/// feasible by the time scale k(T) = max(1, v_peak / v_max, sqrt(a_peak / a_max)) (stretching
+/// time by k divides speeds by k and accelerations by k^2 and keeps the MINCO optimum of a
+/// rest-to-rest problem), and F is evaluated at k T. Rest-to-rest problems only: with moving
+/// ends a longer trajectory can need more speed (a head acceleration held longer), so
+/// stretching is no way to the limits; such problems are refused. Where k = 1 the gradient is
+/// MINCO's own dJ*/dT (envelope theorem, MincoSolver::cost_and_gradients):
+///   dF/dtau_i = (dJ*/dT_i + rho) T_i;
+/// where a limit is active (k > 1) it is taken by central differences of F in tau, and since F
+/// has kinks there (the sampled peak moves between samples) a coordinate pattern search in
+/// tau finishes: at the answer no single duration scaled by exp(+-1e-3) lowers F. The answer
+/// is never worse than the start: Ceres and the search accept only decreasing steps, and a
+/// guard keeps the (feasible) trapezoid otherwise.
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "miner/traj/minco.hpp"
+#include "miner/traj/trapezoidal_allocation.hpp"
+
+namespace miner::traj {
+
+/// Re-times t to run k times slower: p'(t) = p(t / k), so durations scale by k, velocities by
+/// 1/k and accelerations by 1/k^2 (coefficient j divided by k^j). For a rest-to-rest MINCO
+/// solution this is again the optimum for the scaled durations.
+void scale_time(PolynomialTrajectory& t, double k);
+
+/// Largest speed and acceleration of t, sampled at `samples` + 1 evenly spaced instants of
+/// every segment (both ends included): bounded work whatever the durations.
+std::pair<double, double> sampled_extremes(const PolynomialTrajectory& t, int samples);
+
+struct AllocationOptions {
+  double rho = 1.0;           ///< weight of the total time in F (cost units per second)
+  Limits limits;
+  /// Speed and acceleration are checked at this many + 1 instants per segment (and the limits
+  /// said to hold there).
+  int samples_per_segment = 32;
+  int max_iterations = 200;   ///< Ceres line-search iterations
+};
+
+struct AllocationResult {
+  std::vector<double> durations;          ///< the optimised, feasible durations
+  PolynomialTrajectory trajectory;        ///< MINCO for them
+  double objective = 0.0;                 ///< F at the answer
+  double cost = 0.0, total_time = 0.0;    ///< J* and sum T there
+  double start_objective = 0.0;           ///< F at the (feasible) trapezoid, where Ceres starts
+  double start_scale = 1.0;               ///< k the trapezoid needed to meet the limits
+  double max_speed = 0.0, max_acceleration = 0.0;  ///< sampled, at the answer
+  int iterations = 0;                     ///< Ceres iterations
+  int polish_evaluations = 0;             ///< objective evaluations of the pattern search
+  std::string termination;                ///< Ceres' message
+  double solve_ms = 0.0;
+};
+
+/// Throws miner::Error for a bad problem (validate()), moving ends, bad limits, rho <= 0 or
+/// not finite, or samples_per_segment < 2. `problem.durations` are ignored: the start is the
+/// trapezoid.
+AllocationResult optimise_allocation(const MincoProblem& problem, const AllocationOptions& options);
+
+/// F at durations T made feasible, as the optimiser sees it (exposed for tests):
+/// (F, the time scale k applied).
+std::pair<double, double> feasible_objective(const MincoProblem& problem, const std::vector<double>& durations,
+                                             const AllocationOptions& options);
+
+}  // namespace miner::traj

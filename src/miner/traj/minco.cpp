@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include <Eigen/LU>
@@ -416,7 +417,20 @@ AnswerCheck measure_answer(const MincoProblem& p, const PolynomialTrajectory& tr
     const Eigen::Vector3d a = p.points.row(i).transpose(), b = p.points.row(i + 1).transpose();
     const Eigen::Vector3d ea = tr.evaluate_segment(i, 0.0) - a, eb = tr.evaluate_segment(i, p.durations[i]) - b;
     out.constraint = std::max({out.constraint, residual(ea, scale(i, 0)), residual(eb, scale(i, 0))});
-    const double miss = std::max(ea.cwiseAbs().maxCoeff(), eb.cwiseAbs().maxCoeff()) / out.position_scale;
+    // An upper bound on the exact miss of the coefficients as stored: the miss evaluated by
+    // Horner's rule in long double plus the bound on its rounding, 2N eps_ld of the terms'
+    // size (Higham, Accuracy and Stability, 5.1); in double that bound alone would be ~1e-13 S.
+    const auto c = tr.segment_coefficients(i);
+    const long double T = p.durations[static_cast<std::size_t>(i)];
+    long double miss_ld = 0.0L;
+    for (int ax = 0; ax < 3; ++ax) {
+      long double end = 0.0L;
+      for (int j = N - 1; j >= 0; --j) end = end * T + static_cast<long double>(c(j, ax));
+      miss_ld = std::max({miss_ld, std::abs(static_cast<long double>(c(0, ax)) - static_cast<long double>(p.points(i, ax))),
+                          std::abs(end - static_cast<long double>(p.points(i + 1, ax)))});
+    }
+    const double horner = 2.0 * N * static_cast<double>(std::numeric_limits<long double>::epsilon()) * scale(i, 0);
+    const double miss = (static_cast<double>(miss_ld) + horner) / out.position_scale;
     if (out.worst_segment < 0 || miss > out.interpolation) {
       out.interpolation = miss;
       out.worst_segment = i;

@@ -80,9 +80,10 @@ class MincoSolver {
 ///  - constraint: head and tail derivatives 0..s-1, both ends of every segment at its
 ///    waypoints, continuity of derivatives 0..s-1 at interior waypoints (what flight uses);
 ///  - optimality: continuity of derivatives s..2s-2 (the optimality conditions);
-/// and interpolation: the largest distance (max norm) of a segment end from its waypoint,
-/// relative to the problem's position scale L = max(largest |coordinate|, extent of the
-/// points): what a user of the waypoints sees.
+/// and interpolation: an upper bound on the largest distance (max norm) of a segment end from
+/// its waypoint in exact arithmetic (the miss evaluated in double plus Horner's rounding
+/// bound 2N eps S_i0), relative to the problem's position scale L = max(largest |coordinate|,
+/// extent of the points): what a user of the waypoints sees.
 struct AnswerCheck {
   bool finite = true;
   double constraint = 0.0;

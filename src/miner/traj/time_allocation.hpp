@@ -32,8 +32,9 @@ namespace miner::traj {
 /// solution this is again the optimum for the scaled durations.
 void scale_time(PolynomialTrajectory& t, double k);
 
-/// Largest speed and acceleration of t, sampled at `samples` + 1 evenly spaced instants of
-/// every segment (both ends included): bounded work whatever the durations.
+/// Largest speed and acceleration of t: per segment, `samples` + 1 evenly spaced instants
+/// (both ends included), then a golden-section search around the largest sample (to 1e-9 of
+/// the sample step): bounded work whatever the durations.
 std::pair<double, double> sampled_extremes(const PolynomialTrajectory& t, int samples);
 
 struct AllocationOptions {
@@ -42,7 +43,7 @@ struct AllocationOptions {
   /// Speed and acceleration are checked at this many + 1 instants per segment (and the limits
   /// said to hold there).
   int samples_per_segment = 32;
-  int max_iterations = 200;   ///< Ceres line-search iterations
+  int max_iterations = 100;   ///< Ceres line-search iterations per round
 };
 
 struct AllocationResult {

@@ -92,6 +92,16 @@ Scenario scenario_from_json(const Json& doc, const std::string& origin, const st
     }
     if (t.has("v_max")) s.limits.v_max = t.at("v_max").positive_number();
     if (t.has("a_max")) s.limits.a_max = t.at("a_max").positive_number();
+    if (t.has("allocation")) {
+      s.allocation = t.at("allocation").string();
+      if (s.allocation != "trapezoid" && s.allocation != "optimise")
+        t.at("allocation").fail("must be \"trapezoid\" or \"optimise\", got \"" + s.allocation + "\"");
+    }
+    if (t.has("rho")) {
+      if (s.allocation != "optimise") t.at("rho").fail("only used with \"allocation\": \"optimise\"");
+      s.rho = t.at("rho").positive_number();
+    }
+    t.only_keys({"file", "order", "v_max", "a_max", "allocation", "rho"});
   }
   if (root.has("planner")) {
     const JsonField p = root.at("planner");
@@ -284,7 +294,13 @@ ReferencePlan build_reference(const Scenario& s) {
     options.order = s.order;
     options.limits = s.limits;
     options.robot_radius = radius;
+    if (s.allocation == "optimise") {
+      traj::AllocationOptions a;
+      a.rho = s.rho;
+      options.optimise = a;
+    }
     auto repaired = traj::repair_collisions(*s.map, path, options);
+    r.allocation = repaired.allocation;
     r.trajectory = std::move(repaired.trajectory);
     r.path = std::move(repaired.waypoints);
     const auto [v, a] = trajectory_extremes(r.trajectory, kLimitSampleStep);

@@ -34,6 +34,7 @@
 #include "miner/flight/vehicle.hpp"
 #include "miner/plan/heuristic_region.hpp"
 #include "miner/traj/polynomial_trajectory.hpp"
+#include "miner/traj/time_allocation.hpp"
 #include "miner/traj/trapezoidal_allocation.hpp"
 #include "miner/world/map.hpp"
 
@@ -51,6 +52,9 @@ struct Scenario {
   std::optional<Eigen::MatrixX3d> waypoints;  ///< interior waypoints, one per row
   int order = 4;                            ///< s: 3 jerk, 4 snap
   traj::Limits limits{0.8, 0.5};
+  /// "trapezoid" or "optimise" (REQ-TRAJ-011: J + rho sum T within the limits, by Ceres).
+  std::string allocation = "trapezoid";
+  double rho = 1.0;
   std::optional<traj::PolynomialTrajectory> trajectory_file;
   std::uint64_t seed = 1;
   double hover_after_s = 3.0;
@@ -102,6 +106,7 @@ struct ReferencePlan {
   Eigen::MatrixX3d path;        ///< the waypoints MINCO went through (after repair)
   std::string source;           ///< "waypoints", "planner" or "file"
   double time_scale = 1.0;      ///< durations were stretched by this to meet the limits
+  std::optional<traj::AllocationResult> allocation;  ///< with "allocation": "optimise"
   double max_speed = 0.0, max_acceleration = 0.0;  ///< of the final trajectory
   std::size_t planner_iterations = 0;
   /// With source "planner": the heuristic region the planner sampled, its final tree

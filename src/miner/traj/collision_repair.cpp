@@ -50,9 +50,16 @@ RepairResult repair_collisions(const world::Map& map, const Eigen::MatrixX3d& pa
   r.waypoints = path;
   MincoSolver solver;
   for (;; ++r.iterations) {
-    const MincoProblem p = rest_to_rest(o.order, r.waypoints, trapezoidal_allocation(r.waypoints, o.limits));
-    validate(p);
-    solver.solve(p, r.trajectory);
+    if (o.optimise) {
+      AllocationOptions a = *o.optimise;
+      a.limits = o.limits;
+      r.allocation = optimise_allocation(rest_to_rest(o.order, r.waypoints, {}), a);
+      r.trajectory = r.allocation->trajectory;
+    } else {
+      const MincoProblem p = rest_to_rest(o.order, r.waypoints, trapezoidal_allocation(r.waypoints, o.limits));
+      validate(p);
+      solver.solve(p, r.trajectory);
+    }
     const std::vector<int> hits = colliding_segments(r.trajectory, map, o.robot_radius, step);
     if (hits.empty()) return r;
     if (r.iterations == o.max_iterations) {

@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// Collision repair (paper Alg. 2 lines 8-20, after Bry et al. 2015; REQ-TRAJ-008):
-/// allocate durations trapezoidally, solve MINCO rest-to-rest through the path, check
+/// allocate durations (trapezoid, or optimised: REQ-TRAJ-011), solve MINCO rest-to-rest through the path, check
 /// every segment against the map for the robot radius, insert the halfway point of the
 /// straight path segment under each colliding trajectory segment, and repeat. As
 /// waypoints are added the trajectory converges to the (collision-free) polyline, so the
@@ -9,7 +9,10 @@
 
 #include <Eigen/Core>
 
+#include <optional>
+
 #include "miner/traj/minco.hpp"
+#include "miner/traj/time_allocation.hpp"
 #include "miner/traj/trapezoidal_allocation.hpp"
 #include "miner/world/map.hpp"
 
@@ -23,6 +26,9 @@ struct RepairOptions {
   /// Collision sampling: consecutive samples at most this far apart (m); the chords
   /// between samples are checked exactly. 0 means half the map resolution.
   double sample_step = 0.0;
+  /// Durations by optimise_allocation (REQ-TRAJ-011; its limits are `limits`) instead of the
+  /// trapezoid, in every round, so the optimised curve is the one repaired.
+  std::optional<AllocationOptions> optimise;
 };
 
 struct RepairResult {
@@ -30,6 +36,7 @@ struct RepairResult {
   Eigen::MatrixX3d waypoints;  ///< the path with the inserted halfway points
   int iterations = 0;          ///< re-solves performed
   int inserted = 0;            ///< halfway points inserted
+  std::optional<AllocationResult> allocation;  ///< the last round's, with `optimise`
 };
 
 /// Index of the first trajectory segment whose sampled chords come within the robot

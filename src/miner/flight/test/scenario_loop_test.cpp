@@ -84,6 +84,31 @@ TEST_CASE("Bad scenarios are refused before flight with the fault named", "[REQ-
   expect_scenario_error(doc, "t0 < t1");
 }
 
+TEST_CASE("A scenario's trajectory.allocation optimise gives a lower J + rho T within the limits", "[REQ-TRAJ-011][REQ-FLIGHT-007]") {
+  miner::Json doc = default_doc();
+  doc["planner"]["region"] = "astar";  // the path does not depend on the network
+  const auto trapezoid = flight::build_reference(flight::scenario_from_json(doc, "s.json", kScenarios));
+  doc["trajectory"]["allocation"] = "optimise";
+  doc["trajectory"]["rho"] = 2.0;
+  const auto s = flight::scenario_from_json(doc, "s.json", kScenarios);
+  const auto optimised = flight::build_reference(s);
+  REQUIRE(optimised.allocation);
+  CHECK(optimised.allocation->objective <= optimised.allocation->start_objective);
+  const double F_trapezoid = trapezoid.trajectory.cost() + 2.0 * trapezoid.trajectory.total_duration();
+  const double F_optimised = optimised.trajectory.cost() + 2.0 * optimised.trajectory.total_duration();
+  CHECK(F_optimised < F_trapezoid);
+  CHECK(optimised.max_speed <= s.limits.v_max * (1 + 1e-6));
+  CHECK(optimised.max_acceleration <= s.limits.a_max * (1 + 1e-6));
+  // Bad requests are refused naming the field.
+  doc["trajectory"]["allocation"] = "optimize";
+  expect_scenario_error(doc, "trajectory.allocation: must be \"trapezoid\" or \"optimise\"");
+  doc["trajectory"]["allocation"] = "trapezoid";
+  expect_scenario_error(doc, "trajectory.rho: only used with");
+  doc["trajectory"].erase("rho");
+  doc["trajectory"]["v_maxx"] = 1.0;
+  expect_scenario_error(doc, "trajectory.v_maxx: unknown key");
+}
+
 TEST_CASE("A trajectory file that exceeds the limits or misses the start is refused", "[REQ-FLIGHT-007]") {
   Eigen::MatrixX3d points(2, 3);
   points << 5, 5, 3, 12, 9, 4;

@@ -185,12 +185,13 @@ FrontendBenchResult run_frontend_bench(const world::Map& map, const std::string&
   std::vector<Entry> entries;
   for (const std::string& name : out.options.planners) {
     const bool ompl = is_ompl_planner(name);
-    if (ompl) {
-      const auto names = ompl_planner_names();
-      if (std::find(names.begin(), names.end(), name) == names.end()) {
-        throw Error("unknown planner \"" + name + "\" (OMPL planners: ompl:RRTstar, ompl:InformedRRTstar, "
-                    "ompl:BITstar, ompl:ABITstar, ompl:AITstar, ompl:RRTConnect)");
-      }
+    // Every valid name in the message, ours and OMPL's (issue 20: it used to list 4 of 11).
+    std::vector<std::string> valid{"rrtstar", "informed", "guided", "miner", kMinerSgan};
+    for (const auto& n : ompl_planner_names()) valid.push_back(n);
+    if (std::find(valid.begin(), valid.end(), name) == valid.end()) {
+      std::string list;
+      for (const auto& v : valid) list += (list.empty() ? "" : ", ") + v;
+      throw Error("unknown planner \"" + name + "\" (planners: " + list + ")");
     }
     const bool sgan_planner = name == kMinerSgan;
     const plan::PlannerKind kind =
@@ -378,8 +379,37 @@ nlohmann::json to_json(const FrontendBenchResult& r) {
           {"run_records", runs}};
 }
 
-nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts) {
+nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, const std::vector<std::string>& files) {
   if (parts.empty()) throw Error("merge: no shard files");
+  // Each part must be a campaign's JSON before anything is compared (REQ-REPORT-006): a map
+  // or a truncated file is named with the field at fault, not as "a different campaign".
+  for (std::size_t p = 0; p < parts.size(); ++p) {
+    const std::string origin = p < files.size() ? files[p] : "shard file " + std::to_string(p + 1);
+    const JsonField root(parts[p], "", origin);
+    if (!parts[p].is_object()) root.fail("expected the JSON of `miner bench frontend --shard i/N --json`");
+    if (parts[p].contains("format"))
+      root.fail("is a \"" + (parts[p]["format"].is_string() ? parts[p]["format"].get<std::string>() : std::string("?")) +
+                "\" file, not the JSON of `miner bench frontend --shard i/N --json`");
+    const JsonField shard = root.at("shard");
+    (void)shard.at("index").integer();
+    (void)shard.at("count").integer();
+    (void)root.at("total_s").number();
+    (void)root.at("map").string();
+    for (const char* k : {"throughput", "region"}) (void)root.at(k);
+    const JsonField planners = root.at("planners");
+    for (std::size_t i = 0; i < planners.array_size(); ++i) (void)planners.at(i).at("planner").string();
+    const JsonField records = root.at("run_records");
+    for (std::size_t k = 0; k < records.array_size(); ++k) {
+      const JsonField r = records.at(k);
+      (void)r.at("planner").string();
+      (void)r.at("run").integer();
+      try {
+        (void)run_from(parts[p]["run_records"][k]);
+      } catch (const nlohmann::json::exception& e) {
+        r.fail(std::string("malformed run record: ") + e.what());
+      }
+    }
+  }
   // Everything but the per-shard fields must agree.
   const auto settings = [](nlohmann::json j) {
     for (const char* k : {"planners", "run_records", "shard", "total_s", "throughput", "region"}) j.erase(k);
@@ -389,7 +419,7 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts) {
   std::vector<nlohmann::json> tags;
   std::vector<std::string> names;
   for (std::size_t p = 0; p < parts.size(); ++p) {
-    names.push_back("shard file " + std::to_string(p + 1));
+    names.push_back(p < files.size() ? files[p] : "shard file " + std::to_string(p + 1));
     if (settings(parts[p]) != common)
       throw Error("merge: " + names.back() + " is from a different campaign (map, query, seed, runs or settings differ)");
     tags.push_back(parts[p].at("shard"));

@@ -124,7 +124,11 @@ nlohmann::json to_json(const FrontendBenchResult& result);
 /// runs, planners and settings; every shard exactly once) into the JSON the unsharded
 /// campaign writes: run records in planner-then-run order, summaries recomputed from
 /// them, total_s summed. Throws miner::Error naming the mismatch or the missing shard.
-nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts);
+/// `names` (the files, for messages; default "shard file k") name the part at fault; a part
+/// that is not a `bench frontend --json` output (a map file, a truncated record) is refused
+/// naming the file and the field.
+nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts,
+                                     const std::vector<std::string>& names = {});
 /// A table like the paper's Table I.
 void print_table(const FrontendBenchResult& result, std::ostream& out);
 /// OMPL's benchmark log format (ompl::tools::Benchmark::saveResultsToStream), readable by

@@ -69,7 +69,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
       ->capture_default_str();
   b->add_option("--budget", o->bench.budget_s, "seconds per (method, order, M)")->capture_default_str();
   b->add_option("--samples", o->bench.samples, "timed batches (median reported)")->capture_default_str();
-  b->add_option("--seed", o->bench.seed, "seed of the waypoints")->capture_default_str();
+  b->add_option("--seed", o->bench.seed, "seed of the waypoints")->capture_default_str()->check(kUnsigned64);
   add_output_options(b, o->output);
   b->callback([o, &out] {
     const auto records = bench::run_backend_bench(o->bench);
@@ -86,7 +86,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
                  "planners (default: rrtstar,informed,guided,miner and every ompl:* planner)")
       ->delimiter(',');
   fc->add_option("--runs", f->bench.runs, "runs per planner")->check(CLI::PositiveNumber)->capture_default_str();
-  fc->add_option("--seed", f->bench.seed, "master seed (run k uses stream k)")->capture_default_str();
+  fc->add_option("--seed", f->bench.seed, "master seed (run k uses stream k)")->capture_default_str()->check(kUnsigned64);
   fc->add_option("--target-factor", f->bench.target_factor, "target cost = this x the A* reference cost")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
@@ -108,7 +108,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   fc->add_option("--throughput-iterations", f->bench.throughput_iterations,
                  "iterations of the rrtstar vs ompl:RRTstar throughput check (0: skip)")
       ->capture_default_str();
-  fc->add_option("--ompl-log", f->ompl_log, "also write OMPL's benchmark log format to this file");
+  fc->add_option("--ompl-log", f->ompl_log, "also write OMPL's benchmark log format to this file")->check(kOutputFile);
   fc->add_option("--shard", f->shard, "i/N: run only runs r with r % N == i (join the parts with `miner bench merge`)");
   fc->add_flag("--quiet", f->quiet, "no progress bar on stderr");
   add_output_options(fc, f->output);
@@ -126,7 +126,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   hc->add_option("--split", h->bench.split, "split to measure (test: map seeds never trained on)")->capture_default_str();
   hc->add_option("--samples", h->bench.samples, "first N samples of the split (0: all)")->capture_default_str();
   hc->add_option("--weights", h->bench.weights, "sGAN weights (default: the shipped fixtures/sgan/sgan.bin)");
-  hc->add_option("--seed", h->bench.seed, "noise seed (sample k: seed + k) and planner seed")->capture_default_str();
+  hc->add_option("--seed", h->bench.seed, "noise seed (sample k: seed + k) and planner seed")->capture_default_str()->check(kUnsigned64);
   hc->add_option("--iterations", h->bench.max_iterations, "planner iteration budget per query")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
@@ -150,7 +150,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   mc->callback([mo, &out] {
     std::vector<Json> parts;
     for (const auto& file : mo->parts) parts.push_back(read_json_file(file));
-    const Json merged = bench::merge_frontend_shards(parts);
+    const Json merged = bench::merge_frontend_shards(parts, mo->parts);
     std::ostringstream text;
     text << "merged " << parts.size() << " shards of " << merged["map"].get<std::string>() << ": "
          << merged["run_records"].size() << " runs\n";
@@ -175,7 +175,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   pc->add_option("--planners", p->bench.planners, "front-end planners")->delimiter(',')->capture_default_str();
   pc->add_option("--runs", p->bench.runs, "front-end runs per planner and map")->capture_default_str()
       ->check(CLI::PositiveNumber);
-  pc->add_option("--seed", p->bench.seed, "seed of every campaign")->capture_default_str();
+  pc->add_option("--seed", p->bench.seed, "seed of every campaign")->capture_default_str()->check(kUnsigned64);
   pc->add_option("--time-limit", p->bench.time_limit_s, "seconds per front-end run")->capture_default_str()
       ->check(CLI::PositiveNumber);
   pc->add_option("--iterations", p->bench.max_iterations, "front-end iteration budget")->capture_default_str()
@@ -193,8 +193,9 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
       ->capture_default_str()->check(CLI::PositiveNumber);
   pc->add_option("--jobs", p->bench.jobs, "threads for generating the heuristic test set")->capture_default_str()
       ->check(CLI::PositiveNumber);
-  pc->add_option("--results", p->results, "the Markdown file to write")->capture_default_str();
-  pc->add_option("--figures", p->figures, "folder for the box plots (default: <results folder>/results)");
+  pc->add_option("--results", p->results, "the Markdown file to write")->capture_default_str()->check(kOutputFileNewFolder);
+  pc->add_option("--figures", p->figures, "folder for the box plots (default: <results folder>/results)")
+      ->check(kOutputFolder);
   pc->add_flag("--json", p->json, "print every figure as JSON");
   pc->add_flag("--quiet", p->quiet, "no progress on stderr");
   pc->callback([p, &out] {
@@ -219,6 +220,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
     std::vector<std::pair<std::string, std::string>> files;
     for (const auto& [name, svg] : bench::results_figures(r)) files.emplace_back(name, svg);
     write_folder_atomic(figures.string(), files);
+    if (!results.parent_path().empty()) fs::create_directories(results.parent_path());
     write_file_atomic(results.string(), bench::results_markdown(r, link));
     if (p->json) out << dump_json(bench::to_json(r));
     else out << "wrote " << results.string() << " and " << files.size() << " box plots in " << figures.string() << "\n";
@@ -239,14 +241,15 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   sc->add_option("--planners", su->bench.planners, "planners")->delimiter(',')->capture_default_str();
   sc->add_option("--runs", su->bench.runs, "runs per planner, map and steering step")->capture_default_str()
       ->check(CLI::PositiveNumber);
-  sc->add_option("--seed", su->bench.seed, "seed of every campaign")->capture_default_str();
+  sc->add_option("--seed", su->bench.seed, "seed of every campaign")->capture_default_str()->check(kUnsigned64);
   sc->add_option("--time-limit", su->bench.time_limit_s, "seconds per run")->capture_default_str()
       ->check(CLI::PositiveNumber);
   sc->add_option("--iterations", su->bench.max_iterations, "iteration budget per run")->capture_default_str()
       ->check(CLI::PositiveNumber);
   sc->add_option("--weights", su->bench.weights, "sGAN weights (default: the shipped ones)");
-  sc->add_option("--results", su->results, "the Markdown file to write")->capture_default_str();
-  sc->add_option("--figures", su->figures, "folder for the box plots (default: <results folder>/suite)");
+  sc->add_option("--results", su->results, "the Markdown file to write")->capture_default_str()->check(kOutputFileNewFolder);
+  sc->add_option("--figures", su->figures, "folder for the box plots (default: <results folder>/suite)")
+      ->check(kOutputFolder);
   sc->add_flag("--json", su->json, "print every figure as JSON");
   sc->add_flag("--quiet", su->quiet, "no progress on stderr");
   sc->callback([su, &out] {
@@ -255,9 +258,6 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
     su->bench.suite_file = su->suite;
     const fs::path results(su->results);
     const fs::path figures = su->figures.empty() ? results.parent_path() / "suite" : fs::path(su->figures);
-    // The outputs' folders are checked before the campaigns, not after them.
-    const fs::path results_dir = results.parent_path().empty() ? fs::path(".") : results.parent_path();
-    if (!fs::is_directory(results_dir)) throw Error("--results: folder " + results_dir.string() + " does not exist");
     std::ostringstream command;
     command << "miner bench suite --suite " << su->suite << " --runs " << su->bench.runs << " --seed "
             << su->bench.seed << " --time-limit " << su->bench.time_limit_s << " --iterations "
@@ -272,6 +272,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
     std::vector<std::pair<std::string, std::string>> files;
     for (const auto& [name, svg] : bench::suite_figures(r)) files.emplace_back(name, svg);
     write_folder_atomic(figures.string(), files);
+    if (!results.parent_path().empty()) fs::create_directories(results.parent_path());
     write_file_atomic(results.string(), bench::suite_markdown(r, link));
     if (su->json) out << dump_json(bench::to_json(r));
     else out << "wrote " << results.string() << " and " << files.size() << " box plots in " << figures.string() << "\n";

@@ -1,10 +1,13 @@
 #include "cli/cli.hpp"
 
 #include <cmath>
+#include <filesystem>
 #include <iostream>
 #include <new>
 
 #include <CLI/CLI.hpp>
+
+#include <unistd.h>
 
 #include "miner/core/error.hpp"
 
@@ -19,6 +22,60 @@ const CLI::Validator kFiniteNonNegative(
       return {};
     },
     "NONNEGATIVE");
+
+const CLI::Validator kUnsigned64(
+    [](std::string& text) -> std::string {
+      static const std::string kMax = "18446744073709551615";  // 2^64 - 1
+      const bool digits = !text.empty() && text.find_first_not_of("0123456789") == std::string::npos;
+      if (!digits) return "must be a non-negative integer (decimal digits only), got " + text;
+      const std::string trimmed = text.substr(std::min(text.find_first_not_of('0'), text.size() - 1));
+      if (trimmed.size() > kMax.size() || (trimmed.size() == kMax.size() && trimmed > kMax))
+        return "must be at most 18446744073709551615 (2^64 - 1), got " + text;
+      return {};
+    },
+    "UINT64");
+
+const CLI::Validator kOutputFile(
+    [](std::string& text) -> std::string {
+      namespace fs = std::filesystem;
+      if (text.empty()) return "an output file needs a name";
+      const fs::path p(text);
+      std::error_code ec;
+      if (fs::is_directory(p, ec)) return text + " is a folder, not a file";
+      const fs::path parent = p.parent_path().empty() ? fs::path(".") : p.parent_path();
+      if (!fs::is_directory(parent, ec)) return "the folder " + parent.string() + " does not exist";
+      if (::access(parent.c_str(), W_OK) != 0) return "the folder " + parent.string() + " is not writable";
+      return {};
+    },
+    "OUTPUT FILE");
+
+const CLI::Validator kOutputFolder(
+    [](std::string& text) -> std::string {
+      namespace fs = std::filesystem;
+      if (text.empty()) return "an output folder needs a name";
+      std::error_code ec;
+      fs::path p = fs::absolute(fs::path(text), ec);
+      if (fs::exists(p, ec) && !fs::is_directory(p, ec)) return text + " is a file, not a folder";
+      // The folder and its missing parents are created next to the nearest existing ancestor.
+      fs::path ancestor = p.parent_path();
+      while (!ancestor.empty() && !fs::exists(ancestor, ec) && ancestor != ancestor.parent_path())
+        ancestor = ancestor.parent_path();
+      if (!fs::is_directory(ancestor, ec)) return ancestor.string() + " is not a folder";
+      if (::access(ancestor.c_str(), W_OK) != 0) return "the folder " + ancestor.string() + " is not writable";
+      return {};
+    },
+    "OUTPUT FOLDER");
+
+const CLI::Validator kOutputFileNewFolder(
+    [](std::string& text) -> std::string {
+      namespace fs = std::filesystem;
+      if (text.empty()) return "an output file needs a name";
+      std::error_code ec;
+      if (fs::is_directory(fs::path(text), ec)) return text + " is a folder, not a file";
+      std::string parent = fs::absolute(fs::path(text), ec).parent_path().string();
+      return kOutputFolder(parent);
+    },
+    "OUTPUT FILE");
 
 const CLI::Validator kFinite(
     [](std::string& text) -> std::string {
@@ -56,7 +113,7 @@ ResolvedQuery resolve_query(const QueryOptions& q) {
 
 void add_output_options(CLI::App* cmd, OutputOptions& o) {
   cmd->add_flag("--json", o.json, "print the result as JSON");
-  cmd->add_option("--out", o.out, "also write the JSON result to this file");
+  cmd->add_option("--out", o.out, "also write the JSON result to this file")->check(kOutputFile);
 }
 
 void emit(const OutputOptions& o, const Json& doc, const std::string& human, std::ostream& out) {

@@ -36,6 +36,19 @@ void emit(const OutputOptions& o, const Json& doc, const std::string& human, std
 /// CLI11 validators: a finite number; a finite number >= 0.
 extern const CLI::Validator kFinite;
 extern const CLI::Validator kFiniteNonNegative;
+/// An unsigned 64-bit integer written as decimal digits only: "-1" is refused (CLI11 would
+/// wrap it to 2^64 - 1) and so is anything above 2^64 - 1 (never clamped). REQ-CLI-002.
+extern const CLI::Validator kUnsigned64;
+/// Output paths checked when the command line is parsed, before any work (issue 20: a bad
+/// --ompl-log used to fail after the whole campaign). kOutputFile: the folder that will hold
+/// the file exists and is writable, and the path is not a folder. kOutputFolder: the path is
+/// not a file, and its nearest existing ancestor is a writable folder (missing ones are
+/// created). REQ-CLI-003.
+extern const CLI::Validator kOutputFile;
+extern const CLI::Validator kOutputFolder;
+/// A file whose missing folders the command creates (bench paper/suite --results): the
+/// path is not a folder and the nearest existing ancestor of its folder is writable.
+extern const CLI::Validator kOutputFileNewFolder;
 
 /// --map, --start x y z, --goal x y z, --radius: a planning query, where start, goal and
 /// radius default to the map's stored "query" (REQ-CLI-004).

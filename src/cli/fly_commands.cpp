@@ -27,7 +27,7 @@ struct ScenarioOptions {
 
 void add_scenario_options(CLI::App* cmd, ScenarioOptions& o) {
   cmd->add_option("--scenario", o.scenario, "miner-scenario-v1 file (default: the embedded indoor-1 scenario)");
-  cmd->add_option("--seed", o.seed, "override the scenario's seed")->check(CLI::NonNegativeNumber);
+  cmd->add_option("--seed", o.seed, "override the scenario's seed")->check(CLI::NonNegativeNumber)->check(kUnsigned64);
 }
 
 flight::Scenario resolve_scenario(const ScenarioOptions& o) {
@@ -124,7 +124,7 @@ void add_fly_commands(CLI::App& app, std::ostream& out) {
   auto o = std::make_shared<FlyCliOptions>();
   CLI::App* fly = app.add_subcommand("fly", "fly a scenario in closed loop: reference -> SE(3) PID -> N3 -> CVODE -> EKF");
   add_scenario_options(fly, o->scenario);
-  fly->add_option("--out", o->out, "run folder (default runs/<scenario>-seed<seed>)");
+  fly->add_option("--out", o->out, "run folder (default runs/<scenario>-seed<seed>)")->check(kOutputFolder);
   fly->add_flag("--ground-truth", o->ground_truth, "diagnostic: the controller reads the true state, not the EKF");
   fly->add_flag("--json", o->json, "print the summary as JSON");
   fly->callback([o, &out] { run_fly(*o, out); });

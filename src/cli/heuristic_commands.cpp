@@ -80,7 +80,7 @@ void add_heuristic_commands(CLI::App& app, std::ostream& out) {
   d->add_option("--count", o->dataset.count, "train + validation samples")->capture_default_str();
   d->add_option("--test-count", o->dataset.test_count, "test samples from unseen map seeds")->capture_default_str();
   d->add_option("--val-fraction", o->dataset.val_fraction, "share of --count kept for validation")->capture_default_str();
-  d->add_option("--seed", o->dataset.seed, "master seed")->capture_default_str();
+  d->add_option("--seed", o->dataset.seed, "master seed")->capture_default_str()->check(kUnsigned64);
   d->add_option("--preset", o->dataset.preset, "map preset (sim, indoor, cluttered, rooms, forest, multilevel)")->capture_default_str();
   d->add_option("--dims", o->dims, "heuristic grid nx ny nz")->expected(3)->capture_default_str();
   d->add_option("--dilation", o->dataset.dilation, "cells around start, goal and path cells (1: 3x3x3)")->capture_default_str();
@@ -88,7 +88,7 @@ void add_heuristic_commands(CLI::App& app, std::ostream& out) {
   d->add_option("--jobs", o->dataset.jobs, "worker threads (the output does not depend on it)")->capture_default_str();
   d->add_option("--shard", o->shard, "i/N: write only part i of N (shard files j with j % N == i); join with --merge");
   d->add_option("--merge", o->merge, "join these part folders (made with --shard) into --out instead of generating");
-  d->add_option("--out", o->out, "output folder (written as a whole)")->required();
+  d->add_option("--out", o->out, "output folder (written as a whole)")->required()->check(kOutputFolder);
   d->callback([o, &out] {
     if (!o->merge.empty()) {
       const Json doc = heuristic::merge_dataset_parts(o->merge, o->out);
@@ -110,9 +110,9 @@ void add_heuristic_commands(CLI::App& app, std::ostream& out) {
   CLI::App* c = app.add_subcommand("heuristic", "the sGAN's heuristic region for a map and query (Alg. 1 lines 2-3)");
   add_query_options(c, h->query);
   c->add_option("--weights", h->weights, "sGAN weights file (default: the shipped fixtures/sgan/sgan.bin)");
-  c->add_option("--seed", h->seed, "seed of the generator's noise")->capture_default_str();
+  c->add_option("--seed", h->seed, "seed of the generator's noise")->capture_default_str()->check(kUnsigned64);
   c->add_flag("--raw", h->raw, "write the thresholded network output's probabilities, unfiltered");
-  c->add_option("--out", h->region_out, "region file to write (miner-region-v1)")->required();
+  c->add_option("--out", h->region_out, "region file to write (miner-region-v1)")->required()->check(kOutputFile);
   c->add_flag("--json", h->output.json, "print the summary as JSON");
   c->callback([h, &out] { run_heuristic(*h, out); });
 

@@ -141,12 +141,12 @@ void add_map_commands(CLI::App& app, std::ostream& out) {
                 "map preset: sim (100 m, paper Sec. V-B), indoor (10 m site, Sec. V-D), or a family drawing its "
                 "size per map: cluttered, rooms, forest, multilevel")
       ->capture_default_str();
-  g->add_option("--seed", gen->seed, "random seed")->capture_default_str();
+  g->add_option("--seed", gen->seed, "random seed")->capture_default_str()->check(kUnsigned64);
   g->add_option("--obstacles", gen->obstacles, "number of obstacles (default: the preset's range)")
       ->check(CLI::NonNegativeNumber);
   g->add_option("--size", gen->size, "families: extents X Y Z in m instead of drawn ones")->expected(3);
   g->add_option("--resolution", gen->resolution, "families: grid resolution in m instead of the drawn one");
-  g->add_option("--out", gen->out, "output file (.json, or .bt for OctoMap)")->required();
+  g->add_option("--out", gen->out, "output file (.json, or .bt for OctoMap)")->required()->check(kOutputFile);
   g->callback([gen, &out] { run_gen(*gen, out); });
 
   auto info = std::make_shared<InfoOptions>();
@@ -160,7 +160,7 @@ void add_map_commands(CLI::App& app, std::ostream& out) {
   auto conv = std::make_shared<ConvertOptions>();
   CLI::App* c = map->add_subcommand("convert", "convert between miner-map-v1 JSON and OctoMap .bt");
   c->add_option("--in", conv->in, "input map (.json or .bt)")->required();
-  c->add_option("--out", conv->out, "output map (.json or .bt)")->required();
+  c->add_option("--out", conv->out, "output map (.json or .bt)")->required()->check(kOutputFile);
   c->callback([conv, &out] { run_convert(*conv, out); });
 
   auto astar = std::make_shared<AstarOptions>();

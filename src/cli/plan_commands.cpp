@@ -182,7 +182,7 @@ void add_plan_commands(CLI::App& app, std::ostream& out) {
   p->add_option("--planner", po->planner, "rrtstar | informed | guided | miner")
       ->check(CLI::IsMember({"rrtstar", "informed", "guided", "miner"}))
       ->capture_default_str();
-  p->add_option("--seed", po->planner_options.seed, "random seed")->capture_default_str();
+  p->add_option("--seed", po->planner_options.seed, "random seed")->capture_default_str()->check(kUnsigned64);
   p->add_option("--region", po->region,
                 "miner's region: sgan (the network, filtered), astar (the A*-dilated oracle) or a "
                 "miner-region-v1 file")
@@ -234,7 +234,7 @@ void add_plan_commands(CLI::App& app, std::ostream& out) {
   CLI::App* ra = region->add_subcommand("astar", "the A*-dilated ground-truth region (paper Sec. V-A.1)");
   add_query_options(ra, ro->query);
   add_region_grid_options(ra, ro->grid);
-  ra->add_option("--out", ro->out, "output region file (miner-region-v1 JSON)")->required();
+  ra->add_option("--out", ro->out, "output region file (miner-region-v1 JSON)")->required()->check(kOutputFile);
   ra->callback([ro, &out] { run_region_astar(*ro, out); });
 }
 

@@ -40,7 +40,7 @@ void add_traj_commands(CLI::App& app, std::ostream& out) {
   auto solve = std::make_shared<SolveOptions>();
   CLI::App* s = traj->add_subcommand("solve", "solve a trajectory problem file (docs/traj.md)");
   s->add_option("--problem", solve->problem, "problem JSON: order, points, head, tail, durations or limits")->required();
-  s->add_option("--out", solve->out, "write the answer JSON here (default: stdout)");
+  s->add_option("--out", solve->out, "write the answer JSON here (default: stdout)")->check(kOutputFile);
   s->add_option("--allocate", solve->allocate,
                 "durations from the limits: trapezoid (default) or optimise (min J + rho sum T within the limits, Ceres)")
       ->check(CLI::IsMember({"trapezoid", "optimise"}));

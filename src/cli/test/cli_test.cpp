@@ -193,6 +193,40 @@ TEST_CASE("A failing command leaves an existing output file untouched", "[REQ-CL
   CHECK(read(gen_out) == map_before);
 }
 
+TEST_CASE("Output paths are checked before any work", "[REQ-CLI-003]") {
+  const std::string map = write("pillar-out.json", kPillarMap);
+  // A campaign with a log in a missing folder: refused at once (usage error), not after the runs.
+  const Run log = miner_cli({"bench", "frontend", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5",
+                             "--planners", "rrtstar", "--runs", "1000", "--ompl-log", "/nonexistent/x.log"});
+  CHECK(log.code == 2);
+  CHECK_THAT(log.err, Contains("--ompl-log") && Contains("/nonexistent does not exist"));
+  CHECK_THAT(log.out, !Contains("rrtstar"));
+  // --out naming a folder, or inside a file.
+  const Run folder = miner_cli({"astar", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5", "--out", dir()});
+  CHECK(folder.code == 2);
+  CHECK_THAT(folder.err, Contains("is a folder, not a file"));
+  const Run in_file = miner_cli({"fly", "--out", map + "/run"});
+  CHECK(in_file.code == 2);
+  CHECK_THAT(in_file.err, Contains("is not a folder"));
+  const Run file_as_folder = miner_cli({"fly", "--out", map});
+  CHECK(file_as_folder.code == 2);
+  CHECK_THAT(file_as_folder.err, Contains("is a file, not a folder"));
+}
+
+TEST_CASE("Seeds are refused, not wrapped or clamped, when negative or above 2^64 - 1", "[REQ-CLI-002]") {
+  const std::string out = dir() + "/seed-map.json";
+  for (const char* bad : {"-1", "18446744073709551616", "99999999999999999999999", "1e3", "0x10", ""}) {
+    const Run r = miner_cli({"map", "gen", "--preset", "indoor", "--seed", bad, "--out", out});
+    INFO(bad << ": " << r.err);
+    CHECK(r.code == 2);
+    CHECK_THAT(r.err, Contains("--seed"));
+  }
+  const Run neg = miner_cli({"map", "gen", "--preset", "indoor", "--seed", "-1", "--out", out});
+  CHECK_THAT(neg.err, Contains("non-negative integer"));
+  CHECK(miner_cli({"map", "gen", "--preset", "indoor", "--seed", "18446744073709551615", "--out", out}).code == 0);
+  CHECK(miner_cli({"map", "gen", "--preset", "indoor", "--seed", "007", "--out", out}).code == 0);
+}
+
 TEST_CASE("traj solve answers the problem contract on stdout or in --out", "[REQ-TRAJ-006][REQ-CLI-001]") {
   const std::string problem = write("problem.json", R"({"order": 4,
     "points": [[0,0,0],[2,1,0],[4,0,1]],
@@ -502,6 +536,29 @@ TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[RE
   const std::string other = dir() + "/other-seed.json";
   REQUIRE(miner_cli(with({"--shard", "1/3", "--seed", "9", "--out", other})).code == 0);
   CHECK_THAT(miner_cli({"bench", "merge", parts[0], parts[1], other}).err, Contains("different campaign"));
+  // Not a campaign at all, or a part without its records: the file and the field are named.
+  const std::string a_map = write("merge-map.json", kPillarMap);
+  const Run map_part = miner_cli({"bench", "merge", parts[0], parts[1], a_map});
+  CHECK(map_part.code == 1);
+  CHECK_THAT(map_part.err, Contains(a_map + ": (top level): is a \"miner-map-v1\" file"));
+  {
+    std::ifstream in(parts[2]);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    miner::Json cut = miner::parse_json(ss.str(), parts[2]);
+    cut.erase("run_records");
+    const std::string no_records = dir() + "/no-records.json";
+    std::ofstream(no_records) << cut.dump();
+    const Run r = miner_cli({"bench", "merge", parts[0], parts[1], no_records});
+    CHECK(r.code == 1);
+    CHECK_THAT(r.err, Contains(no_records + ": run_records: missing required field"));
+    CHECK_THAT(r.err, !Contains("internal error"));
+    cut = miner::parse_json(ss.str(), parts[2]);
+    cut["run_records"][0].erase("planner");
+    std::ofstream(no_records) << cut.dump();
+    CHECK_THAT(miner_cli({"bench", "merge", parts[0], parts[1], no_records}).err,
+               Contains("run_records[0].planner: missing required field"));
+  }
   for (const char* bad : {"3/3", "-1/2", "1", "a/b", "1/2x"}) CHECK(miner_cli(with({"--shard", bad})).code == 1);
 
   // Datasets: the merged parts are byte-identical to the unsharded folder.

@@ -54,6 +54,21 @@ JsonField JsonField::at(const std::string& key) const {
   return JsonField(*it, child, origin_);
 }
 
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
 void JsonField::only_keys(const std::vector<std::string>& known) const {
   if (!value_->is_object()) fail(std::string("expected an object, got ") + type_name(*value_));
   for (auto it = value_->begin(); it != value_->end(); ++it) {
@@ -61,7 +76,15 @@ void JsonField::only_keys(const std::vector<std::string>& known) const {
     std::string list;
     for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
     const std::string child = path_.empty() ? it.key() : path_ + "." + it.key();
-    throw Error(origin_ + ": " + child + ": unknown key (known: " + list + ")");
+    // The nearest known key by edit distance, when it is near enough to be a misspelling.
+    std::string nearest;
+    std::size_t best = std::max<std::size_t>(2, it.key().size() / 3) + 1;
+    for (const auto& k : known) {
+      const std::size_t d = edit_distance(it.key(), k);
+      if (d < best) best = d, nearest = k;
+    }
+    throw Error(origin_ + ": " + child + ": unknown key" + (nearest.empty() ? "" : ", did you mean \"" + nearest + "\"?") +
+                " (known: " + list + ")");
   }
 }
 

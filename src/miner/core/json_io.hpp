@@ -46,7 +46,8 @@ class JsonField {
   std::string string() const;
   Eigen::Vector3d vec3() const;         ///< array of 3 finite numbers
   /// An object whose keys are all in `known` (REQ-CORE-003: no ignored unknown key);
-  /// otherwise throws naming the first unknown key and listing the known ones.
+  /// otherwise throws naming the first unknown key, the nearest known one when it is within
+  /// max(2, length / 3) edits ("did you mean"), and the known ones.
   void only_keys(const std::vector<std::string>& known) const;
 
   /// Throws Error("<origin>: <path>: <message>").
@@ -57,6 +58,10 @@ class JsonField {
   std::string path_;
   std::string origin_;
 };
+
+/// Levenshtein distance (insertions, deletions, substitutions): the "did you mean" of
+/// JsonField::only_keys.
+std::size_t edit_distance(const std::string& a, const std::string& b);
 
 /// [x, y, z] as a JSON array: what JsonField::vec3 reads back.
 Json vec3_json(const Eigen::Vector3d& v);

@@ -9,6 +9,7 @@
 namespace miner::flight {
 
 ControllerParams controller_params_from_json(const JsonField& f) {
+  f.only_keys({"rate_hz", "kp", "kv", "ki", "integral_limit", "max_tilt_deg"});
   ControllerParams c;
   if (f.has("rate_hz")) c.rate_hz = f.at("rate_hz").positive_number();
   auto gains = [&](const char* key, Eigen::Vector3d& g, bool allow_zero) {

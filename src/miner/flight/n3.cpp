@@ -40,6 +40,7 @@ void validate(const Config& c) {
 }
 
 Config config_from_json(const JsonField& f) {
+  f.only_keys({"rate_hz", "latency_s", "timeout_s", "failsafe", "max_tilt_deg", "max_yaw_rate_deg"});
   Config c;
   if (f.has("rate_hz")) c.rate_hz = f.at("rate_hz").number();
   if (f.has("latency_s")) c.latency_s = f.at("latency_s").number();

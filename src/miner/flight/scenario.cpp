@@ -44,6 +44,9 @@ Scenario scenario_from_json(const Json& doc, const std::string& origin, const st
   const std::string format = root.at("format").string();
   if (format != kScenarioFormat)
     root.at("format").fail("unknown format tag \"" + format + "\", expected \"" + kScenarioFormat + "\"");
+  root.only_keys({"format", "name", "map", "vehicle", "start", "goal", "waypoints", "trajectory", "planner", "seed",
+                  "hover_after_s", "goal_tolerance_m", "planning_margin_m", "imu", "pose", "n3", "controller", "ekf",
+                  "command_dropout_s"});
   Scenario s;
   s.origin = origin;
   if (root.has("name")) s.name = root.at("name").string();
@@ -105,6 +108,7 @@ Scenario scenario_from_json(const Json& doc, const std::string& origin, const st
   }
   if (root.has("planner")) {
     const JsonField p = root.at("planner");
+    p.only_keys({"region", "weights", "iterations"});
     if (p.has("region")) {
       s.region = p.at("region").string();
       if (s.region != "sgan" && s.region != "astar") p.at("region").fail("must be \"sgan\" or \"astar\"");
@@ -121,7 +125,12 @@ Scenario scenario_from_json(const Json& doc, const std::string& origin, const st
     if (!f.value().is_number_unsigned()) f.fail("must be a non-negative integer");
     s.seed = f.value().get<std::uint64_t>();
   }
-  if (root.has("hover_after_s")) s.hover_after_s = root.at("hover_after_s").positive_number();
+  if (root.has("hover_after_s")) {
+    s.hover_after_s = root.at("hover_after_s").positive_number();
+    if (s.hover_after_s > kMaxFlightSeconds)
+      root.at("hover_after_s").fail("must be at most " + std::to_string(static_cast<int>(kMaxFlightSeconds)) +
+                                    " s (the longest simulated flight), got " + std::to_string(s.hover_after_s));
+  }
   if (root.has("goal_tolerance_m")) s.goal_tolerance = root.at("goal_tolerance_m").positive_number();
   if (root.has("planning_margin_m")) {
     s.planning_margin = root.at("planning_margin_m").number();
@@ -133,6 +142,7 @@ Scenario scenario_from_json(const Json& doc, const std::string& origin, const st
   if (root.has("controller")) s.controller = controller_params_from_json(root.at("controller"));
   if (root.has("ekf")) {
     const JsonField e = root.at("ekf");
+    e.only_keys({"gate_probability", "initial_position_sigma", "initial_velocity_sigma", "initial_attitude_sigma"});
     if (e.has("gate_probability")) {
       s.ekf.gate_probability = e.at("gate_probability").positive_number();
       if (s.ekf.gate_probability >= 1.0) e.at("gate_probability").fail("must be below 1");
@@ -210,6 +220,18 @@ constexpr double kLimitSlack = 1e-6;
 /// Start/end states must match to this (m, m/s, m/s^2).
 constexpr double kEndpointTolerance = 1e-6;
 
+/// Refuses a reference that, with the hover after it, would fly longer than
+/// kMaxFlightSeconds: before its 1 ms sampling or any simulation (issue 20: unbounded work).
+void require_flight_length(const Scenario& s, const traj::PolynomialTrajectory& t) {
+  const double total = t.total_duration() + s.hover_after_s;
+  if (!(total <= kMaxFlightSeconds))
+    throw Error(s.origin + ": the flight would last " + std::to_string(total) + " s (reference " +
+                std::to_string(t.total_duration()) + " s + hover " + std::to_string(s.hover_after_s) +
+                " s), more than the " + std::to_string(static_cast<int>(kMaxFlightSeconds)) +
+                " s a simulated flight may; raise trajectory.v_max / a_max (now " + std::to_string(s.limits.v_max) +
+                " m/s, " + std::to_string(s.limits.a_max) + " m/s^2) or shorten the route");
+}
+
 void check_envelope(const Scenario& s, const traj::PolynomialTrajectory& t) {
   const double max_tilt = kEnvelopeMargin * deg2rad(s.controller.max_tilt_deg);
   const double max_thrust = kEnvelopeMargin * s.vehicle.max_thrust();
@@ -243,6 +265,7 @@ ReferencePlan build_reference(const Scenario& s) {
     r.path.resize(m + 1, 3);
     for (int i = 0; i < m; ++i) r.path.row(i) = r.trajectory.evaluate_segment(i, 0.0).transpose();
     r.path.row(m) = r.trajectory.evaluate(r.trajectory.total_duration()).transpose();
+    require_flight_length(s, r.trajectory);
     const auto [v, a] = trajectory_extremes(r.trajectory, kLimitSampleStep);
     if (v > s.limits.v_max * (1 + kLimitSlack) || a > s.limits.a_max * (1 + kLimitSlack))
       throw Error(s.origin + ": trajectory file: maximum speed " + std::to_string(v) + " m/s and acceleration " +
@@ -303,11 +326,13 @@ ReferencePlan build_reference(const Scenario& s) {
     r.allocation = repaired.allocation;
     r.trajectory = std::move(repaired.trajectory);
     r.path = std::move(repaired.waypoints);
+    require_flight_length(s, r.trajectory);
     const auto [v, a] = trajectory_extremes(r.trajectory, kLimitSampleStep);
     const double k = std::max({1.0, v / s.limits.v_max, std::sqrt(a / s.limits.a_max)});
     if (k > 1.0 + kLimitSlack) {
       r.time_scale = k * (1.0 + kLimitSlack);
       traj::scale_time(r.trajectory, r.time_scale);
+      require_flight_length(s, r.trajectory);
     }
     r.stage_ms.emplace_back("trajectory", elapsed_ms(t_traj));
   }

@@ -41,6 +41,11 @@
 namespace miner::flight {
 
 inline constexpr const char* kScenarioFormat = "miner-scenario-v1";
+/// Longest simulated flight (reference + hover, s): bounds the work and the log of one
+/// `miner fly` (~4 x 10^5 N3 ticks, a ~100 MB log at most). A scenario asking for more (a
+/// long hover, or limits so low that the reference lasts hours) is refused before any
+/// sampling or simulation (REQ-FLIGHT-007).
+inline constexpr double kMaxFlightSeconds = 1000.0;
 
 struct Scenario {
   std::string name = "scenario";
@@ -57,7 +62,7 @@ struct Scenario {
   double rho = 1.0;
   std::optional<traj::PolynomialTrajectory> trajectory_file;
   std::uint64_t seed = 1;
-  double hover_after_s = 3.0;
+  double hover_after_s = 3.0;               ///< <= kMaxFlightSeconds
   double goal_tolerance = 0.3;              ///< m
   /// Added to the vehicle radius when planning and repairing the reference (m): room for
   /// the tracking error (REQ-FLIGHT-008's noise floor is 0.10 m).

@@ -68,6 +68,8 @@ double optional_non_negative(const JsonField& f, const char* key, double fallbac
 }  // namespace
 
 ImuParams imu_params_from_json(const JsonField& f) {
+  f.only_keys({"accel_noise_density", "gyro_noise_density", "accel_bias_random_walk", "gyro_bias_random_walk",
+               "accel_bias_initial", "gyro_bias_initial"});
   ImuParams p;
   p.accel_noise_density = optional_non_negative(f, "accel_noise_density", p.accel_noise_density);
   p.gyro_noise_density = optional_non_negative(f, "gyro_noise_density", p.gyro_noise_density);
@@ -79,6 +81,7 @@ ImuParams imu_params_from_json(const JsonField& f) {
 }
 
 PoseParams pose_params_from_json(const JsonField& f) {
+  f.only_keys({"rate_hz", "delay_s", "position_sigma", "attitude_sigma", "outlier_probability", "outlier_magnitude"});
   PoseParams p;
   if (f.has("rate_hz")) p.rate_hz = f.at("rate_hz").positive_number();
   p.delay_s = optional_non_negative(f, "delay_s", p.delay_s);

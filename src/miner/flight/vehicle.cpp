@@ -68,6 +68,9 @@ VehicleParams vehicle_from_json(const Json& doc, const std::string& origin) {
   const std::string format = root.at("format").string();
   if (format != kVehicleFormat)
     root.at("format").fail("unknown format tag \"" + format + "\", expected \"" + kVehicleFormat + "\"");
+  root.only_keys({"format", "name", "mass_kg", "inertia_kg_m2", "arm_length_m", "thrust_coefficient_N_per_rad_s2",
+                  "torque_to_thrust_ratio_m", "rotor_speed_min_rad_s", "rotor_speed_max_rad_s",
+                  "motor_time_constant_up_s", "motor_time_constant_down_s", "linear_drag_N_s_per_m", "radius_m"});
   VehicleParams v;
   if (root.has("name")) v.name = root.at("name").string();
   v.mass = root.at("mass_kg").number();

@@ -19,6 +19,22 @@ constexpr double kBoundsRelativeTolerance = 1e-9;
 
 }  // namespace
 
+std::size_t HeuristicRegion::cell_count(const Eigen::Vector3i& dims) {
+  if ((dims.array() < 1).any()) {
+    throw Error("region dims: every entry must be >= 1, got [" + std::to_string(dims.x()) + ", " +
+                std::to_string(dims.y()) + ", " + std::to_string(dims.z()) + "]");
+  }
+  // In double: nx ny nz of three ints reaches 2^93 and would wrap any integer type.
+  const double n = static_cast<double>(dims.x()) * dims.y() * dims.z();
+  if (n > static_cast<double>(kMaxCells)) {
+    std::ostringstream os;
+    os << "region dims: [" << dims.x() << ", " << dims.y() << ", " << dims.z() << "] is " << n
+       << " cells, more than the limit of " << kMaxCells;
+    throw Error(os.str());
+  }
+  return static_cast<std::size_t>(n);
+}
+
 HeuristicRegion::HeuristicRegion(world::Box bounds, Eigen::Vector3i dims,
                                  std::vector<double> probabilities, double threshold,
                                  std::string source)
@@ -33,15 +49,7 @@ HeuristicRegion::HeuristicRegion(world::Box bounds, Eigen::Vector3i dims,
     throw Error("region bounds: max " + format_point(bounds_.max) + " must exceed min " +
                 format_point(bounds_.min) + " on every axis");
   }
-  if ((dims_.array() < 1).any()) {
-    throw Error("region dims: every entry must be >= 1, got [" + std::to_string(dims_.x()) + ", " +
-                std::to_string(dims_.y()) + ", " + std::to_string(dims_.z()) + "]");
-  }
-  const std::size_t n = static_cast<std::size_t>(dims_.x()) * dims_.y() * dims_.z();
-  if (n > kMaxCells) {
-    throw Error("region dims: " + std::to_string(n) + " cells exceed the limit of " +
-                std::to_string(kMaxCells));
-  }
+  const std::size_t n = cell_count(dims_);
   if (probabilities_.size() != n) {
     throw Error("region probabilities: expected nx*ny*nz = " + std::to_string(n) + " values, got " +
                 std::to_string(probabilities_.size()));
@@ -117,7 +125,7 @@ HeuristicRegion HeuristicRegion::from_path(const world::Box& bounds, const Eigen
   if (dilation < 0) throw Error("region dilation: must be >= 0, got " + std::to_string(dilation));
   if (path.empty()) throw Error("region from path: the path has no points");
   HeuristicRegion region(bounds, dims,
-                         std::vector<double>(static_cast<std::size_t>(std::max(dims.prod(), 0)), 0.0),
+                         std::vector<double>(cell_count(dims), 0.0),
                          1.0, std::move(source));
   const Eigen::Vector3d cell = region.cell_size_;
   auto cell_of = [&](const Eigen::Vector3d& p) {

@@ -42,6 +42,9 @@ class HeuristicRegion {
                   double threshold, std::string source = "");
 
   static constexpr std::size_t kMaxCells = std::size_t{1} << 24;
+  /// nx ny nz, checked without integer wrap: throws miner::Error naming the dims when an
+  /// entry is < 1 or the product exceeds kMaxCells (REQ-PLAN-005).
+  static std::size_t cell_count(const Eigen::Vector3i& dims);
 
   static HeuristicRegion from_json(const Json& doc, const std::string& origin);
   static HeuristicRegion load(const std::string& path);

@@ -129,7 +129,12 @@ GridPath astar(const Map& map, const VoxelGrid& grid, const Eigen::Vector3d& sta
   result.grid_cost = cost_to_come[gi] * grid.resolution();
 
   result.points.push_back(start);
-  for (const auto& c : result.cells) result.points.push_back(grid.cell_center(c));
+  // Start and goal in one cell: the straight segment between them (free: both are clear
+  // of the inflated obstacles and a cell's free block is convex), not a detour through the
+  // cell's centre; start == goal costs 0.
+  if (si != gi) {
+    for (const auto& c : result.cells) result.points.push_back(grid.cell_center(c));
+  }
   result.points.push_back(goal);
   for (std::size_t i = 1; i < result.points.size(); ++i) {
     result.cost += (result.points[i] - result.points[i - 1]).norm();

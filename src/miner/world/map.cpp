@@ -34,6 +34,28 @@ std::string obstacle_name(std::size_t i, const Box& b) {
 
 }  // namespace
 
+Eigen::Vector3i grid_dims(const Box& bounds, double resolution) {
+  // Snaps in the cell count: a face within this many cells of a whole number is on it.
+  constexpr double kGridSnapTolerance = 1e-9;
+  const Eigen::Vector3d extent = bounds.extent();
+  if (resolution > extent.minCoeff()) {
+    std::ostringstream os;
+    os << "resolution: " << resolution << " m is coarser than the smallest extent of the bounds ("
+       << extent.minCoeff() << " m): the grid would have no cell along that axis";
+    throw Error(os.str());
+  }
+  Eigen::Vector3d cells;
+  for (int k = 0; k < 3; ++k) cells[k] = std::max(1.0, std::ceil(extent[k] / resolution - kGridSnapTolerance));
+  if (!(cells.prod() <= kMaxGridCells)) {
+    std::ostringstream os;
+    os << "resolution: " << resolution << " m gives a grid of " << cells.x() << " x " << cells.y() << " x "
+       << cells.z() << " cells, more than the " << kMaxGridCells << " a map may have (A* keeps ~9 bytes per cell); "
+       << "use a coarser resolution";
+    throw Error(os.str());
+  }
+  return cells.cast<int>();
+}
+
 Map::Map(Box bounds, double resolution, std::vector<Box> obstacles, std::optional<Query> query)
     : bounds_(std::move(bounds)),
       resolution_(resolution),
@@ -46,6 +68,7 @@ Map::Map(Box bounds, double resolution, std::vector<Box> obstacles, std::optiona
     os << "resolution: must be positive, got " << resolution_;
     throw Error(os.str());
   }
+  (void)grid_dims(bounds_, resolution_);  // a grid A* and the voxel grid can hold
   for (std::size_t i = 0; i < obstacles_.size(); ++i) {
     validate_box(obstacles_[i], "obstacles[" + std::to_string(i) + "]");
   }
@@ -115,7 +138,9 @@ Map Map::from_json(const Json& doc, const std::string& origin) {
   if (format != kMapFormat) {
     root.at("format").fail("unknown format tag \"" + format + "\", expected \"" + kMapFormat + "\"");
   }
+  root.only_keys({"format", "bounds", "resolution", "obstacles", "query"});
   const JsonField jb = root.at("bounds");
+  jb.only_keys({"min", "max"});
   Box bounds{jb.at("min").vec3(), jb.at("max").vec3()};
   const double resolution = root.at("resolution").number();
 
@@ -125,6 +150,7 @@ Map Map::from_json(const Json& doc, const std::string& origin) {
   obstacles.reserve(n);
   for (std::size_t i = 0; i < n; ++i) {
     const JsonField o = jo.at(i);
+    o.only_keys({"type", "min", "max"});
     const std::string type = o.at("type").string();
     if (type != "box") o.at("type").fail("unknown obstacle type \"" + type + "\", expected \"box\"");
     obstacles.push_back({o.at("min").vec3(), o.at("max").vec3()});
@@ -133,6 +159,7 @@ Map Map::from_json(const Json& doc, const std::string& origin) {
   std::optional<Query> query;
   if (root.has("query")) {
     const JsonField q = root.at("query");
+    q.only_keys({"start", "goal", "robot_radius"});
     query = Query{q.at("start").vec3(), q.at("goal").vec3(),
                   q.has("robot_radius") ? q.at("robot_radius").number() : 0.0};
   }

@@ -25,6 +25,9 @@
 namespace miner::world {
 
 inline constexpr const char* kMapFormat = "miner-map-v1";
+/// Largest grid a map may have (cells of `resolution` over its bounds): 2^28 cells keep A*'s
+/// ~9 bytes per cell near 2.4 GB. A map whose resolution gives more is refused (REQ-WORLD-002).
+inline constexpr double kMaxGridCells = 268435456.0;
 
 /// A start/goal pair stored with a map (optional extension of miner-map-v1), so a map
 /// generated for a benchmark carries the query it was checked against.
@@ -33,6 +36,12 @@ struct Query {
   Eigen::Vector3d goal;
   double robot_radius = 0.0;
 };
+
+/// Cells of the map's grid per axis: ceil(extent / resolution), a face within 1e-9 cells of a
+/// whole number of cells snapping onto it (10 m / 0.1 m is 100 cells, not 101), at least 1.
+/// Throws miner::Error naming the resolution when the grid would exceed kMaxGridCells (the
+/// count in double: no integer wrap) or when the resolution is coarser than an extent.
+Eigen::Vector3i grid_dims(const Box& bounds, double resolution);
 
 class Map {
  public:

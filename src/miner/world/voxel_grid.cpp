@@ -10,9 +10,6 @@
 namespace miner::world {
 
 namespace {
-/// Snaps in the cell count: a face within 1e-9 cells of a whole number of cells is on
-/// that cell boundary (so 10 m / 0.1 m is 100 cells, not 101).
-constexpr double kGridSnapTolerance = 1e-9;
 
 /// Lower edge of cell i along one axis, computed the one way every query computes it.
 double cell_edge(double origin, double res, int i) { return origin + i * res; }
@@ -36,21 +33,10 @@ VoxelGrid::VoxelGrid(const Map& map, double robot_radius)
     : origin_(map.bounds().min), resolution_(map.resolution()), robot_radius_(robot_radius) {
   require_finite(robot_radius, "robot radius");
   if (robot_radius < 0.0) throw Error("robot radius: must not be negative");
-  const Eigen::Vector3d cells = map.bounds().extent() / resolution_;
-  double total = 1.0;
-  for (int k = 0; k < 3; ++k) {
-    const double n = std::max(1.0, std::ceil(cells[k] - kGridSnapTolerance));
-    total *= n;
-    if (total > static_cast<double>(kMaxCells)) {
-      std::ostringstream os;
-      os << "resolution: " << resolution_ << " m gives more than " << kMaxCells
-         << " grid cells for bounds of extent " << format_point(map.bounds().extent())
-         << " m; use a coarser resolution";
-      throw Error(os.str());
-    }
-    dims_[k] = static_cast<int>(n);
-  }
-  occupancy_.assign(static_cast<std::size_t>(total), 0);
+  dims_ = grid_dims(map.bounds(), resolution_);  // checked when the map was built (REQ-WORLD-002)
+  occupancy_.assign(static_cast<std::size_t>(dims_.x()) * static_cast<std::size_t>(dims_.y()) *
+                        static_cast<std::size_t>(dims_.z()),
+                    0);
 
   // Cells whose centre lies outside the bounds (the last layer when extent/res is not whole).
   for (int k = 0; k < 3; ++k) {

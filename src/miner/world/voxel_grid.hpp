@@ -23,8 +23,6 @@ class Map;
 
 class VoxelGrid {
  public:
-  /// Grids larger than this are refused with a message naming the resolution.
-  static constexpr std::size_t kMaxCells = std::size_t{1} << 28;  // 256 Mi cells = 256 MiB
 
   VoxelGrid(const Map& map, double robot_radius);
 

@@ -98,9 +98,14 @@ TEST_CASE("only_keys refuses an unknown key, naming it and the known ones", "[RE
   const JsonField root(doc, "", "k.json");
   CHECK_NOTHROW(root.only_keys({"a", "b"}));
   CHECK_NOTHROW(root.only_keys({"b", "a", "z"}));
-  CHECK_THROWS_WITH(root.only_keys({"a"}), Contains("k.json: b: unknown key (known: a)"));
+  CHECK_THROWS_WITH(root.only_keys({"a"}), Contains("k.json: b: unknown key, did you mean \"a\"? (known: a)"));
   CHECK_THROWS_WITH(root.at("b").only_keys({"c", "controller"}),
-                    Contains("k.json: b.controler: unknown key (known: c, controller)"));
+                    Contains("k.json: b.controler: unknown key, did you mean \"controller\"? (known: c, controller)"));
+  // Nothing near enough: no suggestion.
+  CHECK_THROWS_WITH(root.at("b").only_keys({"c", "gains"}), Contains("b.controler: unknown key (known: c, gains)"));
+  CHECK(miner::edit_distance("controler", "controller") == 1);
+  CHECK(miner::edit_distance("", "abc") == 3);
+  CHECK(miner::edit_distance("kitten", "sitting") == 3);
   CHECK_THROWS_WITH(root.at("a").only_keys({"a"}), Contains("a: expected an object, got number"));
 }
 

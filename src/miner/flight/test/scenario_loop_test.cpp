@@ -82,6 +82,30 @@ TEST_CASE("Bad scenarios are refused before flight with the fault named", "[REQ-
   doc = default_doc();
   doc["command_dropout_s"] = {2.0, 1.0};
   expect_scenario_error(doc, "t0 < t1");
+  // Unknown keys anywhere are refused, with the nearest known key (issue 20: "controler" used
+  // to fly with the default gains).
+  doc = default_doc();
+  doc["controler"] = {{"kp", {1, 1, 1}}};
+  expect_scenario_error(doc, "s.json: controler: unknown key, did you mean \"controller\"?");
+  for (const char* section : {"imu", "pose", "n3", "controller", "ekf", "planner"}) {
+    doc = default_doc();
+    doc[section]["gainz"] = 1;
+    expect_scenario_error(doc, std::string(section) + ".gainz: unknown key");
+  }
+  // Bounded work: a hover of a day, or limits so low the reference would last hours, are
+  // refused before any sampling or simulation.
+  doc = default_doc();
+  doc["hover_after_s"] = 86400;
+  expect_scenario_error(doc, "hover_after_s: must be at most 1000 s");
+  doc = default_doc();
+  doc["planner"]["region"] = "astar";
+  doc["trajectory"]["v_max"] = 1e-4;
+  doc["trajectory"]["a_max"] = 1e-6;
+  expect_scenario_error(doc, "more than the 1000 s a simulated flight may");
+  doc = default_doc();
+  doc["vehicle"] = flight::to_json(flight::VehicleParams{});
+  doc["vehicle"]["mass_kgg"] = 2;
+  expect_scenario_error(doc, "mass_kgg: unknown key, did you mean \"mass_kg\"?");
 }
 
 TEST_CASE("A scenario's trajectory.allocation optimise gives a lower J + rho T within the limits", "[REQ-TRAJ-011][REQ-FLIGHT-007]") {

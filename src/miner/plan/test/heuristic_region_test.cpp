@@ -1,5 +1,7 @@
 #include <catch2/catch.hpp>
 
+#include <limits>
+
 #include <fstream>
 
 #include "miner/core/error.hpp"
@@ -71,7 +73,18 @@ TEST_CASE("A region round-trips through miner-region-v1 and bad files name the f
   doc["probabilities"][2] = "x";
   CHECK_THROWS_WITH(HeuristicRegion::from_json(doc, "r.json"), Contains("probabilities[2]"));
   CHECK_THROWS_WITH(HeuristicRegion(Box{{0, 0, 0}, {1, 1, 1}}, I(8192, 8192, 1), {}, 0.5),
-                    Contains("exceed the limit"));
+                    Contains("more than the limit"));
+  // Dims whose product wraps 64 bits (2^31 - 1 cubed ~ 2^93; a wrapped product could pass a
+  // size check) are refused, from a file and from the A*-dilated region alike.
+  const int big = std::numeric_limits<int>::max();
+  CHECK_THROWS_WITH(HeuristicRegion::cell_count(I(big, big, big)), Contains("more than the limit"));
+  CHECK_THROWS_WITH(HeuristicRegion::cell_count(I(1 << 22, 1 << 21, 1 << 21)), Contains("more than the limit"));
+  CHECK(HeuristicRegion::cell_count(I(32, 32, 32)) == 32768);
+  doc = r.to_json();
+  doc["dims"] = {big, big, big};
+  CHECK_THROWS_WITH(HeuristicRegion::from_json(doc, "r.json"), Contains("more than the limit"));
+  CHECK_THROWS_WITH(HeuristicRegion::from_path(Box{{0, 0, 0}, {1, 1, 1}}, I(big, big, 4), {{0.5, 0.5, 0.5}}, 1, "t"),
+                    Contains("more than the limit"));
   CHECK_THROWS_WITH(HeuristicRegion(Box{{0, 0, 0}, {0, 1, 1}}, I(1, 1, 1), {1.0}, 0.5), Contains("must exceed"));
 }
 

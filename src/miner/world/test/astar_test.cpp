@@ -37,6 +37,17 @@ TEST_CASE("In free space A* follows the octile distance between cell centres", "
   CHECK(miner::world::octile_distance(I(0, 0, 0), I(9, 5, 2), 1.0) == Approx(expected));
 }
 
+TEST_CASE("Start and goal in one cell: the straight segment; start == goal costs 0", "[REQ-WORLD-007]") {
+  const Map map(Box{{0, 0, 0}, {10, 10, 10}}, 1.0, {});
+  const VoxelGrid grid(map, 0.0);
+  const auto same = astar(map, grid, V(3.2, 4.7, 5.1), V(3.2, 4.7, 5.1));
+  CHECK(same.cost == 0.0);
+  CHECK(same.points.size() == 2);
+  const auto cell = astar(map, grid, V(3.2, 4.7, 5.1), V(3.9, 4.1, 5.8));
+  CHECK(cell.cost == Approx((V(3.9, 4.1, 5.8) - V(3.2, 4.7, 5.1)).norm()).margin(kSumTolerance));
+  CHECK(cell.grid_cost == 0.0);
+}
+
 TEST_CASE("A* goes through the only door of a wall and its path is collision-free", "[REQ-WORLD-007][REQ-WORLD-008]") {
   const Map map = miner::world::test::wall_with_door_map();
   const VoxelGrid grid(map, 0.0);

@@ -88,6 +88,23 @@ TEST_CASE("Bad map documents are refused with the field named", "[REQ-WORLD-002]
   d["query"] = {{"start", {1, 1, 1}}, {"goal", {2, 2, 2}}, {"robot_radius", -1}};
   CHECK_THAT(error_of(d), Contains("query.robot_radius: must not be negative"));
   CHECK_THAT(error_of(Json::array()), Contains("expected a JSON object"));
+  // Unknown keys, at every level, are refused with the nearest known one.
+  d = valid_doc();
+  d["resolutoin"] = 0.5;
+  CHECK_THAT(error_of(d), Contains("m.json: resolutoin: unknown key, did you mean \"resolution\"?"));
+  d = valid_doc();
+  d["obstacles"][0]["mx"] = {1, 1, 1};
+  CHECK_THAT(error_of(d), Contains("obstacles[0].mx: unknown key"));
+  d = valid_doc();
+  d["bounds"]["maxx"] = {1, 1, 1};
+  CHECK_THAT(error_of(d), Contains("bounds.maxx: unknown key, did you mean \"max\"?"));
+  // A resolution coarser than the map (no cell on an axis) or one giving an unholdable grid.
+  d = valid_doc();
+  d["resolution"] = 1e308;
+  CHECK_THAT(error_of(d), Contains("resolution: 1e+308 m is coarser than the smallest extent"));
+  d = valid_doc();
+  d["resolution"] = 1e-6;
+  CHECK_THAT(error_of(d), Contains("more than the 2.68435e+08 a map may have"));
   CHECK_THROWS_WITH(Map::load(miner::world::test::temp_path("does-not-exist.json")),
                     Contains("cannot open file"));
 }

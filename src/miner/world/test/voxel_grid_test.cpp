@@ -56,7 +56,9 @@ TEST_CASE("Cell lookup: indices, centres, the upper bound, outside points", "[RE
   CHECK_FALSE(grid.contains(I(10, 0, 0)));
 }
 
-TEST_CASE("A resolution that would need too many cells is refused by name", "[REQ-WORLD-006]") {
-  const Map map(Box{{0, 0, 0}, {1000, 1000, 1000}}, 0.01, {});
-  CHECK_THROWS_WITH(VoxelGrid(map, 0.0), Contains("resolution: 0.01 m gives more than"));
+TEST_CASE("A resolution that would need too many cells is refused by name", "[REQ-WORLD-006][REQ-WORLD-002]") {
+  CHECK_THROWS_WITH(Map(Box{{0, 0, 0}, {1000, 1000, 1000}}, 0.01, {}), Contains("resolution: 0.01 m gives a grid of"));
+  // The grid is the map's: 10 m at 0.1 m is 100 cells (snapped), not 101.
+  CHECK(miner::world::grid_dims(Box{{0, 0, 0}, {10, 10, 10}}, 0.1) == I(100, 100, 100));
+  CHECK(VoxelGrid(Map(Box{{0, 0, 0}, {10, 10, 10}}, 0.1, {}), 0.0).dims() == I(100, 100, 100));
 }

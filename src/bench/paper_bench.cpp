@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "bench/campaign_stats.hpp"
+#include "bench/results_text.hpp"
 #include "bench/ompl_planners.hpp"
 #include "miner/core/error.hpp"
 #include "miner/core/json_io.hpp"
@@ -80,33 +81,13 @@ const double kPaperConnectivity = 0.963, kPaperSafety = 0.971;
 const double kPaperMse[2][6] = {{0.0513, 0.0919, 0.0003, 0.0222, 0.0285, 0.0006},
                                 {0.0716, 0.1089, 0.0004, 0.0237, 0.0115, 0.0008}};
 
-std::string f(double v, int digits) {
-  if (!std::isfinite(v)) return "—";
-  char buf[48];
-  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
-  return buf;
-}
+std::string f(double v, int digits) { return fixed(v, digits); }
 
 std::string pct(double v) { return std::isfinite(v) ? f(100.0 * v, 1) + " %" : "—"; }
 
-std::string git_commit() {
-  std::string out;
-  if (FILE* p = ::popen("git describe --always --dirty 2>/dev/null", "r")) {
-    char buf[128];
-    while (std::fgets(buf, sizeof buf, p)) out += buf;
-    ::pclose(p);
-  }
-  while (!out.empty() && (out.back() == '\n' || out.back() == '\r')) out.pop_back();
-  return out.empty() ? "unknown" : out;
-}
 
 std::string map_label(const std::string& path) { return std::filesystem::path(path).stem().string(); }
 
-const PlannerSummary* find_summary(const FrontendBenchResult& r, const std::string& planner) {
-  for (const auto& s : r.summaries)
-    if (s.planner == planner) return &s;
-  return nullptr;
-}
 
 const BackendRecord* find_record(const std::vector<BackendRecord>& records, const std::string& method, int order) {
   for (const auto& r : records)

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "bench/campaign_stats.hpp"
+#include "bench/results_text.hpp"
 #include "bench/ompl_planners.hpp"
 #include "miner/core/error.hpp"
 #include "miner/core/json_io.hpp"
@@ -25,29 +26,9 @@ constexpr const char* kSuiteFormat = "miner-bench-suite-v1";
 /// upper bound, never in a headline.
 constexpr const char* kOraclePlanner = "miner";
 
-std::string f(double v, int digits) {
-  if (!std::isfinite(v)) return "—";
-  char buf[48];
-  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
-  return buf;
-}
+std::string f(double v, int digits) { return fixed(v, digits); }
 
-std::string git_commit() {
-  std::string out;
-  if (FILE* p = ::popen("git describe --always --dirty 2>/dev/null", "r")) {
-    char buf[128];
-    while (std::fgets(buf, sizeof buf, p)) out += buf;
-    ::pclose(p);
-  }
-  while (!out.empty() && (out.back() == '\n' || out.back() == '\r')) out.pop_back();
-  return out.empty() ? "unknown" : out;
-}
 
-const PlannerSummary* find_summary(const FrontendBenchResult& r, const std::string& planner) {
-  for (const auto& s : r.summaries)
-    if (s.planner == planner) return &s;
-  return nullptr;
-}
 
 /// The runs' values of one stage (`target` or first solution), +inf for a miss.
 std::vector<double> stage_values(const FrontendBenchResult& r, const std::string& planner, bool target, bool time) {

@@ -136,6 +136,35 @@ int run_cli(const std::vector<std::string>& args, std::ostream& out, std::ostrea
   add_fly_commands(app, out);
   add_heuristic_commands(app, out);
 
+  // An unknown command is named, with the commands there are and the nearest one (CLI11
+  // alone says only "A subcommand is required").
+  {
+    CLI::App* current = &app;
+    std::string path = "miner";
+    for (const std::string& a : args) {
+      if (a.empty() || a[0] == '-') break;
+      const auto subs = current->get_subcommands([](CLI::App*) { return true; });
+      if (subs.empty()) break;
+      CLI::App* next = nullptr;
+      std::string list, nearest;
+      std::size_t best = std::max<std::size_t>(2, a.size() / 3) + 1;
+      for (CLI::App* sub : subs) {
+        const std::string& name = sub->get_name();
+        list += (list.empty() ? "" : ", ") + name;
+        if (name == a) next = sub;
+        const std::size_t d = edit_distance(a, name);
+        if (d < best) best = d, nearest = name;
+      }
+      if (!next) {
+        err << "miner: usage error: unknown command \"" << a << "\" for `" << path << "`"
+            << (nearest.empty() ? "" : ", did you mean \"" + nearest + "\"?") << " (commands: " << list << ")\n"
+            << "run '" << path << " --help' for usage\n";
+        return static_cast<int>(ExitCode::kUsage);
+      }
+      current = next;
+      path += " " + a;
+    }
+  }
   // CLI11 parses in reverse order of the vector it is given.
   std::vector<std::string> reversed(args.rbegin(), args.rend());
   try {

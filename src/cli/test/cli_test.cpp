@@ -193,6 +193,18 @@ TEST_CASE("A failing command leaves an existing output file untouched", "[REQ-CL
   CHECK(read(gen_out) == map_before);
 }
 
+TEST_CASE("An unknown command is named with the commands there are", "[REQ-CLI-002]") {
+  const Run top = miner_cli({"plna", "--map", "x.json"});
+  CHECK(top.code == 2);
+  CHECK_THAT(top.err, Contains("unknown command \"plna\" for `miner`, did you mean \"plan\"?") && Contains("bench"));
+  const Run sub = miner_cli({"map", "foo"});
+  CHECK(sub.code == 2);
+  CHECK_THAT(sub.err, Contains("unknown command \"foo\" for `miner map`") && Contains("gen") && Contains("convert"));
+  CHECK_THAT(sub.err, !Contains("did you mean"));
+  const Run bench = miner_cli({"bench", "suit"});
+  CHECK_THAT(bench.err, Contains("did you mean \"suite\"?"));
+}
+
 TEST_CASE("Output paths are checked before any work", "[REQ-CLI-003]") {
   const std::string map = write("pillar-out.json", kPillarMap);
   // A campaign with a log in a missing folder: refused at once (usage error), not after the runs.

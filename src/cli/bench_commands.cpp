@@ -85,26 +85,26 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   fc->add_option("--planners", f->bench.planners,
                  "planners (default: rrtstar,informed,guided,miner and every ompl:* planner)")
       ->delimiter(',');
-  fc->add_option("--runs", f->bench.runs, "runs per planner")->check(CLI::PositiveNumber)->capture_default_str();
+  fc->add_option("--runs", f->bench.runs, "runs per planner")->check(kPositive)->capture_default_str();
   fc->add_option("--seed", f->bench.seed, "master seed (run k uses stream k)")->capture_default_str()->check(kUnsigned64);
   fc->add_option("--target-factor", f->bench.target_factor, "target cost = this x the A* reference cost")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   fc->add_option("--max-iterations", f->bench.max_iterations, "iteration budget per run")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   fc->add_option("--time-limit", f->bench.time_limit_s, "wall-clock cap per run in s")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   fc->add_option("--step", f->bench.planner_options.steer_step, "steering step eta in m (default 0.1 x diagonal)")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   fc->add_option("--goal-radius", f->bench.planner_options.goal_radius, "goal radius in m (default 2 x resolution)")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   fc->add_flag("!--no-safeguard", f->bench.planner_options.safeguard,
                "miner, miner-sgan: the paper's fixed mu, without the safeguard (REQ-PLAN-020)");
   fc->add_option("--region", f->bench.region_file, "miner's region file (default: the A*-dilated region)");
   fc->add_option("--weights", f->bench.weights_file, "miner-sgan's weights (default: the shipped fixtures/sgan/sgan.bin)");
-  fc->add_option("--region-dims", f->region_dims, "A*-dilated region grid")->expected(3)->check(CLI::PositiveNumber);
+  fc->add_option("--region-dims", f->region_dims, "A*-dilated region grid")->expected(3)->check(kPositive);
   fc->add_option("--throughput-iterations", f->bench.throughput_iterations,
                  "iterations of the rrtstar vs ompl:RRTstar throughput check (0: skip)")
       ->capture_default_str();
@@ -128,7 +128,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   hc->add_option("--weights", h->bench.weights, "sGAN weights (default: the shipped fixtures/sgan/sgan.bin)");
   hc->add_option("--seed", h->bench.seed, "noise seed (sample k: seed + k) and planner seed")->capture_default_str()->check(kUnsigned64);
   hc->add_option("--iterations", h->bench.max_iterations, "planner iteration budget per query")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   hc->add_option("--target-factor", h->bench.target_factor, "target cost = this x the sample's A* cost")
       ->capture_default_str();
@@ -174,25 +174,25 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
       ->delimiter(',')->capture_default_str();
   pc->add_option("--planners", p->bench.planners, "front-end planners")->delimiter(',')->capture_default_str();
   pc->add_option("--runs", p->bench.runs, "front-end runs per planner and map")->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   pc->add_option("--seed", p->bench.seed, "seed of every campaign")->capture_default_str()->check(kUnsigned64);
   pc->add_option("--time-limit", p->bench.time_limit_s, "seconds per front-end run")->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   pc->add_option("--iterations", p->bench.max_iterations, "front-end iteration budget")->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   pc->add_option("--weights", p->bench.weights, "sGAN weights (default: the shipped ones)");
   pc->add_option("--heuristic-data", p->bench.heuristic_data, "a `miner dataset` folder (default: generate unseen maps)");
   pc->add_option("--heuristic-samples", p->bench.heuristic_samples, "unseen maps for the heuristic table")
-      ->capture_default_str()->check(CLI::PositiveNumber);
+      ->capture_default_str()->check(kPositive);
   pc->add_option("--heuristic-iterations", p->bench.heuristic_iterations, "MINER vs RRT* budget per heuristic query")
-      ->capture_default_str()->check(CLI::PositiveNumber);
+      ->capture_default_str()->check(kPositive);
   pc->add_option("--scenarios", p->bench.scenarios, "tracking scenarios (default: indoor-1 and indoor-2)")->delimiter(',');
   pc->add_option("--tracking-maps", p->bench.tracking_maps, "maps flown with the default scenario besides indoor-1")
       ->delimiter(',')->capture_default_str();
   pc->add_option("--backend-budget", p->bench.backend_budget_s, "seconds per back-end method and order")
-      ->capture_default_str()->check(CLI::PositiveNumber);
+      ->capture_default_str()->check(kPositive);
   pc->add_option("--jobs", p->bench.jobs, "threads for generating the heuristic test set")->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   pc->add_option("--results", p->results, "the Markdown file to write")->capture_default_str()->check(kOutputFileNewFolder);
   pc->add_option("--figures", p->figures, "folder for the box plots (default: <results folder>/results)")
       ->check(kOutputFolder);
@@ -240,12 +240,12 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   sc->add_option("--suite", su->suite, "suite file (miner-bench-suite-v1: maps, steps, band)")->capture_default_str();
   sc->add_option("--planners", su->bench.planners, "planners")->delimiter(',')->capture_default_str();
   sc->add_option("--runs", su->bench.runs, "runs per planner, map and steering step")->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   sc->add_option("--seed", su->bench.seed, "seed of every campaign")->capture_default_str()->check(kUnsigned64);
   sc->add_option("--time-limit", su->bench.time_limit_s, "seconds per run")->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   sc->add_option("--iterations", su->bench.max_iterations, "iteration budget per run")->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   sc->add_option("--weights", su->bench.weights, "sGAN weights (default: the shipped ones)");
   sc->add_option("--results", su->results, "the Markdown file to write")->capture_default_str()->check(kOutputFileNewFolder);
   sc->add_option("--figures", su->figures, "folder for the box plots (default: <results folder>/suite)")

@@ -77,6 +77,15 @@ const CLI::Validator kOutputFileNewFolder(
     },
     "OUTPUT FILE");
 
+const CLI::Validator kPositive(
+    [](std::string& text) -> std::string {
+      double v = 0.0;
+      if (!CLI::detail::lexical_cast(text, v) || !std::isfinite(v) || !(v > 0.0))
+        return "must be a finite number > 0, got " + text;
+      return {};
+    },
+    "POSITIVE");
+
 const CLI::Validator kFinite(
     [](std::string& text) -> std::string {
       double v = 0.0;

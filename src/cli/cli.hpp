@@ -39,6 +39,9 @@ extern const CLI::Validator kFiniteNonNegative;
 /// An unsigned 64-bit integer written as decimal digits only: "-1" is refused (CLI11 would
 /// wrap it to 2^64 - 1) and so is anything above 2^64 - 1 (never clamped). REQ-CLI-002.
 extern const CLI::Validator kUnsigned64;
+/// A finite number > 0, with a short message ("must be a finite number > 0, got -3"):
+/// CLI11's PositiveNumber prints the largest double with all its 309 digits. REQ-CLI-002.
+extern const CLI::Validator kPositive;
 /// Output paths checked when the command line is parsed, before any work (issue 20: a bad
 /// --ompl-log used to fail after the whole campaign). kOutputFile: the folder that will hold
 /// the file exists and is writable, and the path is not a folder. kOutputFolder: the path is

@@ -27,7 +27,7 @@ struct ScenarioOptions {
 
 void add_scenario_options(CLI::App* cmd, ScenarioOptions& o) {
   cmd->add_option("--scenario", o.scenario, "miner-scenario-v1 file (default: the embedded indoor-1 scenario)");
-  cmd->add_option("--seed", o.seed, "override the scenario's seed")->check(CLI::NonNegativeNumber)->check(kUnsigned64);
+  cmd->add_option("--seed", o.seed, "override the scenario's seed")->check(kFiniteNonNegative)->check(kUnsigned64);
 }
 
 flight::Scenario resolve_scenario(const ScenarioOptions& o) {
@@ -133,9 +133,9 @@ void add_fly_commands(CLI::App& app, std::ostream& out) {
   auto b = std::make_shared<SimBenchCliOptions>();
   CLI::App* sim = bench_cmd->add_subcommand("sim", "real-time factor of the full flight loop on one core");
   add_scenario_options(sim, b->scenario);
-  sim->add_option("--runs", b->bench.runs, "flights to time")->capture_default_str()->check(CLI::PositiveNumber);
+  sim->add_option("--runs", b->bench.runs, "flights to time")->capture_default_str()->check(kPositive);
   sim->add_option("--rtol", b->bench.relative_tolerance, "CVODE relative tolerance")->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   add_output_options(sim, b->output);
   sim->callback([b, &out] {
     const auto r = bench::run_sim_bench(resolve_scenario(b->scenario), b->bench);

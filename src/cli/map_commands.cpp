@@ -143,7 +143,7 @@ void add_map_commands(CLI::App& app, std::ostream& out) {
       ->capture_default_str();
   g->add_option("--seed", gen->seed, "random seed")->capture_default_str()->check(kUnsigned64);
   g->add_option("--obstacles", gen->obstacles, "number of obstacles (default: the preset's range)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(kFiniteNonNegative);
   g->add_option("--size", gen->size, "families: extents X Y Z in m instead of drawn ones")->expected(3);
   g->add_option("--resolution", gen->resolution, "families: grid resolution in m instead of the drawn one");
   g->add_option("--out", gen->out, "output file (.json, or .bt for OctoMap)")->required()->check(kOutputFile);

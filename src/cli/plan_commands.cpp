@@ -27,10 +27,10 @@ struct RegionGridOptions {
 void add_region_grid_options(CLI::App* cmd, RegionGridOptions& r) {
   cmd->add_option("--dims", r.dims, "heuristic grid size nx ny nz (the sGAN's grid)")
       ->expected(3)
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   cmd->add_option("--dilation", r.dilation, "cells added around each path cell (1: 3x3x3 cubes)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(kFiniteNonNegative)
       ->capture_default_str();
 }
 
@@ -190,18 +190,18 @@ void add_plan_commands(CLI::App& app, std::ostream& out) {
   p->add_option("--weights", po->weights, "sGAN weights file (default: the shipped fixtures/sgan/sgan.bin)");
   add_region_grid_options(p, po->grid);
   p->add_option("--iterations", po->planner_options.max_iterations, "iteration budget (Alg. 1's N)")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   p->add_flag("--first", po->planner_options.stop_at_first, "stop at the first solution (Alg. 1 Line 24)");
   p->add_option("--target-cost", po->target_cost, "stop once the path cost is <= this (m)")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   p->add_option("--target-factor", po->target_factor,
                 "stop once the cost is <= this x the A* reference cost (e.g. 1.05)")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   p->add_option("--step", po->planner_options.steer_step, "steering step eta in m (default: 0.1 x map diagonal)")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   p->add_option("--goal-radius", po->planner_options.goal_radius, "goal region radius in m (default: 2 x resolution)")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   p->add_option("--goal-bias", po->planner_options.goal_bias, "probability of sampling the goal")
       ->check(CLI::Range(0.0, 0.999999))
       ->capture_default_str();
@@ -215,7 +215,7 @@ void add_plan_commands(CLI::App& app, std::ostream& out) {
               "miner: the paper's fixed mu_1/mu_2, without the online trust of REQ-PLAN-020");
   p->add_option("--safeguard-iterations", po->planner_options.safeguard_iterations,
                 "miner safeguard: k_0, iterations without a solution after which mu decays as k_0 / t")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   p->add_option("--rewire-factor", po->planner_options.rewire_factor, "rewiring radius factor (>= 1)")
       ->check(CLI::Range(1.0, 100.0))

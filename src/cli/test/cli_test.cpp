@@ -193,6 +193,13 @@ TEST_CASE("A failing command leaves an existing output file untouched", "[REQ-CL
   CHECK(read(gen_out) == map_before);
 }
 
+TEST_CASE("Range errors are short: no 309-digit bound", "[REQ-CLI-002]") {
+  const Run r = miner_cli({"bench", "frontend", "--map", "x.json", "--runs", "-3"});
+  CHECK(r.code == 2);
+  CHECK_THAT(r.err, Contains("--runs: must be a finite number > 0, got -3"));
+  CHECK(r.err.size() < 200);
+}
+
 TEST_CASE("An unknown command is named with the commands there are", "[REQ-CLI-002]") {
   const Run top = miner_cli({"plna", "--map", "x.json"});
   CHECK(top.code == 2);

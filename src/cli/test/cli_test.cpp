@@ -605,6 +605,17 @@ TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[RE
   CHECK_THAT(half.err, Contains("2 parts, got 1"));
   CHECK(miner_cli({"dataset", "--merge", dir() + "/ds-full", "--out", dir() + "/ds-x"}).code == 1);
   CHECK_FALSE(std::filesystem::exists(dir() + "/ds-half"));
+  // A truncated shard in a part is refused, naming it, not copied.
+  std::filesystem::copy(dir() + "/ds-1", dir() + "/ds-1-cut", std::filesystem::copy_options::recursive);
+  std::string shard;
+  for (const auto& e : std::filesystem::directory_iterator(dir() + "/ds-1-cut"))
+    if (e.path().extension() == ".bin") shard = e.path().string();
+  REQUIRE_FALSE(shard.empty());
+  std::filesystem::resize_file(shard, std::filesystem::file_size(shard) - 7);
+  const Run cut = miner_cli({"dataset", "--merge", dir() + "/ds-1-cut", dir() + "/ds-0", "--out", dir() + "/ds-cut"});
+  CHECK(cut.code == 1);
+  CHECK_THAT(cut.err, Contains(shard) && Contains("bytes") && Contains("found"));
+  CHECK_FALSE(std::filesystem::exists(dir() + "/ds-cut"));
 }
 
 TEST_CASE("miner fly refuses a bad scenario before flying", "[REQ-FLIGHT-007]") {

@@ -204,6 +204,10 @@ Json merge_dataset_parts(const std::vector<std::string>& parts, const std::strin
   Json doc = docs.front();
   doc.erase("part");
   std::vector<std::pair<std::string, std::string>> files;
+  const JsonField dims_field(doc.at("dims"), "dims", parts.front() + "/dataset.json");
+  const std::uint64_t cells = plan::HeuristicRegion::cell_count(
+      Eigen::Vector3i(dims_field.at(std::size_t{0}).integer(), dims_field.at(std::size_t{1}).integer(),
+                      dims_field.at(std::size_t{2}).integer()));
   for (const char* split : kSplits) {
     std::vector<std::pair<std::string, Json>> shards;  // file name -> shard record, from every part
     std::vector<Json> index;
@@ -212,7 +216,14 @@ Json merge_dataset_parts(const std::vector<std::string>& parts, const std::strin
       for (const auto& shard : sp["shards"]) {
         const std::string name = shard["file"].get<std::string>();
         shards.emplace_back(name, shard);
-        files.emplace_back(name, read_file_bytes(parts[p] + "/" + name, "dataset shard"));
+        std::string bytes = read_file_bytes(parts[p] + "/" + name, "dataset shard");
+        // A truncated or padded shard is refused, not copied (issue 20): 3 grids per sample.
+        const std::uint64_t expected = shard["count"].get<std::uint64_t>() * 3u * cells;
+        if (bytes.size() != expected)
+          throw Error(parts[p] + "/" + name + ": expected " + std::to_string(expected) + " bytes (" +
+                      std::to_string(shard["count"].get<std::uint64_t>()) + " samples of 3 x " + std::to_string(cells) +
+                      "), found " + std::to_string(bytes.size()));
+        files.emplace_back(name, std::move(bytes));
       }
       for (const auto& e : read_json_file(parts[p] + "/" + sp["index"].get<std::string>())) index.push_back(e);
     }

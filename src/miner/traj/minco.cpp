@@ -462,7 +462,7 @@ void check_answer(const MincoProblem& p, const PolynomialTrajectory& tr) {
                             " m/s of the segments";
   if (!c.finite)
     throw Error("traj: the answer is not finite: the problem is beyond double precision (" + cause +
-                "); give durations in proportion to the segment lengths (or drop \"durations\" and give \"limits\")");
+                "); give durations in proportion to the segment lengths, or limits a trajectory can be flown at");
   if (c.constraint > kAnswerConstraint)
     throw Error("traj: the answer cannot be trusted: a constraint (waypoint, head, tail or continuity of derivatives "
                 "0..s-1) holds only to " + sci(c.constraint) + " relative (bound " + sci(kAnswerConstraint) + "; " +
@@ -473,7 +473,8 @@ void check_answer(const MincoProblem& p, const PolynomialTrajectory& tr) {
                 sci(kAnswerInterpolation) + " x " + sci(c.position_scale) + " m): the optimal trajectory swings to " +
                 sci(c.term_scale) + " m between waypoints " + sci(c.position_scale) +
                 " m apart, beyond what double precision carries: the " + cause +
-                ", and a short segment forces derivatives that its long neighbours must undo; give durations in proportion to the segment lengths (or drop \"durations\" and give \"limits\")");
+                ", and a short segment forces derivatives that its long neighbours must undo; give durations in proportion to "
+                "the segment lengths (e.g. drop \"durations\" and give \"limits\")");
   if (c.optimality > kAnswerOptimality)
     throw Error("traj: the answer cannot be trusted: the optimality conditions (continuity of derivatives s..2s-2) "
                 "hold only to " + sci(c.optimality) + " relative (bound " + sci(kAnswerOptimality) + "; " + cause +

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <tuple>
 
@@ -163,9 +164,16 @@ class AllocationObjective : public ceres::FirstOrderFunction {
   mutable MincoSolver solver_;
 };
 
+/// A number as %g writes it (std::to_string would print 1e-300 as 0.000000).
+std::string short_number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
 void validate(const AllocationOptions& o) {
   validate(o.limits);
-  if (!std::isfinite(o.rho) || !(o.rho > 0.0)) throw Error("rho: must be positive and finite, got " + std::to_string(o.rho));
+  if (!std::isfinite(o.rho) || !(o.rho > 0.0)) throw Error("rho: must be positive and finite, got " + short_number(o.rho));
   if (o.samples_per_segment < 2) throw Error("samples per segment: must be at least 2");
   if (o.max_iterations < 1) throw Error("allocation iterations: must be at least 1");
 }
@@ -196,7 +204,8 @@ AllocationResult optimise_allocation(const MincoProblem& problem, const Allocati
   Evaluation start;
   if (!evaluate(base, base.durations, o, solver, start))
     throw Error("allocation: the trapezoidal durations cannot be stretched to meet the limits (v_max " +
-                std::to_string(o.limits.v_max) + ", a_max " + std::to_string(o.limits.a_max) + ")");
+                short_number(o.limits.v_max) + " m/s, a_max " + short_number(o.limits.a_max) +
+                " m/s^2): the trajectory is beyond double precision at these limits");
 
   const std::size_t M = base.durations.size();
   std::vector<double> tau(M);

@@ -18,6 +18,7 @@
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
 
+#include "miner/plan/heuristic_region.hpp"
 #include "miner/plan/rrt_star.hpp"
 
 namespace miner::world {
@@ -34,7 +35,7 @@ struct FrontendBenchOptions {
   std::size_t max_iterations = 200000;  ///< the project's planners (and OMPL's RRT*s)
   double time_limit_s = 10.0;   ///< per run, every planner (wall clock, benchmark only)
   plan::PlannerOptions planner_options;  ///< steer step, goal radius, mu_1, mu_2, ...
-  Eigen::Vector3i region_dims{32, 32, 32};
+  Eigen::Vector3i region_dims = plan::HeuristicRegion::default_dims();
   int region_dilation = 1;
   std::string region_file;      ///< miner: this region instead of the A*-dilated one
   std::string weights_file;     ///< miner-sgan: these weights instead of the shipped ones

@@ -19,6 +19,7 @@
 #include "miner/core/shard.hpp"
 #include "miner/core/error.hpp"
 #include "miner/core/json_io.hpp"
+#include "miner/plan/heuristic_region.hpp"
 
 namespace miner::cli {
 
@@ -31,7 +32,7 @@ struct BackendOptions {
 struct FrontendOptions {
   QueryOptions query;
   bench::FrontendBenchOptions bench;
-  std::vector<int> region_dims = {32, 32, 32};
+  std::vector<int> region_dims = std::vector<int>(3, plan::HeuristicRegion::kGridSide);
   std::string ompl_log;
   std::string shard;
   bool quiet = false;

@@ -15,6 +15,7 @@
 #include "miner/heuristic/dataset.hpp"
 #include "miner/heuristic/region_filter.hpp"
 #include "miner/heuristic/sgan.hpp"
+#include "miner/plan/heuristic_region.hpp"
 #include "miner/plan/rrt_star.hpp"
 
 namespace miner::cli {
@@ -22,7 +23,7 @@ namespace miner::cli {
 namespace {
 struct DatasetCliOptions {
   heuristic::DatasetOptions dataset;
-  std::vector<int> dims = {32, 32, 32};
+  std::vector<int> dims = std::vector<int>(3, plan::HeuristicRegion::kGridSide);
   std::string out;
   std::string shard;
   std::vector<std::string> merge;

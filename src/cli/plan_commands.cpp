@@ -20,7 +20,7 @@ namespace miner::cli {
 namespace {
 
 struct RegionGridOptions {
-  std::vector<int> dims = {32, 32, 32};
+  std::vector<int> dims = std::vector<int>(3, plan::HeuristicRegion::kGridSide);
   int dilation = 1;
 };
 

@@ -290,7 +290,7 @@ ReferencePlan build_reference(const Scenario& s) {
       auto t0 = std::chrono::steady_clock::now();
       if (s.region == "astar") {
         const auto reference = plan::astar_reference(problem);
-        r.region = plan::astar_dilated_region(problem, reference, Eigen::Vector3i(32, 32, 32), 1);
+        r.region = plan::astar_dilated_region(problem, reference, plan::HeuristicRegion::default_dims(), 1);
       } else {
         const auto sgan = heuristic::Sgan::load_or_builtin(s.weights);
         r.region = heuristic::query_region(sgan, *s.map, s.start, s.goal, radius, s.seed).region;

@@ -34,6 +34,7 @@
 
 #include "miner/core/json_io.hpp"
 #include "miner/heuristic/grid.hpp"
+#include "miner/plan/heuristic_region.hpp"
 #include "miner/world/map.hpp"
 
 namespace miner::heuristic {
@@ -46,7 +47,7 @@ struct DatasetOptions {
   int test_count = 100;     ///< samples from unseen map seeds
   double val_fraction = 0.1;
   std::uint64_t seed = 1;
-  Eigen::Vector3i dims{32, 32, 32};
+  Eigen::Vector3i dims = plan::HeuristicRegion::default_dims();
   int dilation = 1;         ///< 3x3x3 cubes
   int shard_size = 256;     ///< samples per shard file
   int jobs = 1;             ///< worker threads (the output does not depend on it)

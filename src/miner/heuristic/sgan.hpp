@@ -24,6 +24,7 @@
 #include <Eigen/Core>
 
 #include "miner/core/json_io.hpp"
+#include "miner/plan/heuristic_region.hpp"
 
 namespace miner {
 class Rng;
@@ -33,7 +34,7 @@ namespace miner::heuristic {
 
 struct SganArchitecture {
   int width = 8;
-  Eigen::Vector3i dims{32, 32, 32};  ///< nx, ny, nz; each divisible by 8
+  Eigen::Vector3i dims = plan::HeuristicRegion::default_dims();  ///< nx, ny, nz; each divisible by 8
   double environment_scale = 0.5;   ///< E levels 0/1/2 enter the network as E * scale
   double threshold = 0.5;           ///< cell in the raw region iff R >= threshold
 };

@@ -42,6 +42,10 @@ class HeuristicRegion {
                   double threshold, std::string source = "");
 
   static constexpr std::size_t kMaxCells = std::size_t{1} << 24;
+  /// The heuristic grid's cells per axis: the paper's 32^3 (Sec. IV-A.2), the sGAN's input
+  /// and output and the A*-dilated region's default; one constant for every default.
+  static constexpr int kGridSide = 32;
+  static Eigen::Vector3i default_dims() { return Eigen::Vector3i::Constant(kGridSide); }
   /// nx ny nz, checked without integer wrap: throws miner::Error naming the dims when an
   /// entry is < 1 or the product exceeds kMaxCells (REQ-PLAN-005).
   static std::size_t cell_count(const Eigen::Vector3i& dims);

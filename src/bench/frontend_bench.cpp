@@ -383,9 +383,11 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
   if (parts.empty()) throw Error("merge: no shard files");
   // Each part must be a campaign's JSON before anything is compared (REQ-REPORT-006): a map
   // or a truncated file is named with the field at fault, not as "a different campaign".
+  std::vector<std::string> names;
+  std::vector<RunRecord> runs;  // every part's records, parsed once here
   for (std::size_t p = 0; p < parts.size(); ++p) {
-    const std::string origin = p < files.size() ? files[p] : "shard file " + std::to_string(p + 1);
-    const JsonField root(parts[p], "", origin);
+    names.push_back(p < files.size() ? files[p] : "shard file " + std::to_string(p + 1));
+    const JsonField root(parts[p], "", names.back());
     if (!parts[p].is_object()) root.fail("expected the JSON of `miner bench frontend --shard i/N --json`");
     if (parts[p].contains("format"))
       root.fail("is a \"" + (parts[p]["format"].is_string() ? parts[p]["format"].get<std::string>() : std::string("?")) +
@@ -404,7 +406,7 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
       (void)r.at("planner").string();
       (void)r.at("run").integer();
       try {
-        (void)run_from(parts[p]["run_records"][k]);
+        runs.push_back(run_from(parts[p]["run_records"][k]));
       } catch (const nlohmann::json::exception& e) {
         r.fail(std::string("malformed run record: ") + e.what());
       }
@@ -417,20 +419,16 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
   };
   const nlohmann::json common = settings(parts.front());
   std::vector<nlohmann::json> tags;
-  std::vector<std::string> names;
   for (std::size_t p = 0; p < parts.size(); ++p) {
-    names.push_back(p < files.size() ? files[p] : "shard file " + std::to_string(p + 1));
     if (settings(parts[p]) != common)
-      throw Error("merge: " + names.back() + " is from a different campaign (map, query, seed, runs or settings differ)");
+      throw Error("merge: " + names[p] + " is from a different campaign (map, query, seed, runs or settings differ)");
     tags.push_back(parts[p].at("shard"));
   }
   require_complete_parts(tags, names, "merge: the campaign");
-  std::vector<RunRecord> runs;
   double total_s = 0.0;
   nlohmann::json merged = parts.front();
   for (std::size_t p = 0; p < parts.size(); ++p) {
     const auto& part = parts[p];
-    for (const auto& r : part.at("run_records")) runs.push_back(run_from(r));
     total_s += part.at("total_s").get<double>();
     if (part.at("shard").at("index").get<int>() == 0) {
       merged["throughput"] = part.at("throughput");

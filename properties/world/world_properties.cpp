@@ -38,11 +38,57 @@ V random_point(Rng& rng, const Box& b) {
 }
 
 /// A random map of up to 12 boxes in [0, 10]^3 at resolution 0.5 or 1.
-Map random_map(Rng& rng) {
+Map random_box_map(Rng& rng) {
   std::vector<Box> boxes;
   const int n = static_cast<int>(rng.uniform_index(13));
   for (int i = 0; i < n; ++i) boxes.push_back(random_box(rng, -1.0, 10.0, 4.0));
   return Map(Box{{0, 0, 0}, {10, 10, 10}}, rng.uniform01() < 0.5 ? 0.5 : 1.0, std::move(boxes));
+}
+
+/// A random voxel layer on the lattice of `res` overlapping [0, 10]^3 (partly outside it at
+/// times): free background, occupied and unknown blocks, scattered single voxels.
+std::shared_ptr<const VoxelLayer> random_layer(Rng& rng, double res) {
+  const int side = static_cast<int>(std::round(10.0 / res));
+  Eigen::Vector3i origin, dims;
+  for (int k = 0; k < 3; ++k) {
+    origin[k] = static_cast<int>(rng.uniform_index(side / 2 + 3)) - 2;
+    dims[k] = 1 + static_cast<int>(rng.uniform_index(side));
+  }
+  std::vector<std::uint8_t> states(static_cast<std::size_t>(dims.prod()), 0);
+  const auto block = [&](std::uint8_t state, int max_side) {
+    Eigen::Vector3i lo, hi;
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = static_cast<int>(rng.uniform_index(dims[k]));
+      hi[k] = std::min(dims[k], lo[k] + 1 + static_cast<int>(rng.uniform_index(max_side)));
+    }
+    for (int z = lo.z(); z < hi.z(); ++z)
+      for (int y = lo.y(); y < hi.y(); ++y)
+        for (int x = lo.x(); x < hi.x(); ++x) states[(static_cast<std::size_t>(z) * dims.y() + y) * dims.x() + x] = state;
+  };
+  const int blocks = static_cast<int>(rng.uniform_index(6));
+  for (int b = 0; b < blocks; ++b) block(rng.uniform01() < 0.7 ? 1 : 2, 6);
+  const int singles = static_cast<int>(rng.uniform_index(20));
+  for (int b = 0; b < singles; ++b) block(rng.uniform01() < 0.7 ? 1 : 2, 1);
+  return std::make_shared<const VoxelLayer>(origin, res, dims, std::move(states));
+}
+
+/// A box map, half the time with a voxel layer under a random unknown-space policy.
+Map random_map(Rng& rng) {
+  const Map boxes = random_box_map(rng);
+  if (rng.uniform01() < 0.5) return boxes;
+  VoxelSource source{random_layer(rng, boxes.resolution()),
+                     rng.uniform01() < 0.5 ? UnknownPolicy::kOccupied : UnknownPolicy::kFree, "", ""};
+  return Map(boxes.bounds(), boxes.resolution(), boxes.obstacles(), std::nullopt, std::move(source));
+}
+
+/// Every obstacle as a box: the boxes and the cubes of the blocked voxels (for brute force).
+std::vector<Box> all_obstacles(const Map& map) {
+  std::vector<Box> out = map.obstacles();
+  if (const VoxelObstacles* v = map.voxels()) {
+    for (std::size_t i = 0; i < v->layer().size(); ++i)
+      if (v->blocked(i)) out.push_back(v->layer().cell_box(v->layer().coords(i)));
+  }
+  return out;
 }
 
 /// Dijkstra with the same moves and corner rule as astar(), written independently.
@@ -107,14 +153,60 @@ TEST_CASE("Point and segment queries agree with the distance definition", "[REQ-
     const Map map = random_map(rng);
     const double r = rng.uniform(0.0, 1.0);
     const V p = random_point(rng, map.bounds()), q = random_point(rng, map.bounds());
+    const std::vector<Box> obstacles = all_obstacles(map);
     double dp = std::numeric_limits<double>::infinity(), ds = dp;
-    for (const Box& b : map.obstacles()) {
+    for (const Box& b : obstacles) {
       dp = std::min(dp, squared_distance(p, b));
       ds = std::min(ds, squared_distance(p, q, b));
     }
     RC_ASSERT(map.point_collision(p, r).has_value() == (dp <= r * r));
     RC_ASSERT(map.segment_collision(p, q, r).has_value() == (ds <= r * r));
-    RC_ASSERT(std::fabs(map.clearance(p) - std::sqrt(dp)) <= kDistanceRounding || map.obstacles().empty());
+    RC_ASSERT(std::fabs(map.clearance(p) - std::sqrt(dp)) <= kDistanceRounding || obstacles.empty());
+  });
+}
+
+TEST_CASE("Voxel queries near the obstacles agree with the cubes' distances", "[REQ-WORLD-012]") {
+  // Random points and short segments drawn next to blocked voxels, where the distance bound
+  // cannot decide and the exact test must; plus rays against a brute-force slab test.
+  property("voxel point, segment and ray queries are exact", [](std::uint64_t seed) {
+    Rng rng(seed);
+    VoxelSource source{random_layer(rng, rng.uniform01() < 0.5 ? 0.25 : 0.5), UnknownPolicy::kOccupied, "", ""};
+    const Map map = Map::from_voxels(source);
+    const std::vector<Box> obstacles = all_obstacles(map);
+    RC_PRE(!obstacles.empty());
+    for (int i = 0; i < 40; ++i) {
+      const Box& near = obstacles[rng.uniform_index(obstacles.size())];
+      const double r = rng.uniform(0.0, 1.0);
+      const V p = random_point(rng, near.inflated(r + 0.5)), q = p + V(rng.normal(), rng.normal(), rng.normal());
+      double dp = std::numeric_limits<double>::infinity(), ds = dp;
+      for (const Box& b : obstacles) {
+        dp = std::min(dp, squared_distance(p, b));
+        ds = std::min(ds, squared_distance(p, q, b));
+      }
+      RC_ASSERT(map.point_collision(p, r).has_value() == (dp <= r * r));
+      RC_ASSERT(map.segment_collision(p, q, r).has_value() == (ds <= r * r));
+      RC_ASSERT(std::fabs(map.clearance(p) - std::sqrt(dp)) <= kDistanceRounding);
+      // First surface along a ray: the smallest entry distance over the cubes.
+      const V dir = (q - p).normalized();
+      double best = std::numeric_limits<double>::infinity();
+      for (const Box& b : obstacles) {
+        double t0 = 0.0, t1 = 20.0;
+        for (int k = 0; k < 3; ++k) {
+          if (dir[k] == 0.0) {
+            if (p[k] < b.min[k] || p[k] > b.max[k]) t0 = 1e9;
+            continue;
+          }
+          double ta = (b.min[k] - p[k]) / dir[k], tb = (b.max[k] - p[k]) / dir[k];
+          if (ta > tb) std::swap(ta, tb);
+          t0 = std::max(t0, ta);
+          t1 = std::min(t1, tb);
+        }
+        if (t0 <= t1) best = std::min(best, t0);
+      }
+      const auto hit = map.raycast(p, dir, 20.0);
+      RC_ASSERT(hit.has_value() == std::isfinite(best));
+      if (hit) RC_ASSERT(std::fabs(*hit - best) <= 1e-9);
+    }
   });
 }
 
@@ -180,7 +272,7 @@ TEST_CASE("A* paths are collision-free in the continuous map for the robot radiu
 TEST_CASE("Maps survive a JSON round trip unchanged", "[REQ-WORLD-001]") {
   property("from_json(to_json(m)) == m", [](std::uint64_t seed) {
     Rng rng(seed);
-    const Map map = random_map(rng);
+    const Map map = random_box_map(rng);
     const Map back = Map::from_json(miner::parse_json(miner::dump_json(map.to_json()), "roundtrip"), "roundtrip");
     RC_ASSERT(back.to_json() == map.to_json());
     RC_ASSERT(back.obstacles().size() == map.obstacles().size());

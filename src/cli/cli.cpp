@@ -97,15 +97,24 @@ const CLI::Validator kFinite(
     "FINITE");
 
 void add_query_options(CLI::App* cmd, QueryOptions& q) {
-  cmd->add_option("--map", q.map, "map file (.json or .bt)")->required();
+  cmd->add_option("--map", q.map, "map file (.json, or an OctoMap .bt/.ot)")->required();
+  cmd->add_option("--unknown", q.unknown,
+                  "voxel maps: unknown space is 'occupied' (the default, safe) or 'free' (default: the map's own)")
+      ->check(CLI::IsMember({"occupied", "free"}));
   cmd->add_option("--start", q.start, "start x y z in m (default: the map's query)")->expected(3)->check(kFinite);
   cmd->add_option("--goal", q.goal, "goal x y z in m (default: the map's query)")->expected(3)->check(kFinite);
   cmd->add_option("--radius", q.radius, "robot radius in m (default: the map's query radius or 0)")
       ->check(kFiniteNonNegative);
 }
 
+world::Map load_map(const std::string& path, const std::string& unknown) {
+  world::Map map = world::Map::load(path);
+  if (unknown.empty()) return map;
+  return map.with_unknown(world::parse_unknown_policy(unknown, "--unknown"));
+}
+
 ResolvedQuery resolve_query(const QueryOptions& q) {
-  world::Map map = world::Map::load(q.map);
+  world::Map map = load_map(q.map, q.unknown);
   if ((q.start.empty() || q.goal.empty()) && !map.query()) {
     throw Error(q.map + ": has no \"query\"; give --start x y z and --goal x y z");
   }

@@ -57,10 +57,13 @@ extern const CLI::Validator kOutputFileNewFolder;
 /// radius default to the map's stored "query" (REQ-CLI-004).
 struct QueryOptions {
   std::string map;
+  std::string unknown;  // empty: the map's own unknown-space policy
   std::vector<double> start, goal;
   double radius = -1.0;
 };
 void add_query_options(CLI::App* cmd, QueryOptions& q);
+/// Loads a map, read under the unknown-space policy `unknown` ("occupied", "free") if not empty.
+world::Map load_map(const std::string& path, const std::string& unknown);
 struct ResolvedQuery {
   world::Map map;
   Eigen::Vector3d start;

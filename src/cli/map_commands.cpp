@@ -46,12 +46,13 @@ void run_gen(const GenOptions& o, std::ostream& out) {
 
 struct InfoOptions {
   std::string map;
+  std::string unknown;
   double radius = -1.0;
   OutputOptions output;
 };
 
 void run_info(const InfoOptions& o, std::ostream& out) {
-  const Map map = Map::load(o.map);
+  const Map map = load_map(o.map, o.unknown);
   const double radius = o.radius >= 0.0 ? o.radius : (map.query() ? map.query()->robot_radius : 0.0);
   const world::VoxelGrid grid(map, radius);
   const double occupied = static_cast<double>(grid.occupied_count()) / static_cast<double>(grid.cell_count());
@@ -73,7 +74,31 @@ void run_info(const InfoOptions& o, std::ostream& out) {
   h << "map:         " << o.map << "\n"
     << "bounds:      " << format_point(map.bounds().min) << " - " << format_point(map.bounds().max) << " m\n"
     << "resolution:  " << map.resolution() << " m\n"
-    << "obstacles:   " << map.obstacles().size() << " boxes\n"
+    << "obstacles:   " << map.obstacles().size() << " boxes\n";
+  if (const world::VoxelObstacles* v = map.voxels()) {
+    const world::VoxelLayer& layer = v->layer();
+    const double cell = std::pow(layer.resolution(), 3);
+    Json counts = Json::object();
+    h << "voxels:      " << layer.dims().x() << " x " << layer.dims().y() << " x " << layer.dims().z() << " from "
+      << map.voxel_source()->file << "\n";
+    for (const auto state : {world::VoxelState::kFree, world::VoxelState::kOccupied, world::VoxelState::kUnknown}) {
+      const char* name = state == world::VoxelState::kFree ? "free" : state == world::VoxelState::kOccupied ? "occupied" : "unknown";
+      const std::size_t n = layer.count(state);
+      counts[name] = {{"voxels", n}, {"volume_m3", static_cast<double>(n) * cell}};
+      h << "  " << std::left << std::setw(10) << name << std::right << n << " voxels, " << static_cast<double>(n) * cell
+        << " m^3\n";
+    }
+    h << "unknown:     treated as " << world::to_string(v->policy())
+      << (v->policy() == world::UnknownPolicy::kOccupied ? " (the safe default; --unknown free to fly through it)"
+                                                         : " (on request)")
+      << "\n";
+    doc["voxels"] = {{"file", map.voxel_source()->file},
+                     {"sha256", map.voxel_source()->sha256},
+                     {"dims", {layer.dims().x(), layer.dims().y(), layer.dims().z()}},
+                     {"counts", counts},
+                     {"unknown_policy", world::to_string(v->policy())}};
+  }
+  h
     << "grid:        " << grid.dims().x() << " x " << grid.dims().y() << " x " << grid.dims().z()
     << " = " << grid.cell_count() << " cells, " << std::fixed << std::setprecision(1)
     << 100.0 * occupied << " % occupied for robot radius " << std::defaultfloat << radius << " m\n";
@@ -91,7 +116,9 @@ struct ConvertOptions {
 void run_convert(const ConvertOptions& o, std::ostream& out) {
   const Map map = Map::load(o.in);
   map.save(o.out);
-  out << "wrote " << o.out << " (" << map.obstacles().size() << " obstacles from " << o.in << ")\n";
+  out << "wrote " << o.out << " (" << map.obstacles().size() << " obstacles";
+  if (map.voxels()) out << ", " << map.voxels()->layer().count(world::VoxelState::kOccupied) << " occupied voxels";
+  out << " from " << o.in << ")\n";
 }
 
 struct AstarOptions {
@@ -151,15 +178,17 @@ void add_map_commands(CLI::App& app, std::ostream& out) {
 
   auto info = std::make_shared<InfoOptions>();
   CLI::App* i = map->add_subcommand("info", "summarise a map and its occupancy grid");
-  i->add_option("--map", info->map, "map file (.json or .bt)")->required();
+  i->add_option("--map", info->map, "map file (.json, or an OctoMap .bt/.ot)")->required();
+  i->add_option("--unknown", info->unknown, "voxel maps: count unknown space as 'occupied' or 'free' in the grid")
+      ->check(CLI::IsMember({"occupied", "free"}));
   i->add_option("--radius", info->radius, "robot radius in m (default: the map's query radius or 0)")
       ->check(kFiniteNonNegative);
   add_output_options(i, info->output);
   i->callback([info, &out] { run_info(*info, out); });
 
   auto conv = std::make_shared<ConvertOptions>();
-  CLI::App* c = map->add_subcommand("convert", "convert between miner-map-v1 JSON and OctoMap .bt");
-  c->add_option("--in", conv->in, "input map (.json or .bt)")->required();
+  CLI::App* c = map->add_subcommand("convert", "convert between miner-map-v1 JSON and OctoMap .bt (a voxel map's JSON references its .bt by path and SHA-256)");
+  c->add_option("--in", conv->in, "input map (.json, .bt or .ot)")->required();
   c->add_option("--out", conv->out, "output map (.json or .bt)")->required()->check(kOutputFile);
   c->callback([conv, &out] { run_convert(*conv, out); });
 

@@ -158,7 +158,7 @@ TEST_CASE("Bad input: each case names what is wrong and exits non-zero", "[REQ-C
       {{"astar", "--map", map, "--start", "1", "1", "1", "--goal", "2", "2", "2", "--radius", "-1"}, 2, "must be a finite number >= 0"},
       {{"astar", "--map", map, "--start", "3.2", "5", "5", "--goal", "9", "9", "9", "--radius", "0.5"}, 1, "lies in an occupied grid cell"},
       {{"map", "gen", "--preset", "swamp", "--out", dir() + "/x.json"}, 1, "unknown map preset \"swamp\""},
-      {{"map", "info", "--map", write("garbage.bt", "not an octree")}, 1, "not a readable OctoMap"},
+      {{"map", "info", "--map", write("garbage.bt", "not an octree")}, 1, "not an OctoMap file"},
   };
   for (const auto& c : cases) {
     const Run r = miner_cli(c.args);

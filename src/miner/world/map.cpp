@@ -5,7 +5,12 @@
 #include <limits>
 #include <sstream>
 
+#include <filesystem>
+
 #include "miner/core/error.hpp"
+#include "miner/core/sha256.hpp"
+#include "miner/world/octree_io.hpp"
+#include "miner/world/voxel_grid.hpp"
 
 namespace miner::world {
 
@@ -27,7 +32,7 @@ void validate_box(const Box& b, const std::string& what) {
 }
 
 
-std::string obstacle_name(std::size_t i, const Box& b) {
+std::string box_name(std::size_t i, const Box& b) {
   return "obstacle " + std::to_string(i) + " [" + format_point(b.min) + " - " +
          format_point(b.max) + "]";
 }
@@ -56,11 +61,13 @@ Eigen::Vector3i grid_dims(const Box& bounds, double resolution) {
   return cells.cast<int>();
 }
 
-Map::Map(Box bounds, double resolution, std::vector<Box> obstacles, std::optional<Query> query)
+Map::Map(Box bounds, double resolution, std::vector<Box> obstacles, std::optional<Query> query,
+         std::optional<VoxelSource> voxels)
     : bounds_(std::move(bounds)),
       resolution_(resolution),
       obstacles_(std::move(obstacles)),
-      query_(std::move(query)) {
+      query_(std::move(query)),
+      source_(std::move(voxels)) {
   validate_box(bounds_, "bounds");
   require_finite(resolution_, "resolution");
   if (!(resolution_ > 0.0)) {
@@ -78,7 +85,56 @@ Map::Map(Box bounds, double resolution, std::vector<Box> obstacles, std::optiona
     require_finite(query_->robot_radius, "query.robot_radius");
     if (query_->robot_radius < 0.0) throw Error("query.robot_radius: must not be negative");
   }
+  if (source_) {
+    if (!source_->layer) throw Error("voxels: no layer");
+    const VoxelLayer& layer = *source_->layer;
+    // The map's grid and the voxels share cells: same resolution, bounds.min on the lattice.
+    constexpr double kLatticeTolerance = 1e-9;
+    if (std::abs(layer.resolution() - resolution_) > kLatticeTolerance * resolution_) {
+      std::ostringstream os;
+      os << "resolution: " << resolution_ << " m differs from the voxels' " << layer.resolution() << " m";
+      throw Error(os.str());
+    }
+    for (int k = 0; k < 3; ++k) {
+      const double cells = bounds_.min[k] / resolution_;
+      if (std::abs(cells - std::round(cells)) > kLatticeTolerance * std::max(1.0, std::abs(cells))) {
+        std::ostringstream os;
+        os << "bounds.min[" << k << "] = " << bounds_.min[k] << " is not a multiple of the voxels' resolution "
+           << resolution_ << " m (the map's grid must share the voxels' cells)";
+        throw Error(os.str());
+      }
+    }
+    voxels_ = std::make_shared<const VoxelObstacles>(source_->layer, source_->unknown);
+  }
   build_index();
+}
+
+Map Map::from_voxels(VoxelSource voxels) {
+  const VoxelLayer& layer = *voxels.layer;
+  return Map(layer.bounds(), layer.resolution(), {}, std::nullopt, std::move(voxels));
+}
+
+Map Map::with_unknown(UnknownPolicy policy) const {
+  if (!source_ || source_->unknown == policy) return *this;
+  VoxelSource source = *source_;
+  source.unknown = policy;
+  return Map(bounds_, resolution_, obstacles_, query_, std::move(source));
+}
+
+Box Map::obstacle_box(std::size_t index) const {
+  if (index < obstacles_.size()) return obstacles_[index];
+  return voxels_->layer().cell_box(voxels_->layer().coords(index - obstacles_.size()));
+}
+
+std::string Map::obstacle_name(std::size_t index) const {
+  if (index < obstacles_.size()) return box_name(index, obstacles_[index]);
+  const VoxelLayer& layer = voxels_->layer();
+  const std::size_t v = index - obstacles_.size();
+  const Eigen::Vector3i c = layer.coords(v);
+  const Box b = layer.cell_box(c);
+  return std::string(layer.state(v) == VoxelState::kUnknown ? "unknown" : "occupied") + " voxel (" +
+         std::to_string(c.x()) + ", " + std::to_string(c.y()) + ", " + std::to_string(c.z()) + ") [" +
+         format_point(b.min) + " - " + format_point(b.max) + "]";
 }
 
 void Map::build_index() {
@@ -138,17 +194,46 @@ Map Map::from_json(const Json& doc, const std::string& origin) {
   if (format != kMapFormat) {
     root.at("format").fail("unknown format tag \"" + format + "\", expected \"" + kMapFormat + "\"");
   }
-  root.only_keys({"format", "bounds", "resolution", "obstacles", "query"});
-  const JsonField jb = root.at("bounds");
-  jb.only_keys({"min", "max"});
-  Box bounds{jb.at("min").vec3(), jb.at("max").vec3()};
-  const double resolution = root.at("resolution").number();
+  root.only_keys({"format", "bounds", "resolution", "obstacles", "query", "voxels"});
+  std::optional<VoxelSource> voxels;
+  if (root.has("voxels")) {
+    const JsonField jv = root.at("voxels");
+    jv.only_keys({"file", "sha256", "unknown"});
+    namespace fs = std::filesystem;
+    fs::path file = jv.at("file").string();
+    if (file.is_relative()) file = fs::path(origin).parent_path() / file;
+    file = fs::absolute(file).lexically_normal();
+    const std::string bytes = read_file_bytes(file.string(), "voxel file");
+    VoxelSource source{nullptr, UnknownPolicy::kOccupied, file.string(), sha256_hex(bytes)};
+    if (jv.has("sha256") && jv.at("sha256").string() != source.sha256) {
+      jv.at("sha256").fail("the voxel file " + file.string() + " has SHA-256 " + source.sha256 +
+                           ", not the recorded one: the file changed since the map was written");
+    }
+    if (jv.has("unknown")) {
+      try {
+        source.unknown = parse_unknown_policy(jv.at("unknown").string(), "unknown");
+      } catch (const Error& e) {
+        jv.at("unknown").fail(e.what());
+      }
+    }
+    source.layer = parse_octree(bytes, file.string());
+    voxels = std::move(source);
+  }
+  Box bounds = voxels ? voxels->layer->bounds() : Box{};
+  double resolution = voxels ? voxels->layer->resolution() : 0.0;
+  if (!voxels || root.has("bounds")) {
+    const JsonField jb = root.at("bounds");
+    jb.only_keys({"min", "max"});
+    bounds = Box{jb.at("min").vec3(), jb.at("max").vec3()};
+  }
+  if (!voxels || root.has("resolution")) resolution = root.at("resolution").number();
 
   std::vector<Box> obstacles;
-  const JsonField jo = root.at("obstacles");
-  const std::size_t n = jo.array_size();
+  const bool listed = !voxels || root.has("obstacles");  // a voxel map needs no box list
+  const std::size_t n = listed ? root.at("obstacles").array_size() : 0;
   obstacles.reserve(n);
   for (std::size_t i = 0; i < n; ++i) {
+    const JsonField jo = root.at("obstacles");
     const JsonField o = jo.at(i);
     o.only_keys({"type", "min", "max"});
     const std::string type = o.at("type").string();
@@ -164,7 +249,7 @@ Map Map::from_json(const Json& doc, const std::string& origin) {
                   q.has("robot_radius") ? q.at("robot_radius").number() : 0.0};
   }
   try {
-    return Map(bounds, resolution, std::move(obstacles), query);
+    return Map(bounds, resolution, std::move(obstacles), query, std::move(voxels));
   } catch (const Error& e) {
     throw Error(origin + ": " + e.what());
   }
@@ -175,7 +260,7 @@ Map Map::load(const std::string& path) {
     return path.size() >= suffix.size() &&
            path.compare(path.size() - suffix.size(), suffix.size(), suffix) == 0;
   };
-  if (ends_with(".bt")) return load_octomap(path);
+  if (ends_with(".bt") || ends_with(".ot")) return load_octomap(path);
   return from_json(read_json_file(path), path);
 }
 
@@ -193,8 +278,44 @@ Json Map::to_json() const {
                     {"goal", vec3_json(query_->goal)},
                     {"robot_radius", query_->robot_radius}};
   }
+  if (source_) {
+    doc["voxels"] = {{"file", source_->file}, {"sha256", source_->sha256}, {"unknown", to_string(source_->unknown)}};
+  }
   return doc;
 }
+
+Map Map::load_octomap(const std::string& path) {
+  namespace fs = std::filesystem;
+  const std::string bytes = read_file_bytes(path, "OctoMap file");
+  VoxelSource source{parse_octree(bytes, path), UnknownPolicy::kOccupied, fs::absolute(path).lexically_normal().string(),
+                     sha256_hex(bytes)};
+  return from_voxels(std::move(source));
+}
+
+VoxelLayer Map::to_voxel_layer() const {
+  if (source_ && obstacles_.empty()) {
+    const VoxelLayer& layer = *source_->layer;
+    const Box lb = layer.bounds();
+    if (lb.min == bounds_.min && lb.max == bounds_.max) return layer;
+  }
+  const VoxelGrid boxes(Map(bounds_, resolution_, obstacles_), 0.0);
+  Eigen::Vector3i origin_cells;
+  for (int k = 0; k < 3; ++k) origin_cells[k] = static_cast<int>(std::round(bounds_.min[k] / resolution_));
+  std::vector<std::uint8_t> states(boxes.cell_count(), static_cast<std::uint8_t>(VoxelState::kFree));
+  for (std::size_t i = 0; i < states.size(); ++i) {
+    if (boxes.occupied(i)) {
+      states[i] = static_cast<std::uint8_t>(VoxelState::kOccupied);
+    } else if (source_) {
+      const VoxelLayer& layer = *source_->layer;
+      const Eigen::Vector3i c = boxes.coords(i) + origin_cells - layer.origin_cells();
+      if ((c.array() >= 0).all() && (c.array() < layer.dims().array()).all())
+        states[i] = layer.states()[layer.index(c.x(), c.y(), c.z())];
+    }
+  }
+  return VoxelLayer(origin_cells, resolution_, boxes.dims(), std::move(states));
+}
+
+void Map::save_octomap(const std::string& path) const { write_octree_bt(to_voxel_layer(), path); }
 
 void Map::save(const std::string& path) const {
   if (path.size() >= 3 && path.compare(path.size() - 3, 3, ".bt") == 0) {
@@ -206,19 +327,52 @@ void Map::save(const std::string& path) const {
 
 std::optional<std::size_t> Map::point_collision(const Eigen::Vector3d& p, double radius) const {
   const Box region{p.array() - radius, p.array() + radius};
-  return query_index(region, radius * radius, [&](const Box& b) { return squared_distance(p, b); });
+  if (auto hit = query_index(region, radius * radius, [&](const Box& b) { return squared_distance(p, b); }))
+    return hit;
+  if (voxels_) {
+    if (const auto v = voxels_->point_hit(p, radius)) return obstacles_.size() + *v;
+  }
+  return std::nullopt;
 }
 
 std::optional<std::size_t> Map::segment_collision(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                                   double radius) const {
   const Box sweep{a.cwiseMin(b).array() - radius, a.cwiseMax(b).array() + radius};
-  return query_index(sweep, radius * radius, [&](const Box& box) { return squared_distance(a, b, box); });
+  if (auto hit = query_index(sweep, radius * radius, [&](const Box& box) { return squared_distance(a, b, box); }))
+    return hit;
+  if (voxels_) {
+    if (const auto v = voxels_->segment_hit(a, b, radius)) return obstacles_.size() + *v;
+  }
+  return std::nullopt;
 }
 
 double Map::clearance(const Eigen::Vector3d& p) const {
   double best = std::numeric_limits<double>::infinity();
   for (const Box& b : obstacles_) best = std::min(best, squared_distance(p, b));
-  return std::sqrt(best);
+  best = std::sqrt(best);
+  return voxels_ ? std::min(best, voxels_->clearance(p)) : best;
+}
+
+std::optional<double> Map::raycast(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double max_range) const {
+  std::optional<double> best = voxels_ ? voxels_->raycast(origin, dir, max_range) : std::nullopt;
+  for (const Box& b : obstacles_) {
+    // Slab test: the ray meets the closed box on [t0, t1].
+    double t0 = 0.0, t1 = best ? *best : max_range;
+    bool miss = false;
+    for (int k = 0; k < 3 && !miss; ++k) {
+      if (dir[k] == 0.0) {
+        miss = origin[k] < b.min[k] || origin[k] > b.max[k];
+        continue;
+      }
+      double ta = (b.min[k] - origin[k]) / dir[k], tb = (b.max[k] - origin[k]) / dir[k];
+      if (ta > tb) std::swap(ta, tb);
+      t0 = std::max(t0, ta);
+      t1 = std::min(t1, tb);
+      miss = t0 > t1;
+    }
+    if (!miss) best = t0;
+  }
+  return best;
 }
 
 void Map::require_free(const Eigen::Vector3d& p, double radius, const std::string& what) const {
@@ -228,13 +382,13 @@ void Map::require_free(const Eigen::Vector3d& p, double radius, const std::strin
                 format_point(bounds_.min) + " - " + format_point(bounds_.max) + "]");
   }
   if (const auto hit = point_collision(p, radius)) {
-    const Box& b = obstacles_[*hit];
+    const Box b = obstacle_box(*hit);
     std::ostringstream os;
     if (squared_distance(p, b) == 0.0) {
-      os << what << " " << format_point(p) << " lies inside " << obstacle_name(*hit, b);
+      os << what << " " << format_point(p) << " lies inside " << obstacle_name(*hit);
     } else {
       os << what << " " << format_point(p) << " is within the robot radius " << radius << " of "
-         << obstacle_name(*hit, b) << " (clearance " << std::sqrt(squared_distance(p, b)) << ")";
+         << obstacle_name(*hit) << " (clearance " << std::sqrt(squared_distance(p, b)) << ")";
     }
     throw Error(os.str());
   }

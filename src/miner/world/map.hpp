@@ -8,11 +8,18 @@
 ///    "bounds": {"min": [0,0,0], "max": [100,100,100]},
 ///    "resolution": 0.5,
 ///    "obstacles": [{"type": "box", "min": [10,10,0], "max": [20,25,40]}],
-///    "query": {"start": [..], "goal": [..], "robot_radius": 0.5}}   // optional
-/// OctoMap binary trees (`.bt`) are accepted too (REQ-WORLD-003).
+///    "query": {"start": [..], "goal": [..], "robot_radius": 0.5},    // optional
+///    "voxels": {"file": "scan.bt", "sha256": "..", "unknown": "occupied"}}  // optional
+/// OctoMap files (`.bt`, `.ot`) load as voxel maps (REQ-WORLD-003, REQ-WORLD-012): free, occupied
+/// and unknown voxels with their exact leaf geometry. A JSON map may reference such a file
+/// ("file" relative to the JSON's folder, its SHA-256 checked when given; REQ-WORLD-015), and
+/// then "bounds" and "resolution" default to the voxels'; boxes and voxels obstruct together.
+/// The unknown-space policy (REQ-WORLD-013) is "occupied" unless the map or the query says
+/// "free"; collision queries see blocked voxels through world::VoxelObstacles.
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -21,6 +28,7 @@
 
 #include "miner/core/json_io.hpp"
 #include "miner/world/box.hpp"
+#include "miner/world/voxel_layer.hpp"
 
 namespace miner::world {
 
@@ -43,35 +51,62 @@ struct Query {
 /// count in double: no integer wrap) or when the resolution is coarser than an extent.
 Eigen::Vector3i grid_dims(const Box& bounds, double resolution);
 
+/// The voxel part of a map: the layer, the policy it is read under, and where it came from.
+struct VoxelSource {
+  std::shared_ptr<const VoxelLayer> layer;
+  UnknownPolicy unknown = UnknownPolicy::kOccupied;
+  /// The OctoMap file the layer was read from (absolute), and its SHA-256.
+  std::string file;
+  std::string sha256;
+};
+
 class Map {
  public:
-  /// Validates every argument (REQ-WORLD-002); throws miner::Error naming the fault.
+  /// Validates every argument (REQ-WORLD-002); throws miner::Error naming the fault. With
+  /// voxels, the resolution must be the layer's and bounds.min must lie on its lattice (so the
+  /// A* grid and the voxels share cells).
   Map(Box bounds, double resolution, std::vector<Box> obstacles,
-      std::optional<Query> query = std::nullopt);
+      std::optional<Query> query = std::nullopt, std::optional<VoxelSource> voxels = std::nullopt);
+  /// A map of voxels alone, bounded by the layer.
+  static Map from_voxels(VoxelSource voxels);
+  /// The same map read under another unknown-space policy (the distance field is rebuilt).
+  Map with_unknown(UnknownPolicy policy) const;
 
-  /// Loads a `miner-map-v1` JSON file, or an OctoMap `.bt` file by its extension.
+  /// Loads a `miner-map-v1` JSON file, or an OctoMap `.bt` / `.ot` file by its extension.
   static Map load(const std::string& path);
-  /// Parses a `miner-map-v1` document; `origin` names it in error messages.
+  /// Parses a `miner-map-v1` document; `origin` names it in error messages and its folder
+  /// anchors a relative voxel file.
   static Map from_json(const Json& doc, const std::string& origin);
-  /// Occupied leaves of an OctoMap binary tree become box obstacles; the bounds are the
-  /// metric bounding box of the tree's known cells, the resolution the tree's.
+  /// An OctoMap file as a voxel map (world::read_octree), bounded by its known leaves.
   static Map load_octomap(const std::string& path);
 
+  /// The document; a voxel map references its file by absolute path and SHA-256.
   Json to_json() const;
   /// Writes the map as JSON (atomic), or as an OctoMap `.bt` if `path` ends in .bt.
   void save(const std::string& path) const;
-  /// Voxelises the obstacles at the map resolution into an OctoMap binary tree; the
-  /// two corner cells of the bounds are stored as free so the bounds survive a round trip.
+  /// The map as voxels at its resolution on the lattice of its bounds: a voxel is occupied if
+  /// the grid of VoxelGrid(map, 0) holds it, unknown if the voxel layer says so, else free.
+  VoxelLayer to_voxel_layer() const;
+  /// Writes to_voxel_layer() as an OctoMap binary tree (free space known, so the bounds survive).
   void save_octomap(const std::string& path) const;
 
   const Box& bounds() const { return bounds_; }
   double resolution() const { return resolution_; }
   const std::vector<Box>& obstacles() const { return obstacles_; }
   const std::optional<Query>& query() const { return query_; }
+  /// The voxel part, or nullptr for a map of boxes only.
+  const VoxelObstacles* voxels() const { return voxels_.get(); }
+  const std::optional<VoxelSource>& voxel_source() const { return source_; }
+  /// The box an obstacle index names: a box obstacle below obstacles().size(), else the voxel
+  /// obstacles().size() + i of the layer.
+  Box obstacle_box(std::size_t index) const;
+  /// "obstacle 3 [..]" or "occupied voxel (i, j, k) [..]" / "unknown voxel ...".
+  std::string obstacle_name(std::size_t index) const;
 
   bool in_bounds(const Eigen::Vector3d& p) const { return bounds_.contains(p); }
 
-  /// Index of an obstacle within distance `radius` of p (boundary counts), if any.
+  /// Index of an obstacle within distance `radius` of p (boundary counts), if any: boxes
+  /// first (the lowest index), then blocked voxels (see obstacle_box).
   std::optional<std::size_t> point_collision(const Eigen::Vector3d& p, double radius = 0.0) const;
   /// Index of an obstacle within `radius` of some point of segment [a, b], if any.
   std::optional<std::size_t> segment_collision(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
@@ -87,6 +122,8 @@ class Map {
 
   /// Distance from p to the nearest obstacle (+infinity with no obstacles).
   double clearance(const Eigen::Vector3d& p) const;
+  /// Distance along the unit direction `dir` to the first obstacle surface within max_range.
+  std::optional<double> raycast(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double max_range) const;
 
   /// Throws miner::Error unless a robot of `radius` can stand at p; `what` names the
   /// point ("start", "goal") and the message names the offending obstacle.
@@ -97,6 +134,8 @@ class Map {
   double resolution_;
   std::vector<Box> obstacles_;
   std::optional<Query> query_;
+  std::optional<VoxelSource> source_;
+  std::shared_ptr<const VoxelObstacles> voxels_;
 
   /// Broad phase: a uniform grid of buckets over the bounds, each listing the obstacles
   /// that overlap it, so a query visits only nearby obstacles. Answers are identical to

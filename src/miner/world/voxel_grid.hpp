@@ -5,8 +5,8 @@
 ///
 /// Cell (i, j, k) is the open cube origin + ([i, i+1) x [j, j+1) x [k, k+1)) * res with
 /// origin = bounds.min and dims = ceil(extent / res). A cell is occupied iff its open
-/// interior meets an obstacle box inflated by r on every side, or its centre lies
-/// outside the bounds. The grid is conservative: it covers the exact rounded-box
+/// interior meets an obstacle box (or blocked voxel, REQ-WORLD-012) inflated by r on every
+/// side, or its centre lies outside the bounds. The grid is conservative: it covers the exact rounded-box
 /// inflation, so a straight move between free cells that A* allows is collision-free
 /// in the continuous map (REQ-WORLD-008).
 
@@ -20,6 +20,8 @@
 namespace miner::world {
 
 class Map;
+class VoxelObstacles;
+struct Box;
 
 class VoxelGrid {
  public:
@@ -57,6 +59,8 @@ class VoxelGrid {
   double resolution_;
   double robot_radius_;
   std::vector<std::uint8_t> occupancy_;
+  /// Blocked voxels of a voxel map, grown by the robot radius like the boxes.
+  void mark_voxels(const VoxelObstacles& voxels, const Box& bounds);
 };
 
 }  // namespace miner::world

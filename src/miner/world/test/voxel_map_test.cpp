@@ -1,0 +1,88 @@
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+#include <fstream>
+
+#include "miner/core/error.hpp"
+#include "miner/core/json_io.hpp"
+#include "miner/core/sha256.hpp"
+#include "miner/world/map.hpp"
+#include "miner/world/octree_io.hpp"
+#include "miner/world/voxel_grid.hpp"
+#include "test_maps.hpp"
+
+using namespace miner::world;
+using Catch::Matchers::Contains;
+using V = Eigen::Vector3d;
+
+namespace {
+
+/// 4 x 4 x 4 voxels of 1 m from the origin: (1, 1, 1) unknown, (2, 2, 2) occupied, the rest free.
+std::shared_ptr<const VoxelLayer> small_layer() {
+  std::vector<std::uint8_t> states(64, static_cast<std::uint8_t>(VoxelState::kFree));
+  states[(1 * 4 + 1) * 4 + 1] = static_cast<std::uint8_t>(VoxelState::kUnknown);
+  states[(2 * 4 + 2) * 4 + 2] = static_cast<std::uint8_t>(VoxelState::kOccupied);
+  return std::make_shared<const VoxelLayer>(Eigen::Vector3i::Zero(), 1.0, Eigen::Vector3i(4, 4, 4), std::move(states));
+}
+
+}  // namespace
+
+TEST_CASE("Unknown space blocks by default and is free only on request", "[REQ-WORLD-013]") {
+  const Map map = Map::from_voxels({small_layer(), UnknownPolicy::kOccupied, "", ""});
+  const V in_unknown(1.5, 1.5, 1.5), in_occupied(2.5, 2.5, 2.5), in_free(0.5, 3.5, 0.5);
+  CHECK(map.point_collision(in_unknown));
+  CHECK(map.point_collision(in_occupied));
+  CHECK_FALSE(map.point_collision(in_free));
+  CHECK_THROWS_WITH(map.require_free(in_unknown, 0.0, "start"), Contains("start (1.5, 1.5, 1.5) lies inside unknown voxel (1, 1, 1)"));
+  CHECK(VoxelGrid(map, 0.0).occupied(Eigen::Vector3i(1, 1, 1)));
+
+  const Map open = map.with_unknown(UnknownPolicy::kFree);
+  CHECK_FALSE(open.point_collision(in_unknown));
+  CHECK(open.point_collision(in_occupied));
+  CHECK_FALSE(VoxelGrid(open, 0.0).occupied(Eigen::Vector3i(1, 1, 1)));
+  CHECK(open.segment_free(V(0.5, 0.5, 0.5), V(1.5, 1.5, 1.5)));
+  CHECK_FALSE(map.segment_free(V(0.5, 0.5, 0.5), V(1.5, 1.5, 1.5)));
+  CHECK_THROWS_WITH(parse_unknown_policy("maybe", "--unknown"), Contains("--unknown: unknown-space policy \"maybe\""));
+}
+
+TEST_CASE("A map file references its voxels by path and SHA-256", "[REQ-WORLD-015][REQ-WORLD-013]") {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::path(test::temp_path("refs")) / "";
+  fs::create_directories(dir);
+  write_octree_bt(*small_layer(), (dir / "small.bt").string());
+  const auto write = [&](const std::string& name, const std::string& text) {
+    std::ofstream((dir / name).string()) << text;
+    return (dir / name).string();
+  };
+  const Map loaded = Map::load(write("ok.json", R"({"format": "miner-map-v1", "voxels": {"file": "small.bt", "unknown": "free"}})"));
+  REQUIRE(loaded.voxels() != nullptr);
+  CHECK(loaded.voxel_source()->file == fs::absolute(dir / "small.bt").lexically_normal().string());
+  CHECK(loaded.voxel_source()->sha256 == miner::sha256_hex(miner::read_file_bytes((dir / "small.bt").string())));
+  CHECK(loaded.voxels()->policy() == UnknownPolicy::kFree);
+  CHECK(loaded.bounds().max == V(4, 4, 4));
+  CHECK(loaded.resolution() == 1.0);
+  // The written document references the file (no copy of the voxels) and reads back the same.
+  const miner::Json doc = loaded.to_json();
+  CHECK(doc["voxels"]["sha256"] == loaded.voxel_source()->sha256);
+  CHECK(Map::from_json(doc, (dir / "again.json").string()).to_json() == doc);
+  // A changed file is refused by its hash; bad fields are named.
+  miner::Json stale = doc;
+  stale["voxels"]["sha256"] = std::string(64, '0');
+  CHECK_THROWS_WITH(Map::from_json(stale, "stale.json"), Contains("voxels.sha256") && Contains("the file changed"));
+  CHECK_THROWS_WITH(Map::load(write("policy.json", R"({"format": "miner-map-v1", "voxels": {"file": "small.bt", "unknown": "maybe"}})")),
+                    Contains("voxels.unknown"));
+  CHECK_THROWS_WITH(Map::load(write("key.json", R"({"format": "miner-map-v1", "voxels": {"files": "small.bt"}})")),
+                    Contains("files") && Contains("did you mean"));
+  CHECK_THROWS_WITH(Map::load(write("gone.json", R"({"format": "miner-map-v1", "voxels": {"file": "gone.bt"}})")),
+                    Contains("gone.bt: cannot open"));
+  CHECK_THROWS_WITH(
+      Map::load(write("lattice.json", R"({"format": "miner-map-v1", "bounds": {"min": [0.5, 0, 0], "max": [4, 4, 4]},
+                                          "resolution": 1, "obstacles": [], "voxels": {"file": "small.bt"}})")),
+      Contains("bounds.min[0] = 0.5 is not a multiple of the voxels' resolution"));
+  // Boxes and voxels obstruct together.
+  const Map both = Map::load(write("both.json", R"({"format": "miner-map-v1", "obstacles": [{"type": "box", "min": [0, 3, 0], "max": [1, 4, 1]}],
+                                                   "voxels": {"file": "small.bt"}})"));
+  CHECK(both.point_collision(V(0.5, 3.5, 0.5)));
+  CHECK(both.point_collision(V(2.5, 2.5, 2.5)));
+  CHECK(both.point_collision(V(1.5, 1.5, 1.5)));  // unknown: occupied by default
+}

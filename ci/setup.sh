@@ -16,7 +16,7 @@ PACKAGES=(
   libceres-dev         # independent optimiser: checks MINCO optimality, refines time allocation
   libsundials-dev      # CVODE integrates the quadrotor rigid body
   # world model and I/O
-  liboctomap-dev       # OctoMap .bt import
+  liboctomap-dev       # OctoMap: scan integration (miner map scan), oracle for the .bt/.ot reader tests
   libnanoflann-dev     # k-d tree for planners' nearest-neighbour queries
   nlohmann-json3-dev   # map / scenario / result JSON
   libcli11-dev         # the `miner` command line

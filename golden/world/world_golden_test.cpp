@@ -9,6 +9,7 @@
 #include "miner/testing/golden.hpp"
 #include "miner/world/astar.hpp"
 #include "miner/world/map_generator.hpp"
+#include "miner/world/octree_io.hpp"
 #include "miner/world/voxel_grid.hpp"
 
 using namespace miner::world;
@@ -54,4 +55,9 @@ TEST_CASE("Fixture maps regenerate byte for byte from their preset and seed", "[
     ss << in.rdbuf();
     CHECK(ss.str() == miner::dump_json(generate_map(generator_preset(preset), static_cast<std::uint64_t>(seed)).to_json()));
   }
+  // fixtures/maps/indoor-1.bt was written by `miner map convert --in indoor-1.json --out indoor-1.bt`.
+  std::ifstream bt(fixture_path("indoor-1.bt"), std::ios::binary);
+  std::stringstream bytes;
+  bytes << bt.rdbuf();
+  CHECK(bytes.str() == miner::world::octree_bt_bytes(generate_map(generator_preset("indoor"), 1).to_voxel_layer()));
 }

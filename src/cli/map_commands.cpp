@@ -1,5 +1,6 @@
 // `miner map gen|info|convert` and `miner astar` (REQ-CLI-*, REQ-WORLD-*).
 #include <cmath>
+#include <filesystem>
 #include <iomanip>
 #include <memory>
 #include <optional>
@@ -14,6 +15,8 @@
 #include "miner/world/astar.hpp"
 #include "miner/world/map.hpp"
 #include "miner/world/map_generator.hpp"
+#include "miner/world/octree_io.hpp"
+#include "miner/world/scan.hpp"
 #include "miner/world/voxel_grid.hpp"
 
 namespace miner::cli {
@@ -156,6 +159,52 @@ void run_astar(const AstarOptions& o, std::ostream& out) {
   emit(o.output, doc, h.str(), out);
 }
 
+struct ScanCliOptions {
+  QueryOptions query;
+  world::ScanOptions scan = [] {
+    world::ScanOptions o;
+    o.body_radius = -1.0;  // unset: the query's radius
+    return o;
+  }();
+  std::vector<double> fov{360.0, 60.0};
+  std::vector<int> rays{180, 16};
+  std::string out, map_out;
+};
+
+void run_scan(const ScanCliOptions& o, std::ostream& out) {
+  if (o.out.size() < 3 || o.out.compare(o.out.size() - 3, 3, ".bt") != 0)
+    throw Error("--out: " + o.out + " must end in .bt (the scan is an OctoMap binary tree)");
+  const ResolvedQuery q = resolve_query(o.query);
+  world::ScanOptions options = o.scan;
+  options.h_fov_deg = o.fov[0];
+  options.v_fov_deg = o.fov[1];
+  options.h_rays = o.rays[0];
+  options.v_rays = o.rays[1];
+  if (options.body_radius < 0.0) options.body_radius = q.radius;
+  // The sensor flies the A* path of the query (the route a mapping flight would take).
+  const world::VoxelGrid grid(q.map, q.radius);
+  const world::GridPath route = world::astar(q.map, grid, q.start, q.goal);
+  const world::ScanResult scan = world::scan_map(q.map, route.points, options);
+  write_file_atomic(o.out, scan.bt);
+  const Map scanned = Map::load(o.out);
+  const world::VoxelLayer& layer = scanned.voxels()->layer();
+  if (!o.map_out.empty()) {
+    Json doc = scanned.to_json();
+    doc["query"] = {{"start", vec3_json(q.start)}, {"goal", vec3_json(q.goal)}, {"robot_radius", q.radius}};
+    // Relative to the JSON's folder when they share one, so the pair can be moved together.
+    const auto bt = std::filesystem::absolute(o.out), json = std::filesystem::absolute(o.map_out);
+    if (bt.parent_path() == json.parent_path()) doc["voxels"]["file"] = bt.filename().string();
+    write_file_atomic(o.map_out, dump_json(doc));
+  }
+  out << "scanned " << o.query.map << " along " << scan.poses << " poses (" << route.cost << " m): " << scan.rays
+      << " rays, " << scan.returns << " returns\n"
+      << "wrote " << o.out << ": " << layer.dims().x() << " x " << layer.dims().y() << " x " << layer.dims().z()
+      << " voxels of " << layer.resolution() << " m, " << layer.count(world::VoxelState::kFree) << " free, "
+      << layer.count(world::VoxelState::kOccupied) << " occupied, " << layer.count(world::VoxelState::kUnknown)
+      << " unknown\n";
+  if (!o.map_out.empty()) out << "wrote " << o.map_out << " (references " << o.out << ", with the query)\n";
+}
+
 }  // namespace
 
 void add_map_commands(CLI::App& app, std::ostream& out) {
@@ -191,6 +240,30 @@ void add_map_commands(CLI::App& app, std::ostream& out) {
   c->add_option("--in", conv->in, "input map (.json, .bt or .ot)")->required();
   c->add_option("--out", conv->out, "output map (.json or .bt)")->required()->check(kOutputFile);
   c->callback([conv, &out] { run_convert(*conv, out); });
+
+  auto scan = std::make_shared<ScanCliOptions>();
+  CLI::App* sc = map->add_subcommand(
+      "scan", "simulate a mapping run: a range sensor flown along the query's A* path (the vehicle's own volume, --radius, known free) builds an OctoMap (free, occupied, unknown)");
+  add_query_options(sc, scan->query);
+  sc->add_option("--range", scan->scan.range, "sensor range in m")->capture_default_str()->check(kPositive);
+  sc->add_option("--fov", scan->fov, "horizontal and vertical field of view in degrees")->expected(2)->capture_default_str();
+  sc->add_option("--rays", scan->rays, "rays across the horizontal and the vertical field")->expected(2)->capture_default_str();
+  sc->add_option("--noise", scan->scan.noise, "range noise standard deviation in m")->capture_default_str()
+      ->check(kFiniteNonNegative);
+  sc->add_option("--dropout", scan->scan.dropout, "probability that a return is lost")->capture_default_str()
+      ->check(kFiniteNonNegative);
+  sc->add_option("--spacing", scan->scan.spacing, "distance between sensor poses along the path in m")
+      ->capture_default_str()->check(kPositive);
+  sc->add_option("--body-radius", scan->scan.body_radius,
+                 "radius in m of the volume the vehicle sweeps along the path, set free (default: --radius)")
+      ->check(kFiniteNonNegative);
+  sc->add_flag("!--no-spin", scan->scan.spin_at_ends, "no full turn at the first and the last pose");
+  sc->add_option("--resolution", scan->scan.resolution, "voxel size in m (default: the map's)")->check(kPositive);
+  sc->add_option("--seed", scan->scan.seed, "random seed (range noise, dropouts)")->capture_default_str()->check(kUnsigned64);
+  sc->add_option("--out", scan->out, "the scan as an OctoMap binary tree (.bt)")->required()->check(kOutputFile);
+  sc->add_option("--map-out", scan->map_out, "also a map file (.json) referencing the scan, with the query")
+      ->check(kOutputFile);
+  sc->callback([scan, &out] { run_scan(*scan, out); });
 
   auto astar = std::make_shared<AstarOptions>();
   CLI::App* a = app.add_subcommand("astar", "shortest 26-connected grid path (A*) between two points");

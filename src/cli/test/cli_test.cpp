@@ -796,3 +796,53 @@ TEST_CASE("Training is deterministic for a seed and exports weights C++ loads an
                      dir() + "/nope --out " + dir() + "/train-d 2> /dev/null")
                         .c_str()) != 0);
 }
+
+TEST_CASE("The scan fixtures are planned and flown through known space only", "[REQ-WORLD-016][REQ-WORLD-013]") {
+  // Simulated mapping runs (fixtures/scans/make.sh): lidar through the indoor site, a depth
+  // camera through an office floor, lidar through a forest; unknown space is occupied.
+  for (const std::string name : {"indoor-1-lidar", "rooms-depth", "forest-lidar"}) {
+    INFO(name);
+    const std::string scenario = std::string(MINER_SOURCE_DIR) + "/fixtures/scenarios/" + name + ".json";
+    const Run r = miner_cli({"fly", "--scenario", scenario, "--out", dir() + "/scan-" + name, "--json"});
+    INFO(r.err);
+    REQUIRE(r.code == 0);
+    const miner::Json summary = miner::parse_json(r.out, "stdout");
+    CHECK(summary["goal_reached"] == true);
+    CHECK(summary["collisions"] == 0);
+    // The run folder references the scan by hash instead of copying its voxels.
+    const miner::Json map = miner::parse_json(read(dir() + "/scan-" + name + "/map.json"), "map.json");
+    CHECK(map["voxels"]["sha256"].get<std::string>().size() == 64);
+    CHECK(map["obstacles"].empty());
+    CHECK_THAT(read(dir() + "/scan-" + name + "/report.html"), Contains("unknown space treated as occupied"));
+  }
+  const std::string map = std::string(MINER_SOURCE_DIR) + "/fixtures/scans/rooms-depth.json";
+  CHECK(miner_cli({"plan", "--map", map, "--radius", "0.3", "--iterations", "30000"}).code == 0);
+}
+
+TEST_CASE("miner map scan writes a deterministic OctoMap and a map that references it", "[REQ-WORLD-016][REQ-WORLD-013]") {
+  const std::string src = std::string(MINER_SOURCE_DIR) + "/fixtures/maps/indoor-1.json";
+  const std::string bt = dir() + "/scan.bt", json = dir() + "/scan.json";
+  const std::vector<std::string> args{"map", "scan", "--map", src, "--rays", "90", "8", "--out", bt, "--map-out", json};
+  const Run r = miner_cli(args);
+  INFO(r.err);
+  REQUIRE(r.code == 0);
+  CHECK_THAT(r.out, Contains("free") && Contains("occupied") && Contains("unknown"));
+  const std::string first = read(bt);
+  REQUIRE(miner_cli(args).code == 0);
+  CHECK(read(bt) == first);
+  const miner::Json doc = miner::parse_json(read(json), "scan.json");
+  CHECK(doc["voxels"]["file"] == "scan.bt");
+  CHECK(doc.contains("query"));
+  const Run info = miner_cli({"map", "info", "--map", json, "--json"});
+  REQUIRE(info.code == 0);
+  const miner::Json i = miner::parse_json(info.out, "stdout");
+  CHECK(i["voxels"]["counts"]["unknown"]["voxels"].get<double>() > 0);
+  CHECK(i["voxels"]["unknown_policy"] == "occupied");
+  const Run open = miner_cli({"map", "info", "--map", json, "--unknown", "free", "--json"});
+  CHECK(miner::parse_json(open.out, "stdout")["grid"]["occupied_cells"] < i["grid"]["occupied_cells"]);
+  // Bad settings name themselves.
+  CHECK_THAT(miner_cli({"map", "scan", "--map", src, "--out", dir() + "/scan.json"}).err, Contains("must end in .bt"));
+  CHECK_THAT(miner_cli({"map", "scan", "--map", src, "--fov", "400", "60", "--out", bt}).err,
+             Contains("horizontal field of view"));
+  CHECK_THAT(miner_cli({"map", "info", "--map", json, "--unknown", "maybe"}).err, Contains("--unknown"));
+}

@@ -88,13 +88,22 @@ std::string plots(const flight::FlightResult& f) {
 Json scene_json(const FlightReportInput& in) {
   const auto& map = *in.scenario.map;
   Json obstacles = Json::array();
-  for (const auto& b : map.obstacles())
+  std::vector<world::Box> boxes = map.obstacles();
+  int block = 0;
+  if (map.voxels()) {
+    // A real scan has ~1e5 occupied voxels: the view draws them in coarser blocks.
+    constexpr std::size_t kMaxVoxelBoxes = 4000;
+    const auto voxels = world::decimated_occupied_boxes(map.voxels()->layer(), kMaxVoxelBoxes, &block);
+    boxes.insert(boxes.end(), voxels.begin(), voxels.end());
+  }
+  for (const auto& b : boxes)
     obstacles.push_back({mm(b.min.x()), mm(b.min.y()), mm(b.min.z()), mm(b.max.x()), mm(b.max.y()), mm(b.max.z())});
   Json scene{{"bounds", {{"min", Json::array()}, {"max", Json::array()}}},
              {"obstacles", obstacles},
              {"radius", in.scenario.vehicle.radius},
              {"start", Json::array()},
              {"goal", Json::array()}};
+  if (map.voxels()) scene["voxel_block_m"] = block * map.resolution();
   push3(scene["bounds"]["min"], map.bounds().min);
   push3(scene["bounds"]["max"], map.bounds().max);
   push3(scene["start"], in.scenario.start);
@@ -139,7 +148,8 @@ std::string render_flight_report(const FlightReportInput& in) {
   const auto& s = in.scenario;
   const auto& f = in.flight;
   const auto& r = in.reference;
-  std::string scene = scene_json(in).dump();
+  const Json scene_doc = scene_json(in);
+  std::string scene = scene_doc.dump();
   // "</" cannot appear inside a <script> element's text.
   for (std::size_t p = scene.find("</"); p != std::string::npos; p = scene.find("</", p + 2)) scene.replace(p, 2, "<\\/");
 
@@ -164,8 +174,15 @@ std::string render_flight_report(const FlightReportInput& in) {
        "<span style=\"color:#f2b134\">&#9632; heuristic region</span><span style=\"color:#6baed6\">&#9632; RRT* tree</span>"
        "<span style=\"color:#9467bd\">&#9632; planned path</span><span style=\"color:#d62728\">&#9632; repaired path</span>"
        "<span style=\"color:#1f77b4\">&#9632; trajectory</span><span style=\"color:#2ca02c\">&#9632; flown (truth)</span>"
-       " Drag to orbit, scroll to zoom, right-drag to pan.</p>\n"
-       "<p id=\"miner-status\" data-state=\"loading\">loading the 3D view...</p>\n";
+       " Drag to orbit, scroll to zoom, right-drag to pan.</p>\n";
+  if (const auto* v = s.map->voxels()) {
+    const auto& src = *s.map->voxel_source();
+    h += "<p>Voxel map " + html_escape(src.file) + " (SHA-256 " + src.sha256.substr(0, 16) + "...), " +
+         std::to_string(v->layer().count(world::VoxelState::kOccupied)) + " occupied voxels of " +
+         fixed(v->layer().resolution(), 3) + " m, drawn as blocks of " + fixed(scene_doc["voxel_block_m"].get<double>(), 3) +
+         " m; unknown space treated as " + world::to_string(v->policy()) + ".</p>\n";
+  }
+  h += "<p id=\"miner-status\" data-state=\"loading\">loading the 3D view...</p>\n";
   h += "<h2>Tracking (the paper's MSE table)</h2>\n<table><tr><th>Env.</th><th>Pos. Err. x</th><th>Pos. Err. y</th>"
        "<th>Pos. Err. z</th><th>Vel. Err. x</th><th>Vel. Err. y</th><th>Vel. Err. z</th></tr>\n<tr><td>" +
        html_escape(s.name) + "</td>";

@@ -21,11 +21,7 @@ constexpr int kTreeDepth = 16;
 constexpr const char* kBinaryHeader = "# Octomap OcTree binary file";
 constexpr const char* kFullHeader = "# Octomap OcTree file";
 
-struct Leaf {
-  std::array<std::uint16_t, 3> key;  // lower corner
-  std::uint8_t depth;
-  VoxelState state;
-};
+using Leaf = OctreeLeaf;
 
 struct Header {
   std::string id;
@@ -228,7 +224,12 @@ std::string exact_decimal(double v) {
 
 std::shared_ptr<const VoxelLayer> parse_octree(const std::string& bytes, const std::string& origin) {
   const Header h = parse_header(bytes, origin);
-  const std::vector<Leaf> leaves = read_leaves(bytes, h, origin);
+  return layer_from_leaves(read_leaves(bytes, h, origin), h.res, origin);
+}
+
+std::shared_ptr<const VoxelLayer> layer_from_leaves(const std::vector<OctreeLeaf>& leaves, double resolution,
+                                                    const std::string& origin) {
+  if (leaves.empty()) fail(origin, "the tree has no known leaf");
   std::array<std::int64_t, 3> lo{}, hi{};
   lo.fill(INT64_MAX);
   hi.fill(INT64_MIN);
@@ -265,7 +266,7 @@ std::shared_ptr<const VoxelLayer> parse_octree(const std::string& bytes, const s
                                      static_cast<int>(lo[1] - kOctreeKeyOffset),
                                      static_cast<int>(lo[2] - kOctreeKeyOffset));
   try {
-    return std::make_shared<const VoxelLayer>(origin_cells, h.res, dims, std::move(states));
+    return std::make_shared<const VoxelLayer>(origin_cells, resolution, dims, std::move(states));
   } catch (const Error& e) {
     fail(origin, e.what());
   }

@@ -18,7 +18,10 @@
 /// The writer emits the maximum-likelihood, pruned .bt OctoMap itself writes for the same
 /// voxels (same bytes: the tests compare them), in one pass over a pyramid of block states.
 
+#include <array>
 #include <cstddef>
+#include <cstdint>
+#include <vector>
 #include <memory>
 #include <string>
 
@@ -30,6 +33,17 @@ namespace miner::world {
 inline constexpr std::size_t kMaxOctreeLeaves = std::size_t{1} << 26;
 /// OctoMap keys are 16 bits; voxel key k has its centre at (k - kOctreeKeyOffset + 0.5) * res.
 inline constexpr int kOctreeKeyOffset = 32768;
+
+/// A known leaf of an octree: its lower-corner key, depth (16: one voxel) and state.
+struct OctreeLeaf {
+  std::array<std::uint16_t, 3> key;
+  std::uint8_t depth;
+  VoxelState state;
+};
+/// The layer of a set of leaves: bounded by their extent, unknown between them. Throws
+/// (prefixed by `origin`) when the extent exceeds kMaxGridCells or no leaf is given.
+std::shared_ptr<const VoxelLayer> layer_from_leaves(const std::vector<OctreeLeaf>& leaves, double resolution,
+                                                    const std::string& origin);
 
 /// Reads a .bt or .ot file into a layer whose voxels are unknown outside the tree's leaves and
 /// whose bounds are the leaves' extent.

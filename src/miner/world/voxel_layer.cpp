@@ -55,6 +55,38 @@ void distance_transform_1d(const std::vector<double>& f, std::vector<double>& ou
 
 }  // namespace
 
+std::vector<double> squared_distance_transform(const std::vector<std::uint8_t>& seeds, const Eigen::Vector3i& n,
+                                               bool cube_to_cube) {
+  std::vector<double> sq(seeds.size());
+  for (std::size_t i = 0; i < seeds.size(); ++i) sq[i] = seeds[i] ? 0.0 : kInf;
+  const int longest = n.maxCoeff();
+  std::vector<double> f(longest), g(longest), out(longest), z(longest + 1);
+  std::vector<int> v(longest);
+  const std::size_t stride[3] = {1, static_cast<std::size_t>(n.x()), static_cast<std::size_t>(n.x()) * n.y()};
+  for (int axis = 0; axis < 3; ++axis) {
+    const int len = n[axis];
+    f.resize(len);
+    g.resize(len);
+    out.resize(len);
+    const int u = (axis + 1) % 3, w = (axis + 2) % 3;
+    for (int b = 0; b < n[w]; ++b)
+      for (int a = 0; a < n[u]; ++a) {
+        const std::size_t base = a * stride[u] + b * stride[w];
+        for (int q = 0; q < len; ++q) f[q] = sq[base + q * stride[axis]];
+        if (cube_to_cube) {
+          // min_q max(|p - q| - 1, 0)^2 + f(q) = min_q |p - q|^2 + min_{|s| <= 1} f(q + s).
+          for (int q = 0; q < len; ++q)
+            g[q] = std::min({f[q], q > 0 ? f[q - 1] : kInf, q + 1 < len ? f[q + 1] : kInf});
+          distance_transform_1d(g, out, v, z);
+        } else {
+          distance_transform_1d(f, out, v, z);
+        }
+        for (int q = 0; q < len; ++q) sq[base + q * stride[axis]] = out[q];
+      }
+  }
+  return sq;
+}
+
 UnknownPolicy parse_unknown_policy(const std::string& text, const std::string& what) {
   if (text == "occupied") return UnknownPolicy::kOccupied;
   if (text == "free") return UnknownPolicy::kFree;
@@ -117,6 +149,40 @@ Eigen::Vector3i VoxelLayer::clamped_cell(const Eigen::Vector3d& p) const {
   return c;
 }
 
+std::vector<Box> decimated_occupied_boxes(const VoxelLayer& layer, std::size_t max_boxes, int* block) {
+  const Eigen::Vector3i& n = layer.dims();
+  for (int f = 1;; f *= 2) {
+    const Eigen::Vector3i m = (n.array() + f - 1) / f;
+    std::vector<std::uint8_t> any(static_cast<std::size_t>(m.x()) * m.y() * m.z(), 0);
+    for (int z = 0; z < n.z(); ++z)
+      for (int y = 0; y < n.y(); ++y)
+        for (int x = 0; x < n.x(); ++x)
+          if (layer.state(layer.index(x, y, z)) == VoxelState::kOccupied)
+            any[(static_cast<std::size_t>(z / f) * m.y() + y / f) * m.x() + x / f] = 1;
+    std::vector<Box> boxes;
+    bool fits = true;
+    for (int z = 0; z < m.z() && fits; ++z)
+      for (int y = 0; y < m.y() && fits; ++y)
+        for (int x = 0; x < m.x(); ++x) {
+          if (!any[(static_cast<std::size_t>(z) * m.y() + y) * m.x() + x]) continue;
+          int end = x;
+          while (end + 1 < m.x() && any[(static_cast<std::size_t>(z) * m.y() + y) * m.x() + end + 1]) ++end;
+          const Eigen::Vector3i lo(x * f, y * f, z * f);
+          const Eigen::Vector3i hi = Eigen::Vector3i((end + 1) * f, (y + 1) * f, (z + 1) * f).cwiseMin(n);
+          boxes.push_back({layer.cell_box(lo).min, layer.cell_box(hi - Eigen::Vector3i::Ones()).max});
+          x = end;
+          if (boxes.size() > max_boxes) {
+            fits = false;
+            break;
+          }
+        }
+    if (fits || m.maxCoeff() == 1) {
+      if (block) *block = f;
+      return boxes;
+    }
+  }
+}
+
 VoxelObstacles::VoxelObstacles(std::shared_ptr<const VoxelLayer> layer, UnknownPolicy policy)
     : layer_(std::move(layer)), policy_(policy) {
   const VoxelLayer& L = *layer_;
@@ -126,29 +192,9 @@ VoxelObstacles::VoxelObstacles(std::shared_ptr<const VoxelLayer> layer, UnknownP
     blocked_[i] = s == VoxelState::kOccupied || (s == VoxelState::kUnknown && policy_ == UnknownPolicy::kOccupied);
     blocked_count_ += blocked_[i];
   }
-  // Exact squared Euclidean distance transform, one axis after the other (separable).
   distance_.assign(L.size(), 0.0f);
   if (blocked_count_ == 0) return;
-  const Eigen::Vector3i& n = L.dims();
-  std::vector<double> sq(L.size());
-  for (std::size_t i = 0; i < L.size(); ++i) sq[i] = blocked_[i] ? 0.0 : kInf;
-  const int longest = n.maxCoeff();
-  std::vector<double> f(longest), out(longest), z(longest + 1);
-  std::vector<int> v(longest);
-  const std::size_t stride[3] = {1, static_cast<std::size_t>(n.x()), static_cast<std::size_t>(n.x()) * n.y()};
-  for (int axis = 0; axis < 3; ++axis) {
-    const int len = n[axis];
-    f.resize(len);
-    out.resize(len);
-    const int u = (axis + 1) % 3, w = (axis + 2) % 3;
-    for (int b = 0; b < n[w]; ++b)
-      for (int a = 0; a < n[u]; ++a) {
-        const std::size_t base = a * stride[u] + b * stride[w];
-        for (int q = 0; q < len; ++q) f[q] = sq[base + q * stride[axis]];
-        distance_transform_1d(f, out, v, z);
-        for (int q = 0; q < len; ++q) sq[base + q * stride[axis]] = out[q];
-      }
-  }
+  const std::vector<double> sq = squared_distance_transform(blocked_, L.dims(), false);
   for (std::size_t i = 0; i < L.size(); ++i) distance_[i] = static_cast<float>(std::sqrt(sq[i]));
 }
 

@@ -78,6 +78,19 @@ class VoxelLayer {
   std::vector<std::uint8_t> states_;
 };
 
+/// Exact squared Euclidean distance transform of a dims grid (x fastest) to its cells with
+/// seeds != 0, in cells (+inf with no seed): between cell centres, or with cube_to_cube the
+/// distance between the closed unit cubes, sum_k max(|dk| - 1, 0)^2 (each axis' 1D transform
+/// runs on its input eroded by one cell, which is that metric's separable form).
+std::vector<double> squared_distance_transform(const std::vector<std::uint8_t>& seeds, const Eigen::Vector3i& dims,
+                                               bool cube_to_cube);
+
+/// Occupied voxels drawn coarsely for a viewer: blocks of f^3 voxels (f = 1, 2, 4, ...; the
+/// smallest f giving at most `max_boxes` boxes) holding any occupied voxel, runs of such blocks
+/// along x merged into one box. `block` receives f. A picture, not an obstacle set: a block is
+/// drawn whole when one of its voxels is occupied.
+std::vector<Box> decimated_occupied_boxes(const VoxelLayer& layer, std::size_t max_boxes, int* block = nullptr);
+
 class VoxelObstacles {
  public:
   VoxelObstacles(std::shared_ptr<const VoxelLayer> layer, UnknownPolicy policy);

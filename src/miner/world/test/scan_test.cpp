@@ -1,0 +1,116 @@
+#include <catch2/catch.hpp>
+
+#include "miner/core/error.hpp"
+#include "miner/world/map.hpp"
+#include "miner/world/octree_io.hpp"
+#include "miner/world/scan.hpp"
+
+using namespace miner::world;
+using Catch::Matchers::Contains;
+using V = Eigen::Vector3d;
+
+namespace {
+
+/// 12 x 8 x 4 m at 0.2 m: one block in the middle of the sensor's way, a low wall behind it.
+Map scene() {
+  return Map(Box{{0, 0, 0}, {12, 8, 4}}, 0.2, {Box{{5, 3, 0}, {7, 5, 3}}, Box{{10, 0, 0}, {10.4, 8, 1}}});
+}
+
+}  // namespace
+
+TEST_CASE("A scan marks free space along rays, surfaces as occupied, the rest unknown", "[REQ-WORLD-016]") {
+  const Map map = scene();
+  ScanOptions o;
+  o.noise = 0.0;
+  o.dropout = 0.0;
+  o.range = 6.0;
+  const std::vector<V> path{V(1, 4, 1.5), V(3, 4, 1.5)};
+  const ScanResult scan = scan_map(map, path, o);
+  const VoxelLayer& layer = *scan.layer;
+  CHECK(scan.poses == 3);
+  CHECK(scan.returns > 0);
+  std::size_t occupied = 0, free = 0, off_surface = 0, buried = 0;
+  for (std::size_t i = 0; i < layer.size(); ++i) {
+    const Box cube = layer.cell_box(layer.coords(i));
+    const V c = cube.center();
+    if (layer.state(i) == VoxelState::kOccupied) {
+      ++occupied;
+      // A return lies on a surface: its voxel touches an obstacle.
+      off_surface += !map.point_collision(c, 0.5 * std::sqrt(3.0) * layer.resolution() + 1e-9);
+    } else if (layer.state(i) == VoxelState::kFree) {
+      ++free;
+      // Rays only cross free space: no free voxel lies wholly inside an obstacle.
+      bool inside = false;
+      for (const Box& b : map.obstacles())
+        inside = inside || ((cube.min.array() >= b.min.array()).all() && (cube.max.array() <= b.max.array()).all());
+      buried += inside;
+    }
+  }
+  CHECK(off_surface == 0);
+  CHECK(buried == 0);
+  CHECK(occupied > 100);
+  CHECK(free > 1000);
+  // Behind the block (seen from x < 5) lies a shadow nobody observed, and beyond the range too.
+  const auto state_at = [&](const V& p) {
+    const Eigen::Vector3i c = layer.clamped_cell(p);
+    return layer.bounds().contains(p) ? layer.state(layer.index(c.x(), c.y(), c.z())) : VoxelState::kUnknown;
+  };
+  CHECK(state_at(V(8.1, 4.1, 1.5)) == VoxelState::kUnknown);
+  CHECK(state_at(V(11.9, 7.9, 3.9)) == VoxelState::kUnknown);
+  CHECK(state_at(V(2.1, 4.1, 1.5)) == VoxelState::kFree);
+  // The same inputs give the same bytes, and the bytes are the layer's.
+  CHECK(scan_map(map, path, o).bt == scan.bt);
+  CHECK(octree_bt_bytes(*parse_octree(scan.bt, "scan")) == scan.bt);
+}
+
+TEST_CASE("Scan noise and dropouts come from the seed and change the map", "[REQ-WORLD-016]") {
+  const Map map = scene();
+  ScanOptions o;
+  o.range = 6.0;
+  const std::vector<V> path{V(1, 4, 1.5), V(3, 4, 1.5)};
+  o.seed = 1;
+  const ScanResult a = scan_map(map, path, o);
+  o.seed = 2;
+  const ScanResult b = scan_map(map, path, o);
+  CHECK(a.bt != b.bt);
+  o.dropout = 0.9;
+  const ScanResult sparse = scan_map(map, path, o);
+  // About a tenth of the returns survive a 90 % dropout (binomial: far more than 5 sd inside).
+  CHECK(sparse.returns < a.returns / 5);
+  CHECK(sparse.returns > a.returns / 20);
+}
+
+TEST_CASE("Bad scan settings are refused naming the setting", "[REQ-WORLD-016]") {
+  const Map map = scene();
+  const std::vector<V> path{V(1, 4, 1.5), V(3, 4, 1.5)};
+  const auto refuses = [&](ScanOptions o, const std::vector<V>& p, const std::string& message) {
+    INFO(message);
+    CHECK_THROWS_WITH(validate_scan(o, map, p), Contains(message));
+  };
+  ScanOptions o;
+  o.range = 0.0;
+  refuses(o, path, "scan range: must lie in (0, 1000] m");
+  o = ScanOptions();
+  o.h_fov_deg = 400.0;
+  refuses(o, path, "scan horizontal field of view");
+  o = ScanOptions();
+  o.dropout = 1.0;
+  refuses(o, path, "scan dropout");
+  o = ScanOptions();
+  refuses(o, {V(1, 4, 1.5), V(30, 4, 1.5)}, "scan path point 1 (30, 4, 1.5) lies outside the map bounds");
+  refuses(o, {}, "scan path: is empty");
+  o.h_rays = 100000;
+  o.v_rays = 1000;
+  refuses(o, path, "exceed the 1e+08 a scan may cast");
+  o = ScanOptions();
+  o.resolution = 1e-4;
+  refuses(o, path, "outside OctoMap's 32768 voxels");
+}
+
+TEST_CASE("Paths are resampled at a fixed spacing, ends included", "[REQ-WORLD-016]") {
+  const auto poses = resample_path({V(0, 0, 0), V(1.5, 0, 0), V(1.5, 1.0, 0)}, 1.0);
+  REQUIRE(poses.size() == 4);
+  CHECK(poses[1].isApprox(V(1, 0, 0)));
+  CHECK(poses[2].isApprox(V(1.5, 0.5, 0)));
+  CHECK(poses[3] == V(1.5, 1.0, 0));
+}

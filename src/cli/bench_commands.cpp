@@ -14,6 +14,7 @@
 #include "bench/heuristic_bench.hpp"
 #include "bench/paper_bench.hpp"
 #include "bench/suite_bench.hpp"
+#include "bench/voxel_bench.hpp"
 #include "miner/core/progress.hpp"
 #include "cli/cli.hpp"
 #include "miner/core/shard.hpp"
@@ -277,6 +278,30 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
     write_file_atomic(results.string(), bench::suite_markdown(r, link));
     if (su->json) out << dump_json(bench::to_json(r));
     else out << "wrote " << results.string() << " and " << files.size() << " box plots in " << figures.string() << "\n";
+  });
+
+  struct VoxelOptions {
+    std::string map;
+    bench::VoxelBenchOptions bench;
+    OutputOptions output;
+  };
+  auto vo = std::make_shared<VoxelOptions>();
+  CLI::App* vc = bench_cmd->add_subcommand(
+      "voxels", "voxel map costs: load time, memory, point/segment/ray queries per second, A* grid and sGAN encoding");
+  vc->add_option("--map", vo->map, "map file (.bt, .ot or .json)")->required();
+  vc->add_option("--radius", vo->bench.robot_radius, "robot radius in m")->capture_default_str()->check(kFiniteNonNegative);
+  vc->add_option("--queries", vo->bench.queries, "random queries of each kind")->capture_default_str()->check(kPositive);
+  vc->add_option("--segment-length", vo->bench.segment_length, "segment query length in m")->capture_default_str()
+      ->check(kPositive);
+  vc->add_option("--repeats", vo->bench.repeats, "timed loads, grid builds and encodings (median)")->capture_default_str()
+      ->check(kPositive);
+  vc->add_option("--seed", vo->bench.seed, "seed of the random queries")->capture_default_str()->check(kUnsigned64);
+  add_output_options(vc, vo->output);
+  vc->callback([vo, &out] {
+    const Json doc = bench::run_voxel_bench(vo->map, vo->bench);
+    std::ostringstream human;
+    bench::print_voxel_bench(doc, human);
+    emit(vo->output, doc, human.str(), out);
   });
 }
 

@@ -846,3 +846,25 @@ TEST_CASE("miner map scan writes a deterministic OctoMap and a map that referenc
              Contains("horizontal field of view"));
   CHECK_THAT(miner_cli({"map", "info", "--map", json, "--unknown", "maybe"}).err, Contains("--unknown"));
 }
+
+TEST_CASE("miner bench voxels reports load time, memory, query rates and encoding time", "[REQ-WORLD-017]") {
+  const std::string bt = std::string(MINER_SOURCE_DIR) + "/fixtures/scans/indoor-1-lidar.bt";
+  const Run r = miner_cli({"bench", "voxels", "--map", bt, "--queries", "2000", "--repeats", "1", "--json"});
+  INFO(r.err);
+  REQUIRE(r.code == 0);
+  const miner::Json doc = miner::parse_json(r.out, "stdout");
+  CHECK(doc["load_ms"].get<double>() > 0.0);
+  CHECK(doc["voxels"]["count"] == 100 * 100 * 51);
+  CHECK(doc["voxels"]["field_bytes"].get<double>() == 5.0 * 100 * 100 * 51);
+  for (const char* kind : {"point", "segment", "ray"}) {
+    CHECK(doc[kind]["per_second"].get<double>() > 0.0);
+    CHECK(doc[kind]["hits"].get<double>() > 0.0);  // half the scan is unknown, hence blocked
+    CHECK(doc[kind]["hits"].get<double>() < 2000.0);
+  }
+  CHECK(doc["encode_ms"].get<double>() > 0.0);
+  CHECK(doc["astar_grid_ms"].get<double>() > 0.0);
+  // The same queries give the same hit counts.
+  const miner::Json again =
+      miner::parse_json(miner_cli({"bench", "voxels", "--map", bt, "--queries", "2000", "--repeats", "1", "--json"}).out, "stdout");
+  CHECK(again["segment"]["hits"] == doc["segment"]["hits"]);
+}

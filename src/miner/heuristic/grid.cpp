@@ -60,6 +60,59 @@ bool box_covered(const world::Box& cell, const std::vector<world::Box>& boxes) {
   return true;
 }
 
+namespace {
+
+/// Channel E of a map's voxel layer, from occupancy in one pass over the voxels (never per
+/// voxel per cell): a voxel is grown-blocked when a blocked voxel's centre lies within the
+/// radius of its centre (the layer's distance transform); a heuristic cell is kPartial when it
+/// holds a grown-blocked voxel centre, kSolid when every voxel centre it holds is grown-blocked
+/// and the layer covers the whole cell.
+void encode_voxels(const world::Map& map, const Eigen::Vector3i& dims, double radius, std::vector<std::uint8_t>& e) {
+  const world::VoxelObstacles& voxels = *map.voxels();
+  const world::VoxelLayer& layer = voxels.layer();
+  const world::Box& b = map.bounds();
+  const Eigen::Vector3d c = cell_size(b, dims);
+  // Heuristic cell of each voxel coordinate, per axis (-1: the voxel's centre is off the grid).
+  std::array<std::vector<int>, 3> to_cell;
+  for (int a = 0; a < 3; ++a) {
+    to_cell[a].resize(static_cast<std::size_t>(layer.dims()[a]));
+    for (int v = 0; v < layer.dims()[a]; ++v) {
+      const double centre = (layer.origin_cells()[a] + v + 0.5) * layer.resolution();
+      const double f = std::floor((centre - b.min[a]) / c[a]);
+      to_cell[a][v] = f >= 0.0 && f < dims[a] ? static_cast<int>(f) : -1;
+    }
+  }
+  const auto cells = static_cast<std::size_t>(dims.prod());
+  std::vector<std::uint32_t> total(cells, 0), grown(cells, 0);
+  const float limit = static_cast<float>(radius / layer.resolution());
+  std::size_t idx = 0;
+  for (int z = 0; z < layer.dims().z(); ++z)
+    for (int y = 0; y < layer.dims().y(); ++y) {
+      const int kz = to_cell[2][z], ky = to_cell[1][y];
+      if (kz < 0 || ky < 0) {
+        idx += static_cast<std::size_t>(layer.dims().x());
+        continue;
+      }
+      const std::size_t row = cell_index(dims, 0, ky, kz);
+      for (int x = 0; x < layer.dims().x(); ++x, ++idx) {
+        const int kx = to_cell[0][x];
+        if (kx < 0) continue;
+        ++total[row + kx];
+        grown[row + kx] += voxels.centre_distance(idx) <= limit;
+      }
+    }
+  const world::Box covered = layer.bounds();
+  for (std::size_t i = 0; i < cells; ++i) {
+    if (grown[i] == 0) continue;
+    const world::Box cell = cell_box(b, dims, cell_coords(dims, i));
+    const bool inside = (cell.min.array() >= covered.min.array()).all() && (cell.max.array() <= covered.max.array()).all();
+    const std::uint8_t level = grown[i] == total[i] && inside ? kSolid : kPartial;
+    e[i] = std::max(e[i], level);
+  }
+}
+
+}  // namespace
+
 std::vector<std::uint8_t> encode_environment(const world::Map& map, const Eigen::Vector3i& dims, double radius) {
   const world::Box& b = map.bounds();
   const Eigen::Vector3d c = cell_size(b, dims);
@@ -110,6 +163,7 @@ std::vector<std::uint8_t> encode_environment(const world::Map& map, const Eigen:
     // cells met by several boxes, none holding them, need the exact cut (box_covered).
     if (inside_one || (local.size() > 1 && box_covered(cell, local))) e[idx] = kSolid;
   }
+  if (map.voxels()) encode_voxels(map, dims, radius, e);
   return e;
 }
 

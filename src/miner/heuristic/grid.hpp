@@ -49,7 +49,10 @@ world::Box cell_box(const world::Box& bounds, const Eigen::Vector3i& dims, const
 /// faces cut the cell into sub-boxes, each of which is inside one box or outside all).
 bool box_covered(const world::Box& cell, const std::vector<world::Box>& boxes);
 
-/// Channel E: kFree / kPartial / kSolid per cell for obstacles grown by `radius`.
+/// Channel E: kFree / kPartial / kSolid per cell for obstacles grown by `radius`. Boxes are cut
+/// exactly; a voxel layer (REQ-WORLD-012) is read from its occupancy in one pass over the voxels
+/// (REQ-HEUR-012): a cell holding a voxel centre within `radius` of a blocked voxel's centre is
+/// partial, solid when all the voxel centres it holds are and the layer covers it.
 std::vector<std::uint8_t> encode_environment(const world::Map& map, const Eigen::Vector3i& dims, double radius);
 
 /// Channel S: the (2 dilation + 1)^3 cubes around the cells of start and goal.

@@ -233,8 +233,17 @@ std::optional<std::size_t> VoxelObstacles::exact_hit(const Eigen::Vector3d& a, c
   return std::nullopt;
 }
 
+std::optional<std::size_t> VoxelObstacles::containing_blocked(const Eigen::Vector3d& p) const {
+  const VoxelLayer& L = *layer_;
+  if (!L.bounds().contains(p)) return std::nullopt;
+  const Eigen::Vector3i c = L.clamped_cell(p);
+  const std::size_t idx = L.index(c.x(), c.y(), c.z());
+  return blocked_[idx] ? std::optional<std::size_t>(idx) : std::nullopt;
+}
+
 std::optional<std::size_t> VoxelObstacles::point_hit(const Eigen::Vector3d& p, double radius) const {
   if (blocked_count_ == 0 || distance_lower_bound(p) > radius) return std::nullopt;
+  if (const auto inside = containing_blocked(p)) return inside;
   return exact_hit(p, p, radius);
 }
 
@@ -244,6 +253,7 @@ std::optional<std::size_t> VoxelObstacles::segment_hit(const Eigen::Vector3d& a,
   const Eigen::Vector3d d = b - a;
   const double len = d.norm();
   if (!(len > 0.0)) return point_hit(a, radius);
+  if (const auto inside = containing_blocked(a)) return inside;
   if (!Box{a.cwiseMin(b).array() - radius, a.cwiseMax(b).array() + radius}.overlaps(layer_->bounds()))
     return std::nullopt;
   const double res = layer_->resolution();

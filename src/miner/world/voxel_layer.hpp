@@ -21,6 +21,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -100,10 +101,16 @@ class VoxelObstacles {
   UnknownPolicy policy() const { return policy_; }
   bool blocked(std::size_t idx) const { return blocked_[idx] != 0; }
   std::size_t blocked_count() const { return blocked_count_; }
+  /// Distance from voxel idx's centre to the nearest blocked voxel's centre, in voxels (0 for
+  /// a blocked voxel, +inf when none is blocked; float-rounded).
+  float centre_distance(std::size_t idx) const {
+    return blocked_count_ == 0 ? std::numeric_limits<float>::infinity() : distance_[idx];
+  }
 
   /// Bound B of the file comment: no blocked cube lies within this distance of p.
   double distance_lower_bound(const Eigen::Vector3d& p) const;
-  /// A blocked voxel within `radius` of p (boundary counts), the lowest index among them.
+  /// A blocked voxel within `radius` of p (boundary counts): the one holding p if it is
+  /// blocked, else the lowest index among them.
   std::optional<std::size_t> point_hit(const Eigen::Vector3d& p, double radius) const;
   /// A blocked voxel within `radius` of some point of [a, b]. The segment is walked by
   /// bound B (sphere tracing); pieces of one voxel's length where B cannot decide are
@@ -125,6 +132,9 @@ class VoxelObstacles {
   /// Distance from each voxel centre to the nearest blocked centre, in voxels (float: exact
   /// to ~6e-8 relative; bound B subtracts that rounding).
   std::vector<float> distance_;
+  /// The blocked voxel whose cube holds p (the clamped cell, so points on a face may name
+  /// either neighbour's), if any.
+  std::optional<std::size_t> containing_blocked(const Eigen::Vector3d& p) const;
   /// Blocked voxels whose cube lies within `radius` of some point of [a, b], voxels of the
   /// box [min(a,b) - radius, max(a,b) + radius]; the lowest index.
   std::optional<std::size_t> exact_hit(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double radius) const;

@@ -1,0 +1,69 @@
+#include <catch2/catch.hpp>
+
+#include <memory>
+
+#include "miner/heuristic/grid.hpp"
+#include "miner/world/map.hpp"
+
+using namespace miner;
+using miner::heuristic::kFree;
+using miner::heuristic::kPartial;
+using miner::heuristic::kSolid;
+
+namespace {
+
+/// 64 x 64 x 32 voxels of 0.25 m: an occupied block of 24 x 24 x 32 voxels (6 x 6 x 8 m) from
+/// voxel (8, 8, 0), an unknown block of 8^3 from (40, 40, 8), free elsewhere.
+world::Map layer_map(world::UnknownPolicy policy) {
+  const Eigen::Vector3i dims(64, 64, 32);
+  std::vector<std::uint8_t> s(static_cast<std::size_t>(dims.prod()), 0);
+  const auto fill = [&](Eigen::Vector3i lo, Eigen::Vector3i size, world::VoxelState state) {
+    for (int z = lo.z(); z < lo.z() + size.z(); ++z)
+      for (int y = lo.y(); y < lo.y() + size.y(); ++y)
+        for (int x = lo.x(); x < lo.x() + size.x(); ++x)
+          s[(static_cast<std::size_t>(z) * dims.y() + y) * dims.x() + x] = static_cast<std::uint8_t>(state);
+  };
+  fill({8, 8, 0}, {24, 24, 32}, world::VoxelState::kOccupied);
+  fill({40, 40, 8}, {8, 8, 8}, world::VoxelState::kUnknown);
+  auto layer = std::make_shared<const world::VoxelLayer>(Eigen::Vector3i::Zero(), 0.25, dims, std::move(s));
+  return world::Map::from_voxels({layer, policy, "", ""});
+}
+
+}  // namespace
+
+TEST_CASE("Channel E of a voxel map comes from its occupancy", "[REQ-HEUR-012]") {
+  const Eigen::Vector3i dims(16, 16, 8);  // 1 m cells: 4^3 voxels each
+  const world::Map map = layer_map(world::UnknownPolicy::kOccupied);
+  const std::vector<std::uint8_t> e = heuristic::encode_environment(map, dims, 0.0);
+  const auto at = [&](int i, int j, int k) { return e[heuristic::cell_index(dims, i, j, k)]; };
+  // Cells wholly inside the occupied block are solid; its faces' cells partial or solid; far
+  // cells free; the unknown block counts as an obstacle under the default policy.
+  CHECK(at(4, 4, 2) == kSolid);
+  CHECK(at(7, 7, 7) == kSolid);
+  CHECK(at(12, 2, 2) == kFree);
+  CHECK(at(10, 10, 2) >= kPartial);
+  CHECK(at(10, 10, 2) == kSolid);  // the unknown block fills cells (10..11, 10..11, 2..3)
+  CHECK(at(8, 4, 2) == kFree);     // x in [8, 9]: the block ends at 8 m
+  // Growing by the robot radius makes the neighbours of the block partial.
+  const std::vector<std::uint8_t> grown = heuristic::encode_environment(map, dims, 0.5);
+  CHECK(grown[heuristic::cell_index(dims, 8, 4, 2)] == kPartial);
+  CHECK(grown[heuristic::cell_index(dims, 12, 2, 2)] == kFree);
+  // Unknown space read as free leaves its cells free.
+  const std::vector<std::uint8_t> open =
+      heuristic::encode_environment(layer_map(world::UnknownPolicy::kFree), dims, 0.0);
+  CHECK(open[heuristic::cell_index(dims, 10, 10, 2)] == kFree);
+  CHECK(open[heuristic::cell_index(dims, 4, 4, 2)] == kSolid);
+  // Every cell holding a blocked voxel is at least partial, and no cell without one is.
+  std::size_t wrong = 0;
+  const world::VoxelObstacles& v = *map.voxels();
+  std::vector<std::uint8_t> holds(e.size(), 0);
+  for (std::size_t i = 0; i < v.layer().size(); ++i) {
+    if (!v.blocked(i)) continue;
+    const Eigen::Vector3d c = v.layer().cell_center(v.layer().coords(i));
+    holds[heuristic::cell_index(dims, heuristic::cell_of(map.bounds(), dims, c).x(),
+                                heuristic::cell_of(map.bounds(), dims, c).y(),
+                                heuristic::cell_of(map.bounds(), dims, c).z())] = 1;
+  }
+  for (std::size_t i = 0; i < e.size(); ++i) wrong += (e[i] != kFree) != (holds[i] != 0);
+  CHECK(wrong == 0);
+}

@@ -16,6 +16,7 @@
 #include "miner/world/map.hpp"
 #include "miner/world/map_generator.hpp"
 #include "miner/world/octree_io.hpp"
+#include "miner/world/point_cloud.hpp"
 #include "miner/world/scan.hpp"
 #include "miner/world/voxel_grid.hpp"
 
@@ -205,6 +206,39 @@ void run_scan(const ScanCliOptions& o, std::ostream& out) {
   if (!o.map_out.empty()) out << "wrote " << o.map_out << " (references " << o.out << ", with the query)\n";
 }
 
+struct ImportOptions {
+  std::vector<std::string> clouds;
+  std::vector<double> origin;
+  double resolution = 0.05;
+  double range = 0.0;
+  std::string out;
+};
+
+void run_import(const ImportOptions& o, std::ostream& out) {
+  if (o.out.size() < 3 || o.out.compare(o.out.size() - 3, 3, ".bt") != 0)
+    throw Error("--out: " + o.out + " must end in .bt (the map is an OctoMap binary tree)");
+  std::vector<world::CloudScan> scans;
+  std::size_t points = 0, skipped = 0;
+  for (const std::string& path : o.clouds) {
+    world::PointCloud cloud = world::read_point_cloud(path);
+    Eigen::Vector3d origin;
+    if (!o.origin.empty()) origin = Eigen::Vector3d(o.origin[0], o.origin[1], o.origin[2]);
+    else if (cloud.viewpoint) origin = *cloud.viewpoint;
+    else throw Error(path + ": no sensor origin (a PLY file has none): give --origin x y z, the sensor position the rays start from");
+    points += cloud.points.size();
+    skipped += cloud.skipped;
+    scans.push_back({std::move(cloud), origin});
+  }
+  const auto layer = world::integrate_clouds(scans, o.resolution, o.range);
+  world::write_octree_bt(*layer, o.out);
+  out << "imported " << points << " points from " << o.clouds.size() << " cloud(s)";
+  if (skipped) out << " (" << skipped << " non-finite points skipped)";
+  out << "\nwrote " << o.out << ": " << layer->dims().x() << " x " << layer->dims().y() << " x " << layer->dims().z()
+      << " voxels of " << layer->resolution() << " m, " << layer->count(world::VoxelState::kFree) << " free, "
+      << layer->count(world::VoxelState::kOccupied) << " occupied, " << layer->count(world::VoxelState::kUnknown)
+      << " unknown\n";
+}
+
 }  // namespace
 
 void add_map_commands(CLI::App& app, std::ostream& out) {
@@ -264,6 +298,18 @@ void add_map_commands(CLI::App& app, std::ostream& out) {
   sc->add_option("--map-out", scan->map_out, "also a map file (.json) referencing the scan, with the query")
       ->check(kOutputFile);
   sc->callback([scan, &out] { run_scan(*scan, out); });
+
+  auto import = std::make_shared<ImportOptions>();
+  CLI::App* im = map->add_subcommand(
+      "import", "point clouds (.ply, .pcd) to a voxel map: OctoMap traces each point's ray from the sensor (free) to the point (occupied)");
+  im->add_option("--cloud", import->clouds, "point cloud file (.ply or .pcd); repeat for several scans")->required();
+  im->add_option("--origin", import->origin, "sensor position x y z in m (default: each PCD file's VIEWPOINT)")
+      ->expected(3)->check(kFinite);
+  im->add_option("--resolution", import->resolution, "voxel size in m")->capture_default_str()->check(kPositive);
+  im->add_option("--range", import->range, "longest ray in m; farther points only free the ray up to it (default: no limit)")
+      ->check(kPositive);
+  im->add_option("--out", import->out, "the map as an OctoMap binary tree (.bt)")->required()->check(kOutputFile);
+  im->callback([import, &out] { run_import(*import, out); });
 
   auto astar = std::make_shared<AstarOptions>();
   CLI::App* a = app.add_subcommand("astar", "shortest 26-connected grid path (A*) between two points");

@@ -8,7 +8,7 @@
 
 #include "miner/core/error.hpp"
 #include "miner/core/rng.hpp"
-#include "miner/world/octree_io.hpp"
+#include "miner/world/octree_leaves.hpp"
 
 namespace miner::world {
 
@@ -168,15 +168,7 @@ ScanResult scan_map(const Map& map, const std::vector<Eigen::Vector3d>& path, co
     for (const auto& key : swept) tree.setNodeValue(key, tree.getClampingThresMinLog(), true);
   }
   tree.updateInnerOccupancy();
-  // The leaves by key and depth (exact: no float coordinates), classified as OctoMap's
-  // maximum-likelihood tree would be; MINER's writer then gives the bytes writeBinary would.
-  std::vector<OctreeLeaf> leaves;
-  for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
-    const octomap::OcTreeKey corner = it.getIndexKey();
-    leaves.push_back({{corner[0], corner[1], corner[2]}, static_cast<std::uint8_t>(it.getDepth()),
-                      tree.isNodeOccupied(*it) ? VoxelState::kOccupied : VoxelState::kFree});
-  }
-  result.layer = layer_from_leaves(leaves, res, "scan");
+  result.layer = layer_of_tree(tree, "scan");
   result.bt = octree_bt_bytes(*result.layer);
   result.poses = poses.size();
   return result;

@@ -1,0 +1,338 @@
+#include "miner/world/point_cloud.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <sstream>
+
+#include <octomap/OcTree.h>
+
+#include "miner/core/error.hpp"
+#include "miner/core/json_io.hpp"
+#include "miner/world/octree_leaves.hpp"
+
+namespace miner::world {
+
+namespace {
+
+[[noreturn]] void fail(const std::string& origin, const std::string& what) { throw Error(origin + ": " + what); }
+
+/// Header lines up to and including `last` (e.g. "end_header", "DATA ..."); returns the offset
+/// of the first data byte.
+struct Lines {
+  const std::string& bytes;
+  const std::string& origin;
+  std::size_t pos = 0;
+  std::string next() {
+    constexpr std::size_t kMaxHeaderLine = 4096;
+    if (pos >= bytes.size()) fail(origin, "the header ends before its last line");
+    const std::size_t end = bytes.find('\n', pos);
+    const std::size_t stop = end == std::string::npos ? bytes.size() : end;
+    if (stop - pos > kMaxHeaderLine) fail(origin, "a header line is longer than 4096 bytes");
+    std::string line = bytes.substr(pos, stop - pos);
+    pos = end == std::string::npos ? bytes.size() : end + 1;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    return line;
+  }
+};
+
+std::vector<std::string> words(const std::string& line) {
+  std::istringstream in(line);
+  std::vector<std::string> w;
+  for (std::string s; in >> s;) w.push_back(s);
+  return w;
+}
+
+std::size_t count_of(const std::string& text, const std::string& what, const std::string& origin) {
+  if (text.empty() || text.size() > 12 || text.find_first_not_of("0123456789") != std::string::npos)
+    fail(origin, what + " \"" + text + "\" is not a count");
+  const std::size_t n = std::stoull(text);
+  if (n > kMaxCloudPoints) {
+    std::ostringstream os;
+    os << what << " " << n << " exceeds the " << kMaxCloudPoints << " points a cloud may hold";
+    fail(origin, os.str());
+  }
+  return n;
+}
+
+/// One scalar field of a binary record: byte offset, size, kind ('f' float, 'i' signed, 'u' unsigned).
+struct Field {
+  std::string name;
+  std::size_t offset = 0;
+  std::size_t size = 0;
+  char kind = 'f';
+};
+
+double read_scalar(const char* p, const Field& f, bool swap) {
+  unsigned char b[8];
+  std::memcpy(b, p, f.size);
+  if (swap) std::reverse(b, b + f.size);
+  switch (f.kind) {
+    case 'f':
+      if (f.size == 4) {
+        float v;
+        std::memcpy(&v, b, 4);
+        return v;
+      } else {
+        double v;
+        std::memcpy(&v, b, 8);
+        return v;
+      }
+    case 'i': {
+      std::int64_t v = 0;
+      if (f.size == 1) { std::int8_t t; std::memcpy(&t, b, 1); v = t; }
+      if (f.size == 2) { std::int16_t t; std::memcpy(&t, b, 2); v = t; }
+      if (f.size == 4) { std::int32_t t; std::memcpy(&t, b, 4); v = t; }
+      return static_cast<double>(v);
+    }
+    default: {
+      std::uint64_t v = 0;
+      if (f.size == 1) { std::uint8_t t; std::memcpy(&t, b, 1); v = t; }
+      if (f.size == 2) { std::uint16_t t; std::memcpy(&t, b, 2); v = t; }
+      if (f.size == 4) { std::uint32_t t; std::memcpy(&t, b, 4); v = t; }
+      return static_cast<double>(v);
+    }
+  }
+}
+
+double parse_number(const std::string& token, const std::string& origin, std::size_t point) {
+  char* end = nullptr;
+  const double v = std::strtod(token.c_str(), &end);
+  if (end == token.c_str() || *end != '\0') {
+    std::ostringstream os;
+    os << "point " << point << ": \"" << token << "\" is not a number";
+    fail(origin, os.str());
+  }
+  return v;
+}
+
+void add_point(PointCloud& cloud, const Eigen::Vector3d& p) {
+  if (p.allFinite()) cloud.points.push_back(p);
+  else ++cloud.skipped;
+}
+
+/// Reads `n` records of `fields` (x, y, z at xyz[0..2]) from ASCII lines or binary bytes.
+void read_records(PointCloud& cloud, const std::string& bytes, std::size_t pos, std::size_t n,
+                  const std::vector<Field>& fields, const std::array<int, 3>& xyz, bool ascii, bool swap,
+                  std::size_t stride, const std::string& origin) {
+  if (ascii) {
+    std::size_t line_start = pos;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (line_start >= bytes.size()) {
+        std::ostringstream os;
+        os << "data ends after " << i << " of " << n << " points";
+        fail(origin, os.str());
+      }
+      std::size_t end = bytes.find('\n', line_start);
+      if (end == std::string::npos) end = bytes.size();
+      const std::vector<std::string> w = words(bytes.substr(line_start, end - line_start));
+      line_start = end + 1;
+      if (w.empty()) {
+        --i;
+        continue;
+      }
+      if (w.size() < fields.size()) {
+        std::ostringstream os;
+        os << "point " << i << " has " << w.size() << " values, the header declares " << fields.size();
+        fail(origin, os.str());
+      }
+      add_point(cloud, {parse_number(w[xyz[0]], origin, i), parse_number(w[xyz[1]], origin, i),
+                        parse_number(w[xyz[2]], origin, i)});
+    }
+    return;
+  }
+  if ((bytes.size() - pos) / stride < n) {
+    std::ostringstream os;
+    os << "the header declares " << n << " points of " << stride << " bytes, but only " << bytes.size() - pos
+       << " data bytes follow";
+    fail(origin, os.str());
+  }
+  cloud.points.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const char* rec = bytes.data() + pos + i * stride;
+    add_point(cloud, {read_scalar(rec + fields[xyz[0]].offset, fields[xyz[0]], swap),
+                      read_scalar(rec + fields[xyz[1]].offset, fields[xyz[1]], swap),
+                      read_scalar(rec + fields[xyz[2]].offset, fields[xyz[2]], swap)});
+  }
+}
+
+std::array<int, 3> find_xyz(const std::vector<Field>& fields, const std::string& origin) {
+  std::array<int, 3> xyz{-1, -1, -1};
+  for (std::size_t i = 0; i < fields.size(); ++i)
+    for (int a = 0; a < 3; ++a)
+      if (fields[i].name == std::string(1, "xyz"[a])) xyz[a] = static_cast<int>(i);
+  for (int a = 0; a < 3; ++a)
+    if (xyz[a] < 0) fail(origin, std::string("the points have no \"") + "xyz"[a] + "\" field");
+  for (int a = 0; a < 3; ++a)
+    if (fields[xyz[a]].kind != 'f')
+      fail(origin, std::string("field \"") + "xyz"[a] + "\" is not a float or double");
+  return xyz;
+}
+
+PointCloud parse_ply(const std::string& bytes, const std::string& origin) {
+  Lines lines{bytes, origin};
+  if (lines.next() != "ply") fail(origin, "not a PLY file (the first line is not \"ply\")");
+  std::string format;
+  std::size_t vertices = 0;
+  bool in_vertex = false, seen_element = false;
+  std::vector<Field> fields;
+  std::size_t stride = 0;
+  while (true) {
+    const std::vector<std::string> w = words(lines.next());
+    if (w.empty() || w[0] == "comment" || w[0] == "obj_info") continue;
+    if (w[0] == "end_header") break;
+    if (w[0] == "format") {
+      if (w.size() != 3) fail(origin, "malformed format line");
+      format = w[1];
+      if (format != "ascii" && format != "binary_little_endian" && format != "binary_big_endian")
+        fail(origin, "unknown PLY format \"" + format + "\"");
+    } else if (w[0] == "element") {
+      if (w.size() != 3) fail(origin, "malformed element line");
+      if (!seen_element && w[1] != "vertex") fail(origin, "the first element is \"" + w[1] + "\", not \"vertex\"");
+      in_vertex = !seen_element;
+      if (in_vertex) vertices = count_of(w[2], "element vertex", origin);
+      seen_element = true;
+    } else if (w[0] == "property") {
+      if (!in_vertex) continue;  // properties of later elements are never read
+      if (w.size() != 3) fail(origin, "vertex property \"" + (w.size() > 1 ? w[1] : std::string()) +
+                                          "\": list properties are not supported in the vertex element");
+      static const std::vector<std::pair<std::vector<std::string>, std::pair<std::size_t, char>>> kTypes = {
+          {{"char", "int8"}, {1, 'i'}},    {{"uchar", "uint8"}, {1, 'u'}},  {{"short", "int16"}, {2, 'i'}},
+          {{"ushort", "uint16"}, {2, 'u'}}, {{"int", "int32"}, {4, 'i'}},   {{"uint", "uint32"}, {4, 'u'}},
+          {{"float", "float32"}, {4, 'f'}}, {{"double", "float64"}, {8, 'f'}}};
+      Field f;
+      f.name = w[2];
+      for (const auto& [names, type] : kTypes)
+        if (std::find(names.begin(), names.end(), w[1]) != names.end()) std::tie(f.size, f.kind) = type;
+      if (f.size == 0) fail(origin, "vertex property \"" + w[2] + "\" has unknown type \"" + w[1] + "\"");
+      f.offset = stride;
+      stride += f.size;
+      fields.push_back(f);
+    } else {
+      fail(origin, "unknown header line \"" + w[0] + "\"");
+    }
+  }
+  if (format.empty()) fail(origin, "the header has no format line");
+  if (!seen_element) fail(origin, "the header declares no vertex element");
+  const std::array<int, 3> xyz = find_xyz(fields, origin);
+  PointCloud cloud;
+  read_records(cloud, bytes, lines.pos, vertices, fields, xyz, format == "ascii", format == "binary_big_endian",
+               stride, origin);
+  return cloud;
+}
+
+PointCloud parse_pcd(const std::string& bytes, const std::string& origin) {
+  Lines lines{bytes, origin};
+  std::vector<std::string> names, sizes, types, counts;
+  std::size_t points = 0, width = 0, height = 1;
+  bool have_points = false;
+  std::optional<Eigen::Vector3d> viewpoint;
+  std::string data;
+  while (true) {
+    const std::string line = lines.next();
+    const std::vector<std::string> w = words(line);
+    if (w.empty() || w[0][0] == '#') continue;
+    const std::vector<std::string> rest(w.begin() + 1, w.end());
+    if (w[0] == "VERSION") continue;
+    if (w[0] == "FIELDS") names = rest;
+    else if (w[0] == "SIZE") sizes = rest;
+    else if (w[0] == "TYPE") types = rest;
+    else if (w[0] == "COUNT") counts = rest;
+    else if (w[0] == "WIDTH" && rest.size() == 1) width = count_of(rest[0], "WIDTH", origin);
+    else if (w[0] == "HEIGHT" && rest.size() == 1) height = count_of(rest[0], "HEIGHT", origin);
+    else if (w[0] == "POINTS" && rest.size() == 1) {
+      points = count_of(rest[0], "POINTS", origin);
+      have_points = true;
+    } else if (w[0] == "VIEWPOINT" && rest.size() == 7) {
+      Eigen::Vector3d t;
+      for (int a = 0; a < 3; ++a) t[a] = parse_number(rest[a], origin + ": VIEWPOINT", 0);
+      if (!t.allFinite()) fail(origin, "VIEWPOINT is not finite");
+      viewpoint = t;
+    } else if (w[0] == "DATA" && rest.size() == 1) {
+      data = rest[0];
+      break;
+    } else {
+      fail(origin, "unknown or malformed header line \"" + line + "\"");
+    }
+  }
+  if (names.empty()) fail(origin, "the header has no FIELDS line");
+  if (sizes.size() != names.size() || types.size() != names.size() || (!counts.empty() && counts.size() != names.size()))
+    fail(origin, "FIELDS, SIZE, TYPE and COUNT list different numbers of fields");
+  if (!have_points) points = width * height;
+  if (data == "binary_compressed") fail(origin, "DATA binary_compressed is not supported (save the cloud as ascii or binary)");
+  if (data != "ascii" && data != "binary") fail(origin, "unknown DATA \"" + data + "\"");
+  std::vector<Field> fields;
+  std::size_t stride = 0;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    Field f;
+    f.name = names[i];
+    if (sizes[i] != "1" && sizes[i] != "2" && sizes[i] != "4" && sizes[i] != "8")
+      fail(origin, "field \"" + f.name + "\" has SIZE \"" + sizes[i] + "\"");
+    f.size = std::stoul(sizes[i]);
+    if (types[i] != "F" && types[i] != "I" && types[i] != "U")
+      fail(origin, "field \"" + f.name + "\" has TYPE \"" + types[i] + "\"");
+    f.kind = types[i] == "F" ? 'f' : types[i] == "I" ? 'i' : 'u';
+    if ((f.kind == 'f' && f.size != 4 && f.size != 8) || (f.kind != 'f' && f.size == 8))
+      fail(origin, "field \"" + f.name + "\": TYPE " + types[i] + " with SIZE " + sizes[i] + " is not supported");
+    const std::size_t count = counts.empty() ? 1 : count_of(counts[i], "COUNT", origin);
+    if (count == 0 || count > 4096) fail(origin, "field \"" + f.name + "\" has COUNT " + std::to_string(count));
+    if (count != 1 && (f.name == "x" || f.name == "y" || f.name == "z"))
+      fail(origin, "field \"" + f.name + "\" must have COUNT 1");
+    f.offset = stride;
+    stride += f.size * count;
+    fields.push_back(f);
+    // ASCII data lists COUNT values per field: stand-ins keep the token positions.
+    for (std::size_t c = 1; c < count && data == "ascii"; ++c) fields.push_back({f.name + "#", 0, f.size, f.kind});
+  }
+  const std::array<int, 3> xyz = find_xyz(fields, origin);
+  PointCloud cloud;
+  cloud.viewpoint = viewpoint;
+  read_records(cloud, bytes, lines.pos, points, fields, xyz, data == "ascii", false, stride, origin);
+  return cloud;
+}
+
+}  // namespace
+
+PointCloud parse_point_cloud(const std::string& bytes, bool ply, const std::string& origin) {
+  return ply ? parse_ply(bytes, origin) : parse_pcd(bytes, origin);
+}
+
+PointCloud read_point_cloud(const std::string& path) {
+  const auto ends_with = [&](const char* s) {
+    const std::size_t n = std::strlen(s);
+    return path.size() >= n && path.compare(path.size() - n, n, s) == 0;
+  };
+  if (!ends_with(".ply") && !ends_with(".pcd")) throw Error(path + ": a point cloud must be a .ply or .pcd file");
+  return parse_point_cloud(read_file_bytes(path, "point cloud"), ends_with(".ply"), path);
+}
+
+std::shared_ptr<const VoxelLayer> integrate_clouds(const std::vector<CloudScan>& scans, double resolution,
+                                                   double max_range) {
+  if (!std::isfinite(resolution) || !(resolution > 0.0)) throw Error("resolution: must be positive and finite");
+  octomap::OcTree tree(resolution);
+  const double reach = 32767.0 * resolution;
+  const auto point = [](const Eigen::Vector3d& p) {
+    return octomap::point3d(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()));
+  };
+  for (std::size_t s = 0; s < scans.size(); ++s) {
+    const CloudScan& scan = scans[s];
+    const auto beyond = [&](const Eigen::Vector3d& p) { return !(p.cwiseAbs().maxCoeff() < reach); };
+    if (beyond(scan.origin)) throw Error("cloud " + std::to_string(s) + ": the sensor origin " + format_point(scan.origin) +
+                                         " lies beyond OctoMap's key range at this resolution");
+    octomap::Pointcloud cloud;
+    cloud.reserve(scan.cloud.points.size());
+    for (std::size_t i = 0; i < scan.cloud.points.size(); ++i) {
+      const Eigen::Vector3d& p = scan.cloud.points[i];
+      if (beyond(p))
+        throw Error("cloud " + std::to_string(s) + ": point " + std::to_string(i) + " " + format_point(p) +
+                    " lies beyond OctoMap's key range at this resolution (32767 voxels from the origin)");
+      cloud.push_back(point(p));
+    }
+    tree.insertPointCloud(cloud, point(scan.origin), max_range > 0.0 ? max_range : -1.0);
+  }
+  tree.updateInnerOccupancy();
+  return layer_of_tree(tree, "point clouds");
+}
+
+}  // namespace miner::world

@@ -1,0 +1,172 @@
+#include <catch2/catch.hpp>
+
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "miner/core/error.hpp"
+#include "miner/core/rng.hpp"
+#include "miner/world/point_cloud.hpp"
+#include "test_maps.hpp"
+
+using namespace miner::world;
+using Catch::Matchers::Contains;
+using V = Eigen::Vector3d;
+
+namespace {
+
+/// Returns from a wall x = 3 m (y in [-1, 1], z in [0, 1]) seen from (0, 0, 0.5).
+std::vector<V> wall_points() {
+  std::vector<V> p;
+  for (int j = 0; j <= 40; ++j)
+    for (int k = 0; k <= 20; ++k) p.emplace_back(3.0, -1.0 + 0.05 * j, 0.05 * k);
+  return p;
+}
+
+template <typename T>
+void put(std::string& s, T v, bool big_endian) {
+  char b[sizeof(T)];
+  std::memcpy(b, &v, sizeof(T));
+  if (big_endian) std::reverse(b, b + sizeof(T));
+  s.append(b, sizeof(T));
+}
+
+std::string ply(const std::vector<V>& pts, const std::string& format) {
+  std::ostringstream h;
+  h << "ply\nformat " << format << " 1.0\ncomment made by a test\nelement vertex " << pts.size()
+    << "\nproperty float x\nproperty float y\nproperty float z\nproperty uchar intensity\nelement face 0\n"
+       "property list uchar int vertex_indices\nend_header\n";
+  std::string s = h.str();
+  for (const V& p : pts) {
+    if (format == "ascii") {
+      std::ostringstream l;
+      l << p.x() << " " << p.y() << " " << p.z() << " 7\n";
+      s += l.str();
+    } else {
+      const bool be = format == "binary_big_endian";
+      for (int a = 0; a < 3; ++a) put(s, static_cast<float>(p[a]), be);
+      s.push_back('\x07');
+    }
+  }
+  return s;
+}
+
+std::string pcd(const std::vector<V>& pts, bool binary) {
+  std::ostringstream h;
+  h << "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 8 4\nTYPE F F F U\n"
+       "COUNT 1 1 1 1\nWIDTH " << pts.size() << "\nHEIGHT 1\nVIEWPOINT 0 0 0.5 1 0 0 0\nPOINTS " << pts.size()
+    << "\nDATA " << (binary ? "binary" : "ascii") << "\n";
+  std::string s = h.str();
+  for (const V& p : pts) {
+    if (binary) {
+      put(s, static_cast<float>(p.x()), false);
+      put(s, static_cast<float>(p.y()), false);
+      put(s, p.z(), false);
+      put(s, std::uint32_t{0xffffff}, false);
+    } else {
+      std::ostringstream l;
+      l << p.x() << " " << p.y() << " " << p.z() << " 16777215\n";
+      s += l.str();
+    }
+  }
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("PLY and PCD clouds, ASCII and binary, read the same points", "[REQ-WORLD-018]") {
+  const std::vector<V> pts = wall_points();
+  const std::vector<std::pair<std::string, PointCloud>> clouds = {
+      {"ply ascii", parse_point_cloud(ply(pts, "ascii"), true, "a.ply")},
+      {"ply little", parse_point_cloud(ply(pts, "binary_little_endian"), true, "b.ply")},
+      {"ply big", parse_point_cloud(ply(pts, "binary_big_endian"), true, "c.ply")},
+      {"pcd ascii", parse_point_cloud(pcd(pts, false), false, "d.pcd")},
+      {"pcd binary", parse_point_cloud(pcd(pts, true), false, "e.pcd")}};
+  for (const auto& [name, cloud] : clouds) {
+    INFO(name);
+    REQUIRE(cloud.points.size() == pts.size());
+    double worst = 0.0;
+    for (std::size_t i = 0; i < pts.size(); ++i) worst = std::max(worst, (cloud.points[i] - pts[i]).norm());
+    CHECK(worst < 1e-6);  // float storage
+  }
+  CHECK(clouds[3].second.viewpoint == V(0, 0, 0.5));
+  CHECK_FALSE(clouds[0].second.viewpoint.has_value());
+}
+
+TEST_CASE("A cloud becomes free space along its rays, occupied at its points, unknown behind", "[REQ-WORLD-018]") {
+  PointCloud cloud;
+  cloud.points = wall_points();
+  const auto layer = integrate_clouds({{cloud, V(0, 0, 0.5)}}, 0.1, 0.0);
+  const auto state = [&](const V& p) {
+    const Eigen::Vector3i c = layer->clamped_cell(p);
+    return layer->bounds().contains(p) ? layer->state(layer->index(c.x(), c.y(), c.z())) : VoxelState::kUnknown;
+  };
+  CHECK(state(V(3.02, 0.01, 0.51)) == VoxelState::kOccupied);
+  CHECK(state(V(1.51, 0.01, 0.51)) == VoxelState::kFree);
+  CHECK(state(V(0.05, 0.05, 0.55)) == VoxelState::kFree);
+  CHECK(state(V(1.5, 0.95, 0.05)) == VoxelState::kUnknown);  // off every ray
+  CHECK(state(V(3.5, 0.0, 0.5)) == VoxelState::kUnknown);    // behind the wall
+  // A range limit keeps the far points' rays free up to it and drops their hits.
+  const auto short_range = integrate_clouds({{cloud, V(0, 0, 0.5)}}, 0.1, 2.0);
+  CHECK(short_range->count(VoxelState::kOccupied) == 0);
+  CHECK(short_range->count(VoxelState::kFree) > 0);
+}
+
+TEST_CASE("Non-finite points are skipped and counted", "[REQ-WORLD-018]") {
+  const std::string text = "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 3\nHEIGHT 1\nPOINTS 3\nDATA ascii\n"
+                           "1 2 3\nnan nan nan\n4 5 6\n";
+  const PointCloud c = parse_point_cloud(text, false, "nan.pcd");
+  CHECK(c.points.size() == 2);
+  CHECK(c.skipped == 1);
+}
+
+TEST_CASE("Malformed point clouds are refused naming the fault, never crash", "[REQ-WORLD-018][REQ-WORLD-014]") {
+  const auto refuses = [](const std::string& bytes, bool is_ply, const std::string& message) {
+    INFO(message);
+    CHECK_THROWS_WITH(parse_point_cloud(bytes, is_ply, "bad"), Contains("bad: ") && Contains(message));
+  };
+  const std::string good_ply = ply(wall_points(), "binary_little_endian");
+  refuses("plx\n", true, "not a PLY file");
+  refuses("ply\nformat ascii 1.0\n", true, "the header ends before its last line");
+  refuses("ply\nformat binary_middle_endian 1.0\nend_header\n", true, "unknown PLY format");
+  refuses("ply\nformat ascii 1.0\nelement face 1\nend_header\n", true, "the first element is \"face\"");
+  refuses("ply\nformat ascii 1.0\nelement vertex 1\nproperty list uchar int x\nend_header\n", true, "list properties");
+  refuses("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nend_header\n0 0\n", true,
+          "no \"z\" field");
+  refuses("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty quad z\nend_header\n",
+          true, "unknown type \"quad\"");
+  refuses("ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\nend_header\n1 2 3\n",
+          true, "data ends after 1 of 2 points");
+  refuses("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n1 2 x\n",
+          true, "\"x\" is not a number");
+  refuses("ply\nformat binary_little_endian 1.0\nelement vertex 99999999\nproperty float x\nproperty float y\n"
+          "property float z\nend_header\nabc",
+          true, "only 3 data bytes follow");
+  refuses("ply\nformat ascii 1.0\nelement vertex 999999999999\nend_header\n", true, "exceeds the");
+  refuses("VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 1\nDATA binary_compressed\n", false,
+          "binary_compressed is not supported");
+  refuses("VERSION 0.7\nFIELDS x y z\nSIZE 4 4\nTYPE F F F\nPOINTS 1\nDATA ascii\n", false, "different numbers of fields");
+  refuses("VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 1\nSHAPE round\nDATA ascii\n", false,
+          "unknown or malformed header line \"SHAPE round\"");
+  refuses("VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F I F\nPOINTS 1\nDATA ascii\n1 2 3\n", false,
+          "field \"y\" is not a float");
+  PointCloud far;
+  far.points = {V(1e9, 0, 0)};
+  CHECK_THROWS_WITH(integrate_clouds({{far, V(0, 0, 0)}}, 0.05, 0.0), Contains("beyond OctoMap's key range"));
+  // Random corruption of a valid file: read or refused, nothing else.
+  miner::Rng rng(3);
+  int refused = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    std::string bytes = good_ply;
+    for (int f = 0; f < 3; ++f)
+      bytes[rng.uniform_index(std::min<std::size_t>(bytes.size(), 400))] = static_cast<char>(rng.uniform_index(256));
+    if (rng.uniform01() < 0.3) bytes.resize(rng.uniform_index(bytes.size()));
+    try {
+      (void)parse_point_cloud(bytes, true, "mutated.ply");
+    } catch (const miner::Error& e) {
+      ++refused;
+      CHECK_THAT(e.what(), Contains("mutated.ply"));
+    }
+  }
+  CHECK(refused > 0);
+}

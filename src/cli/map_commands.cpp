@@ -92,6 +92,12 @@ void run_info(const InfoOptions& o, std::ostream& out) {
       h << "  " << std::left << std::setw(10) << name << std::right << n << " voxels, " << static_cast<double>(n) * cell
         << " m^3\n";
     }
+    const double known = static_cast<double>(layer.size() - layer.count(world::VoxelState::kUnknown));
+    h << "occupancy:   " << std::fixed << std::setprecision(2)
+      << 100.0 * static_cast<double>(layer.count(world::VoxelState::kOccupied)) / static_cast<double>(layer.size())
+      << " % of the voxels occupied (" << (known > 0 ? 100.0 * static_cast<double>(layer.count(world::VoxelState::kOccupied)) / known : 0.0)
+      << " % of the known ones), " << 100.0 * static_cast<double>(layer.count(world::VoxelState::kUnknown)) / static_cast<double>(layer.size())
+      << " % unknown" << std::defaultfloat << "\n";
     h << "unknown:     treated as " << world::to_string(v->policy())
       << (v->policy() == world::UnknownPolicy::kOccupied ? " (the safe default; --unknown free to fly through it)"
                                                          : " (on request)")
@@ -100,12 +106,17 @@ void run_info(const InfoOptions& o, std::ostream& out) {
                      {"sha256", map.voxel_source()->sha256},
                      {"dims", {layer.dims().x(), layer.dims().y(), layer.dims().z()}},
                      {"counts", counts},
+                     {"occupied_fraction", static_cast<double>(layer.count(world::VoxelState::kOccupied)) / static_cast<double>(layer.size())},
                      {"unknown_policy", world::to_string(v->policy())}};
   }
   h
     << "grid:        " << grid.dims().x() << " x " << grid.dims().y() << " x " << grid.dims().z()
     << " = " << grid.cell_count() << " cells, " << std::fixed << std::setprecision(1)
-    << 100.0 * occupied << " % occupied for robot radius " << std::defaultfloat << radius << " m\n";
+    << 100.0 * occupied << (map.voxels() ? " % blocked (occupied" +
+                                               std::string(map.voxels()->policy() == world::UnknownPolicy::kOccupied ? " or unknown" : "") +
+                                               ", grown by the radius)"
+                                         : std::string(" % occupied"))
+    << " for robot radius " << std::defaultfloat << radius << " m\n";
   if (map.query()) {
     h << "query:       start " << format_point(map.query()->start) << ", goal "
       << format_point(map.query()->goal) << ", robot radius " << map.query()->robot_radius << " m\n";

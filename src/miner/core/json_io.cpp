@@ -14,6 +14,10 @@
 namespace miner {
 
 std::string read_file_bytes(const std::string& path, const std::string& what) {
+  // A device or a pipe (/dev/zero, a FIFO) would be read without end: only regular files.
+  std::error_code ec;
+  if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
+    throw Error(path + ": cannot open " + what + ": not a regular file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path + ": cannot open " + what);
   std::ostringstream ss;
@@ -24,6 +28,26 @@ std::string read_file_bytes(const std::string& path, const std::string& what) {
 Json read_json_file(const std::string& path) { return parse_json(read_file_bytes(path), path); }
 
 Json parse_json(const std::string& text, const std::string& origin) {
+  // Nesting deeper than any MINER document needs is refused before parsing: the JSON library
+  // frees and prints nested values recursively, so 10^6 brackets would overflow the stack.
+  constexpr int kMaxJsonDepth = 256;
+  int depth = 0;
+  bool in_string = false;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (in_string) {
+      if (c == '\\') ++i;
+      else if (c == '"') in_string = false;
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > kMaxJsonDepth)
+        throw Error(origin + ": JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels at byte " +
+                    std::to_string(i));
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
   try {
     return Json::parse(text);
   } catch (const Json::parse_error& e) {

@@ -182,6 +182,15 @@ Json self_contained_scenario(Json doc, const std::string& base_dir) {
   if (doc.contains("map") && doc["map"].is_string()) {
     const std::string map = resolve(base_dir, doc["map"].get<std::string>());
     doc["map"] = std::filesystem::path(map).extension() == ".json" ? read_json_file(map) : Json(absolute(map));
+    // An inlined map's voxel file is relative to the map's folder, not the scenario's.
+    Json& m = doc["map"];
+    if (m.is_object() && m.contains("voxels") && m["voxels"].is_object() && m["voxels"].contains("file") &&
+        m["voxels"]["file"].is_string()) {
+      const std::string map_dir = std::filesystem::path(map).parent_path().string();
+      m["voxels"]["file"] = std::filesystem::absolute(resolve(map_dir, m["voxels"]["file"].get<std::string>()))
+                                .lexically_normal()
+                                .string();
+    }
   }
   if (doc.contains("vehicle") && doc["vehicle"].is_string())
     doc["vehicle"] = read_json_file(resolve(base_dir, doc["vehicle"].get<std::string>()));

@@ -147,9 +147,16 @@ void Map::build_index() {
     index_.dims[k] = std::max(1, static_cast<int>(std::ceil(bounds_.extent()[k] / index_.cell)));
   }
   index_.buckets.assign(static_cast<std::size_t>(index_.dims.prod()), {});
+  index_.large.clear();
+  // A box over more buckets than this is listed once (index_.large): the index stays O(n).
+  constexpr long kMaxBucketsPerObstacle = 512;
   for (std::size_t i = 0; i < obstacles_.size(); ++i) {
     Eigen::Vector3i lo, hi;
     index_.span(obstacles_[i], lo, hi);
+    if (static_cast<long>(hi.x() - lo.x() + 1) * (hi.y() - lo.y() + 1) * (hi.z() - lo.z() + 1) > kMaxBucketsPerObstacle) {
+      index_.large.push_back(static_cast<std::uint32_t>(i));
+      continue;
+    }
     for (int z = lo.z(); z <= hi.z(); ++z)
       for (int y = lo.y(); y <= hi.y(); ++y)
         for (int x = lo.x(); x <= hi.x(); ++x) index_.buckets[index_.at(x, y, z)].push_back(static_cast<std::uint32_t>(i));
@@ -180,6 +187,7 @@ std::optional<std::size_t> Map::query_index(const Box& region, double r2, const 
     for (std::size_t i = 0; i < obstacles_.size(); ++i) consider(i);
     return best;
   }
+  for (const std::uint32_t i : index_.large) consider(i);
   for (int z = lo.z(); z <= hi.z(); ++z)
     for (int y = lo.y(); y <= hi.y(); ++y)
       for (int x = lo.x(); x <= hi.x(); ++x)

@@ -145,6 +145,9 @@ class Map {
     double cell = 1.0;
     Eigen::Vector3i dims{1, 1, 1};
     std::vector<std::vector<std::uint32_t>> buckets;
+    /// Obstacles spanning more than kMaxBucketsPerObstacle buckets, checked by every query
+    /// instead (so n huge boxes cost n entries, not n x 32^3).
+    std::vector<std::uint32_t> large;
     /// Bucket coordinates covering `box` along each axis, clamped to the grid (obstacles
     /// and queries outside the bounds land in the border buckets).
     void span(const Box& box, Eigen::Vector3i& lo, Eigen::Vector3i& hi) const;

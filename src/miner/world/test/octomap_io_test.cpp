@@ -35,7 +35,9 @@ void fill_tree(Tree& tree, std::uint64_t seed) {
     for (int y = -10; y < 20; ++y)
       for (int x = -16; x < 24; ++x) {
         if (x > 10 && y > 10 && z > 4) continue;  // never observed: unknown
-        tree.updateNode(tree.coordToKey(octomap::point3d((x + 0.5f) * 0.1f, (y + 0.5f) * 0.1f, (z + 0.5f) * 0.1f)),
+        tree.updateNode(tree.coordToKey(octomap::point3d(static_cast<float>(x + 0.5) * 0.1f,
+                                                         static_cast<float>(y + 0.5) * 0.1f,
+                                                         static_cast<float>(z + 0.5) * 0.1f)),
                         false);
       }
   for (int b = 0; b < 3; ++b) {
@@ -43,8 +45,9 @@ void fill_tree(Tree& tree, std::uint64_t seed) {
     for (int z = 0; z < 8; ++z)
       for (int y = 0; y < 8; ++y)
         for (int x = 0; x < 8; ++x)
-          tree.updateNode(tree.coordToKey(octomap::point3d((bx + x + 0.5f) * 0.1f, (by + y + 0.5f) * 0.1f,
-                                                           (z + 0.5f) * 0.1f)),
+          tree.updateNode(tree.coordToKey(octomap::point3d(static_cast<float>(bx + x + 0.5) * 0.1f,
+                                                           static_cast<float>(by + y + 0.5) * 0.1f,
+                                                           static_cast<float>(z + 0.5) * 0.1f)),
                           true);
   }
   for (int i = 0; i < 60; ++i) {

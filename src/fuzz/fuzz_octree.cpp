@@ -1,0 +1,22 @@
+// libFuzzer target: MINER's OctoMap reader (REQ-WORLD-014). Any bytes either parse or raise
+// miner::Error; what parses writes back as .bt bytes that parse to the same voxels.
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+#include <string>
+
+#include "miner/core/error.hpp"
+#include "miner/world/octree_io.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::string bytes(reinterpret_cast<const char*>(data), size);
+  try {
+    const auto layer = miner::world::parse_octree(bytes, "fuzz");
+    if (layer->count(miner::world::VoxelState::kUnknown) == layer->size()) return 0;
+    const std::string bt = miner::world::octree_bt_bytes(*layer);
+    const auto again = miner::world::parse_octree(bt, "fuzz-again");
+    if (again->states() != layer->states() || again->origin_cells() != layer->origin_cells()) std::abort();
+  } catch (const miner::Error&) {
+  }
+  return 0;
+}

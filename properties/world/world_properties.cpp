@@ -91,6 +91,19 @@ std::vector<Box> all_obstacles(const Map& map) {
   return out;
 }
 
+/// Point, segment and clearance answers of `map` at p, [p, q] with radius r equal a brute force
+/// over `obstacles` (every box and blocked voxel cube).
+void check_queries(const Map& map, const std::vector<Box>& obstacles, const V& p, const V& q, double r) {
+  double dp = std::numeric_limits<double>::infinity(), ds = dp;
+  for (const Box& b : obstacles) {
+    dp = std::min(dp, squared_distance(p, b));
+    ds = std::min(ds, squared_distance(p, q, b));
+  }
+  RC_ASSERT(map.point_collision(p, r).has_value() == (dp <= r * r));
+  RC_ASSERT(map.segment_collision(p, q, r).has_value() == (ds <= r * r));
+  RC_ASSERT(std::fabs(map.clearance(p) - std::sqrt(dp)) <= kDistanceRounding || obstacles.empty());
+}
+
 /// Dijkstra with the same moves and corner rule as astar(), written independently.
 double dijkstra_grid_cost(const VoxelGrid& grid, const Eigen::Vector3i& s, const Eigen::Vector3i& g) {
   std::vector<double> dist(grid.cell_count(), std::numeric_limits<double>::infinity());
@@ -153,15 +166,7 @@ TEST_CASE("Point and segment queries agree with the distance definition", "[REQ-
     const Map map = random_map(rng);
     const double r = rng.uniform(0.0, 1.0);
     const V p = random_point(rng, map.bounds()), q = random_point(rng, map.bounds());
-    const std::vector<Box> obstacles = all_obstacles(map);
-    double dp = std::numeric_limits<double>::infinity(), ds = dp;
-    for (const Box& b : obstacles) {
-      dp = std::min(dp, squared_distance(p, b));
-      ds = std::min(ds, squared_distance(p, q, b));
-    }
-    RC_ASSERT(map.point_collision(p, r).has_value() == (dp <= r * r));
-    RC_ASSERT(map.segment_collision(p, q, r).has_value() == (ds <= r * r));
-    RC_ASSERT(std::fabs(map.clearance(p) - std::sqrt(dp)) <= kDistanceRounding || obstacles.empty());
+    check_queries(map, all_obstacles(map), p, q, r);
   });
 }
 
@@ -178,14 +183,7 @@ TEST_CASE("Voxel queries near the obstacles agree with the cubes' distances", "[
       const Box& near = obstacles[rng.uniform_index(obstacles.size())];
       const double r = rng.uniform(0.0, 1.0);
       const V p = random_point(rng, near.inflated(r + 0.5)), q = p + V(rng.normal(), rng.normal(), rng.normal());
-      double dp = std::numeric_limits<double>::infinity(), ds = dp;
-      for (const Box& b : obstacles) {
-        dp = std::min(dp, squared_distance(p, b));
-        ds = std::min(ds, squared_distance(p, q, b));
-      }
-      RC_ASSERT(map.point_collision(p, r).has_value() == (dp <= r * r));
-      RC_ASSERT(map.segment_collision(p, q, r).has_value() == (ds <= r * r));
-      RC_ASSERT(std::fabs(map.clearance(p) - std::sqrt(dp)) <= kDistanceRounding);
+      check_queries(map, obstacles, p, q, r);
       // First surface along a ray: the smallest entry distance over the cubes.
       const V dir = (q - p).normalized();
       double best = std::numeric_limits<double>::infinity();

@@ -824,7 +824,7 @@ TEST_CASE("The scan fixtures are planned and flown through known space only", "[
 TEST_CASE("miner map scan writes a deterministic OctoMap and a map that references it", "[REQ-WORLD-016][REQ-WORLD-013]") {
   const std::string src = std::string(MINER_SOURCE_DIR) + "/fixtures/maps/indoor-1.json";
   const std::string bt = dir() + "/scan.bt", json = dir() + "/scan.json";
-  const std::vector<std::string> args{"map", "scan", "--map", src, "--rays", "90", "8", "--out", bt, "--map-out", json};
+  const std::vector<std::string> args{"map", "scan", "--map", src, "--rays", "60", "6", "--spacing", "3", "--resolution", "0.2", "--out", bt, "--map-out", json};
   const Run r = miner_cli(args);
   INFO(r.err);
   REQUIRE(r.code == 0);

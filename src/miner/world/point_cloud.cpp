@@ -315,6 +315,21 @@ std::shared_ptr<const VoxelLayer> integrate_clouds(const std::vector<CloudScan>&
   const auto point = [](const Eigen::Vector3d& p) {
     return octomap::point3d(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()));
   };
+  // Each point's ray walks |point - origin| / res voxels (at most max_range / res): bound the
+  // total before OctoMap starts (it integrates ~1e7 voxels per second).
+  constexpr double kMaxRaySteps = 2e9;
+  double steps = 0.0;
+  for (const CloudScan& scan : scans)
+    for (const Eigen::Vector3d& p : scan.cloud.points) {
+      const double length = (p - scan.origin).norm();
+      steps += (max_range > 0.0 ? std::min(length, max_range) : length) / resolution;
+    }
+  if (steps > kMaxRaySteps) {
+    std::ostringstream os;
+    os << "the clouds' rays would walk " << steps << " voxels at " << resolution << " m, more than the " << kMaxRaySteps
+       << " an import may; use --range, a coarser --resolution or fewer points";
+    throw Error(os.str());
+  }
   for (std::size_t s = 0; s < scans.size(); ++s) {
     const CloudScan& scan = scans[s];
     const auto beyond = [&](const Eigen::Vector3d& p) { return !(p.cwiseAbs().maxCoeff() < reach); };

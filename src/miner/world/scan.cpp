@@ -17,6 +17,8 @@ namespace {
 constexpr double kDegree = M_PI / 180.0;
 /// Most rays one scan may cast (poses x rays per pose): ~10 minutes of OctoMap integration.
 constexpr double kMaxRays = 1e8;
+/// Most voxels all rays together may cross (OctoMap integrates ~1e7 per second).
+constexpr double kMaxRaySteps = 2e9;
 
 void check(bool ok, const std::string& field, const std::string& what) {
   if (!ok) throw Error("scan " + field + ": " + what);
@@ -84,6 +86,15 @@ void validate_scan(const ScanOptions& o, const Map& map, const std::vector<Eigen
     throw Error(os.str());
   }
   const double res = o.resolution > 0.0 ? o.resolution : map.resolution();
+  // Each ray walks up to min(range, the map's diagonal) / res voxels: bound the walk too.
+  const double steps = rays * std::min(o.range, map.bounds().extent().norm()) / res;
+  if (steps > kMaxRaySteps) {
+    std::ostringstream os;
+    os << "scan: " << rays << " rays of up to " << std::min(o.range, map.bounds().extent().norm()) << " m at " << res
+       << " m would walk " << steps << " voxels, more than the " << kMaxRaySteps
+       << " a scan may; use fewer rays, a shorter range or a coarser resolution";
+    throw Error(os.str());
+  }
   // OctoMap keys are 16 bits: the map must lie within 32768 voxels of the origin.
   const double reach = std::max(map.bounds().min.cwiseAbs().maxCoeff(), map.bounds().max.cwiseAbs().maxCoeff());
   if (reach / res >= 32767.0) {

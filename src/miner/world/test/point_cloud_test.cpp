@@ -152,6 +152,8 @@ TEST_CASE("Malformed point clouds are refused naming the fault, never crash", "[
           "field \"y\" is not a float");
   PointCloud far;
   far.points = {V(1e9, 0, 0)};
+  CHECK_THROWS_WITH(integrate_clouds({{far, V(0, 0, 0)}}, 0.05, 0.0), Contains("would walk"));
+  far.points = {V(2000, 0, 0)};
   CHECK_THROWS_WITH(integrate_clouds({{far, V(0, 0, 0)}}, 0.05, 0.0), Contains("beyond OctoMap's key range"));
   // Random corruption of a valid file: read or refused, nothing else.
   miner::Rng rng(3);

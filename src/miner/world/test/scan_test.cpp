@@ -103,7 +103,11 @@ TEST_CASE("Bad scan settings are refused naming the setting", "[REQ-WORLD-016]")
   o.v_rays = 1000;
   refuses(o, path, "exceed the 1e+08 a scan may cast");
   o = ScanOptions();
+  o.resolution = 1e-5;
+  refuses(o, path, "would walk");
+  o = ScanOptions();
   o.resolution = 1e-4;
+  o.h_rays = o.v_rays = 1;
   refuses(o, path, "outside OctoMap's 32768 voxels");
 }
 

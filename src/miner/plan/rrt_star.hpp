@@ -103,9 +103,13 @@ struct PlanningProblem {
   /// samples (REQ-PLAN-021).
   double sampled_volume = 0.0;
 
-  /// Throws miner::Error naming the fault (start/goal out of bounds or in collision).
+  /// Throws miner::Error naming the fault (start/goal out of bounds or in collision). The
+  /// problem refers to `map`, which the caller keeps alive while the problem is used.
   static PlanningProblem make(const world::Map& map, const Eigen::Vector3d& start,
                               const Eigen::Vector3d& goal, double robot_radius);
+  /// A temporary map would dangle: `make(Map::load(path), ...)` does not compile.
+  static PlanningProblem make(world::Map&& map, const Eigen::Vector3d& start, const Eigen::Vector3d& goal,
+                              double robot_radius) = delete;
 };
 
 /// When a stage (first solution, target cost) was reached.

@@ -1,5 +1,8 @@
 #include <catch2/catch.hpp>
 
+#include <type_traits>
+#include <utility>
+
 #include "miner/core/error.hpp"
 #include "miner/plan/heuristic_region.hpp"
 #include "miner/plan/reference.hpp"
@@ -268,4 +271,21 @@ TEST_CASE("The safeguard keeps full trust in a region the solution runs through 
   // The other planners draw nothing from H.
   o.planner = PlannerKind::kRrtStar;
   CHECK(miner::plan::plan(problem, o, &good).region_samples == 0);
+}
+
+namespace {
+/// Whether PlanningProblem::make accepts a map of type M (a deleted overload does not).
+template <typename M, typename = void>
+struct can_make : std::false_type {};
+template <typename M>
+struct can_make<M, std::void_t<decltype(PlanningProblem::make(std::declval<M>(), V(), V(), 0.0))>> : std::true_type {};
+}  // namespace
+
+TEST_CASE("A planning problem cannot be made from a temporary map", "[REQ-PLAN-008]") {
+  // PlanningProblem keeps a pointer to its map: a temporary (make(Map::load(p), ...)) would
+  // dangle, so that overload is deleted and the call does not compile.
+  STATIC_REQUIRE(can_make<const miner::world::Map&>::value);
+  STATIC_REQUIRE(can_make<miner::world::Map&>::value);
+  STATIC_REQUIRE_FALSE(can_make<miner::world::Map&&>::value);
+  STATIC_REQUIRE_FALSE(can_make<miner::world::Map>::value);
 }

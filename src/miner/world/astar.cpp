@@ -18,12 +18,19 @@ namespace {
 constexpr double kSqrt2 = 1.4142135623730951;
 constexpr double kSqrt3 = 1.7320508075688772;
 
+/// A 26-connected step in index arithmetic for one grid: the neighbour is `offset` cells away
+/// and the block it spans with the current cell holds `between` (the cells other than the two
+/// ends: 0, 2 or 6 of them), which must be free too (no corner cutting).
 struct Move {
-  Eigen::Vector3i delta;
+  int dx, dy, dz;
   double length;  // in cells
+  std::ptrdiff_t offset;
+  std::array<std::ptrdiff_t, 6> between;
+  int n_between;
 };
 
-std::array<Move, 26> make_moves() {
+std::array<Move, 26> make_moves(const Eigen::Vector3i& dims) {
+  const std::ptrdiff_t sy = dims.x(), sz = static_cast<std::ptrdiff_t>(dims.x()) * dims.y();
   std::array<Move, 26> moves{};
   int n = 0;
   for (int dz = -1; dz <= 1; ++dz)
@@ -31,21 +38,30 @@ std::array<Move, 26> make_moves() {
       for (int dx = -1; dx <= 1; ++dx) {
         const int nonzero = (dx != 0) + (dy != 0) + (dz != 0);
         if (nonzero == 0) continue;
-        moves[n++] = {{dx, dy, dz}, nonzero == 1 ? 1.0 : nonzero == 2 ? kSqrt2 : kSqrt3};
+        Move& m = moves[static_cast<std::size_t>(n++)];
+        m.dx = dx;
+        m.dy = dy;
+        m.dz = dz;
+        m.length = nonzero == 1 ? 1.0 : nonzero == 2 ? kSqrt2 : kSqrt3;
+        m.offset = dx + dy * sy + dz * sz;
+        m.n_between = 0;
+        // Every cell of the block from the current cell to the neighbour except the two ends.
+        for (int z = 0; z <= std::abs(dz); ++z)
+          for (int y = 0; y <= std::abs(dy); ++y)
+            for (int x = 0; x <= std::abs(dx); ++x) {
+              const std::ptrdiff_t o = x * dx + y * dy * sy + z * dz * sz;
+              if (o != 0 && o != m.offset) m.between[static_cast<std::size_t>(m.n_between++)] = o;
+            }
       }
   return moves;
 }
 
-/// Every cell of the block spanned by `from` and `from + delta` is free.
-bool block_free(const VoxelGrid& grid, const Eigen::Vector3i& from, const Eigen::Vector3i& delta) {
-  for (int z = 0; z <= std::abs(delta.z()); ++z)
-    for (int y = 0; y <= std::abs(delta.y()); ++y)
-      for (int x = 0; x <= std::abs(delta.x()); ++x) {
-        const Eigen::Vector3i c(from.x() + x * delta.x(), from.y() + y * delta.y(),
-                                from.z() + z * delta.z());
-        if (grid.occupied(c)) return false;
-      }
-  return true;
+/// The octile distance in cells for coordinate differences (the same expression as
+/// octile_distance at resolution 1, so costs and the expansion order are unchanged).
+double octile_cells(int ax, int ay, int az) {
+  std::array<int, 3> d{std::abs(ax), std::abs(ay), std::abs(az)};
+  std::sort(d.begin(), d.end(), std::greater<>());
+  return 1.0 * (kSqrt3 * d[2] + kSqrt2 * (d[1] - d[2]) + (d[0] - d[1]));
 }
 
 Eigen::Vector3i endpoint_cell(const Map& map, const VoxelGrid& grid, const Eigen::Vector3d& p,
@@ -76,7 +92,11 @@ GridPath astar(const Map& map, const VoxelGrid& grid, const Eigen::Vector3d& sta
                const Eigen::Vector3d& goal) {
   const Eigen::Vector3i s = endpoint_cell(map, grid, start, "start");
   const Eigen::Vector3i g = endpoint_cell(map, grid, goal, "goal");
-  static const std::array<Move, 26> kMoves = make_moves();
+  // Index arithmetic in the inner loop: A* runs inside every generated map's solvability
+  // check and every dataset sample, so this loop is most of their cost.
+  const std::array<Move, 26> moves = make_moves(grid.dims());
+  const std::size_t nx = static_cast<std::size_t>(grid.dims().x()), ny = static_cast<std::size_t>(grid.dims().y());
+  const int dims[3] = {grid.dims().x(), grid.dims().y(), grid.dims().z()};
 
   const std::size_t n = grid.cell_count();
   constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -99,18 +119,21 @@ GridPath astar(const Map& map, const VoxelGrid& grid, const Eigen::Vector3d& sta
     closed[cur] = 1;
     ++result.expanded;
     if (cur == gi) break;
-    const Eigen::Vector3i c = grid.coords(cur);
-    for (const Move& m : kMoves) {
-      const Eigen::Vector3i nb = c + m.delta;
-      if (!grid.contains(nb)) continue;
-      const std::size_t ni = grid.index(nb);
+    const int cx = static_cast<int>(cur % nx), cy = static_cast<int>((cur / nx) % ny), cz = static_cast<int>(cur / (nx * ny));
+    const auto at = [cur](std::ptrdiff_t offset) { return static_cast<std::size_t>(static_cast<std::ptrdiff_t>(cur) + offset); };
+    for (const Move& m : moves) {
+      const int x = cx + m.dx, y = cy + m.dy, z = cz + m.dz;
+      if (x < 0 || y < 0 || z < 0 || x >= dims[0] || y >= dims[1] || z >= dims[2]) continue;
+      const std::size_t ni = at(m.offset);
       if (closed[ni] || grid.occupied(ni)) continue;
-      if (!block_free(grid, c, m.delta)) continue;
+      bool block_free = true;  // the cells the step passes between: no corner cutting
+      for (int b = 0; b < m.n_between && block_free; ++b) block_free = !grid.occupied(at(m.between[static_cast<std::size_t>(b)]));
+      if (!block_free) continue;
       const double tentative = cost_to_come[cur] + m.length;
       if (tentative < cost_to_come[ni]) {
         cost_to_come[ni] = tentative;
         parent[ni] = static_cast<std::int64_t>(cur);
-        open.emplace(tentative + octile_distance(nb, g, 1.0), ni);
+        open.emplace(tentative + octile_cells(x - g.x(), y - g.y(), z - g.z()), ni);
       }
     }
   }

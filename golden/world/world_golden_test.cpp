@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "miner/core/json_io.hpp"
+#include "miner/core/sha256.hpp"
 #include "miner/testing/golden.hpp"
 #include "miner/world/astar.hpp"
 #include "miner/world/map_generator.hpp"
@@ -60,4 +61,29 @@ TEST_CASE("Fixture maps regenerate byte for byte from their preset and seed", "[
   std::stringstream bytes;
   bytes << bt.rdbuf();
   CHECK(bytes.str() == miner::world::octree_bt_bytes(generate_map(generator_preset("indoor"), 1).to_voxel_layer()));
+}
+
+TEST_CASE("A scan map, its mapping run and its A* path match the golden", "[REQ-WORLD-019][REQ-HARNESS-002]") {
+  // A tripwire over the whole scan pipeline (base map, tour, sensor draw, ray casting, OctoMap
+  // bytes): the voxels are compared by the sha256 of their .bt bytes, the rest as numbers.
+  const miner::testing::Tolerance tol{1e-9, 0.0};
+  GeneratorOverrides o;
+  o.base = "rooms";
+  o.size = Eigen::Vector3d(20, 16, 4);
+  o.resolution = 0.25;
+  const ScanMap scan = generate_scan_map(generator_preset("scan"), 1, o);
+  const Map& map = scan.map;
+  const VoxelLayer& layer = map.voxels()->layer();
+  const ScanOptions& s = scan.sensor;
+  const nlohmann::json actual = {
+      {"base", scan.base},
+      {"sensor", {{"range", s.range}, {"h_fov_deg", s.h_fov_deg}, {"v_fov_deg", s.v_fov_deg}, {"h_rays", s.h_rays},
+                  {"v_rays", s.v_rays}, {"noise", s.noise}, {"dropout", s.dropout}, {"spacing", s.spacing}}},
+      {"bounds", {{"min", miner::vec3_json(map.bounds().min)}, {"max", miner::vec3_json(map.bounds().max)}}},
+      {"resolution", map.resolution()},
+      {"query", {{"start", miner::vec3_json(map.query()->start)}, {"goal", miner::vec3_json(map.query()->goal)}}},
+      {"voxels", {{"free", layer.count(VoxelState::kFree)}, {"occupied", layer.count(VoxelState::kOccupied)},
+                  {"unknown", layer.count(VoxelState::kUnknown)}, {"bt_sha256", miner::sha256_hex(octree_bt_bytes(layer))}}},
+      {"astar", astar_summary(map)}};
+  MINER_REQUIRE_GOLDEN("world/scan-rooms-seed-1.json", actual, tol);
 }

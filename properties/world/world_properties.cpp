@@ -13,6 +13,7 @@
 #include "miner/world/astar.hpp"
 #include "miner/world/map.hpp"
 #include "miner/world/map_generator.hpp"
+#include "miner/world/octree_io.hpp"
 #include "miner/core/json_io.hpp"
 #include "miner/world/voxel_grid.hpp"
 
@@ -25,6 +26,26 @@ namespace {
 
 /// Rounding slack on squared distances of points within ~20 m: a few ulps of 400.
 constexpr double kDistanceRounding = 1e-12;
+
+/// A generated map's query: start and goal free for its radius, and an A* path whose every
+/// segment is collision-free in the continuous map (REQ-WORLD-011, REQ-WORLD-019).
+void rc_assert_query_solvable(const Map& map) {
+  const Query& q = *map.query();
+  RC_ASSERT(map.is_free(q.start, q.robot_radius));
+  RC_ASSERT(map.is_free(q.goal, q.robot_radius));
+  const VoxelGrid grid(map, q.robot_radius);
+  const GridPath path = astar(map, grid, q.start, q.goal);
+  for (std::size_t i = 1; i < path.points.size(); ++i)
+    RC_ASSERT(map.segment_free(path.points[i - 1], path.points[i], q.robot_radius));
+}
+
+/// A size near a family's smallest extents (small maps keep a case cheap; the generator's
+/// logic is the same at every size).
+V small_family_size(Rng& rng, const GeneratorPreset& p) {
+  V size;
+  for (int k = 0; k < 3; ++k) size[k] = std::round(rng.uniform(p.min_extent[k], 1.1 * p.min_extent[k]));
+  return size;
+}
 
 Box random_box(Rng& rng, double lo, double hi, double max_side) {
   V a(rng.uniform(lo, hi), rng.uniform(lo, hi), rng.uniform(lo, hi));
@@ -284,26 +305,49 @@ TEST_CASE("Maps survive a JSON round trip unchanged", "[REQ-WORLD-001]") {
 TEST_CASE("Every family map has a solvable query and the same bytes from the same seed", "[REQ-WORLD-011]") {
   // Small sizes at a coarse resolution keep 100 maps cheap; the generator's logic is the
   // same at every size (the fixture-size maps are checked in map_generator_test).
-  property("family maps are solvable and deterministic", [](std::uint64_t seed) {
+  // Each case generates a map twice and runs A* on it; the `long` label runs 1000.
+  const miner::testing::Cases cases{40, "two generated maps and an A* search per case"};
+  property("family maps are solvable and deterministic", cases, [](std::uint64_t seed) {
     Rng rng(seed);
     const std::vector<std::string> families{"cluttered", "rooms", "forest", "multilevel"};
     const GeneratorPreset p = generator_preset(families[rng.uniform_index(families.size())]);
     GeneratorOverrides o;
-    V size;
-    for (int k = 0; k < 3; ++k) size[k] = std::round(rng.uniform(p.min_extent[k], 1.1 * p.min_extent[k]));
-    o.size = size;
+    o.size = small_family_size(rng, p);
     o.resolution = 0.25;
     try {
       const Map a = generate_map(p, seed, o);
       RC_ASSERT(miner::dump_json(a.to_json()) == miner::dump_json(generate_map(p, seed, o).to_json()));
-      const Query& q = *a.query();
-      RC_ASSERT(a.is_free(q.start, q.robot_radius));
-      RC_ASSERT(a.is_free(q.goal, q.robot_radius));
-      const VoxelGrid grid(a, q.robot_radius);
-      const GridPath path = astar(a, grid, q.start, q.goal);
-      for (std::size_t i = 1; i < path.points.size(); ++i) RC_ASSERT(a.segment_free(path.points[i - 1], path.points[i], q.robot_radius));
+      rc_assert_query_solvable(a);
     } catch (const miner::NoSolution&) {
       RC_FAIL("no solvable map in 16 attempts");
+    }
+  });
+}
+
+TEST_CASE("Every scan map has a free, solvable query in its own voxels and the same bytes from the same seed", "[REQ-WORLD-019]") {
+  // A mapping run over a small map of a random family (a scan of a large one costs seconds of
+  // ray casting); the `long` label runs 1000.
+  const miner::testing::Cases cases{10, "two generated maps, two simulated mapping runs and A* per case"};
+  property("scan maps are solvable in what the run saw, and deterministic", cases, [](std::uint64_t seed) {
+    Rng rng(seed);
+    const std::vector<std::string> families{"cluttered", "rooms", "forest", "multilevel"};
+    const std::string base = families[rng.uniform_index(families.size())];
+    GeneratorOverrides o;
+    o.size = small_family_size(rng, generator_preset(base));
+    o.resolution = 0.25;
+    o.base = base;
+    const GeneratorPreset p = generator_preset("scan");
+    try {
+      const Map a = generate_map(p, seed, o);
+      const Map b = generate_map(p, seed, o);
+      RC_ASSERT(a.voxels() != nullptr);
+      RC_ASSERT(a.obstacles().empty());
+      RC_ASSERT(octree_bt_bytes(a.voxels()->layer()) == octree_bt_bytes(b.voxels()->layer()));
+      RC_ASSERT(a.voxels()->layer().count(VoxelState::kUnknown) > 0);
+      RC_ASSERT(a.query()->robot_radius == p.robot_radius);
+      rc_assert_query_solvable(a);
+    } catch (const miner::NoSolution&) {
+      RC_FAIL("no solvable scan in 16 attempts");
     }
   });
 }

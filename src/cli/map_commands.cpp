@@ -32,6 +32,7 @@ struct GenOptions {
   int obstacles = -1;
   std::vector<double> size;
   double resolution = 0.0;
+  std::string base;
   std::string out;
 };
 
@@ -41,6 +42,21 @@ void run_gen(const GenOptions& o, std::ostream& out) {
   if (o.obstacles >= 0) overrides.obstacles = o.obstacles;
   if (!o.size.empty()) overrides.size = Eigen::Vector3d(o.size[0], o.size[1], o.size[2]);
   if (o.resolution != 0.0) overrides.resolution = o.resolution;
+  if (!o.base.empty()) overrides.base = o.base;
+  if (preset.name == "scan") {
+    const world::ScanMap scan = world::generate_scan_map(preset, o.seed, overrides);
+    scan.map.save(o.out);
+    const world::VoxelLayer& layer = scan.map.voxels()->layer();
+    const Eigen::Vector3d e = scan.map.bounds().extent();
+    const world::ScanOptions& s = scan.sensor;
+    out << "wrote " << o.out << ": preset scan, seed " << o.seed << ", a mapping run over a " << scan.base << " map ("
+        << (s.h_fov_deg >= 360.0 ? "lidar" : "depth camera") << ", " << s.h_fov_deg << " x " << s.v_fov_deg
+        << " deg, range " << s.range << " m, noise " << s.noise << " m, dropout " << s.dropout << "): " << e.x()
+        << " x " << e.y() << " x " << e.z() << " m at " << scan.map.resolution() << " m, "
+        << layer.count(world::VoxelState::kFree) << " free, " << layer.count(world::VoxelState::kOccupied)
+        << " occupied, " << layer.count(world::VoxelState::kUnknown) << " unknown voxels\n";
+    return;
+  }
   const Map map = world::generate_map(preset, o.seed, overrides);
   map.save(o.out);
   const Eigen::Vector3d e = map.bounds().extent();
@@ -257,11 +273,13 @@ void add_map_commands(CLI::App& app, std::ostream& out) {
   map->require_subcommand(1);
 
   auto gen = std::make_shared<GenOptions>();
-  CLI::App* g = map->add_subcommand("gen", "generate a seeded map (presets: sim, indoor, cluttered, rooms, forest, multilevel)");
+  CLI::App* g = map->add_subcommand("gen", "generate a seeded map (presets: sim, indoor, cluttered, rooms, forest, multilevel, scan)");
   g->add_option("--preset", gen->preset,
-                "map preset: sim (100 m, paper Sec. V-B), indoor (10 m site, Sec. V-D), or a family drawing its "
-                "size per map: cluttered, rooms, forest, multilevel")
+                "map preset: sim (100 m, paper Sec. V-B), indoor (10 m site, Sec. V-D), a family drawing its "
+                "size per map: cluttered, rooms, forest, multilevel, or scan: the voxels a simulated mapping run "
+                "leaves over a map of another preset (a .json gets its .bt beside it)")
       ->capture_default_str();
+  g->add_option("--base", gen->base, "scan: the preset the mapping run flies over (default: drawn per map)");
   g->add_option("--seed", gen->seed, "random seed")->capture_default_str()->check(kUnsigned64);
   g->add_option("--obstacles", gen->obstacles, "number of obstacles (default: the preset's range)")
       ->check(kFiniteNonNegative);

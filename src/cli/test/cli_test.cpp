@@ -96,6 +96,34 @@ TEST_CASE("map gen writes a deterministic map and map info summarises it", "[REQ
   CHECK(doc["resolution"] == 0.1);
 }
 
+TEST_CASE("map gen --preset scan writes the run's voxels beside the map, and plans on them", "[REQ-CLI-001][REQ-WORLD-019]") {
+  const std::string a = dir() + "/scan-a.json", b = dir() + "/scan-b.json";
+  const std::vector<std::string> gen{"map", "gen", "--preset", "scan", "--base", "rooms", "--size", "20", "16", "4",
+                                     "--resolution", "0.25", "--seed", "2", "--out"};
+  std::vector<std::string> args = gen;
+  args.push_back(a);
+  const Run r = miner_cli(args);
+  INFO(r.err);
+  REQUIRE(r.code == 0);
+  CHECK_THAT(r.out, Contains("a mapping run over a rooms map") && Contains("unknown voxels"));
+  args.back() = b;
+  REQUIRE(miner_cli(args).code == 0);
+  CHECK(read(dir() + "/scan-a.bt") == read(dir() + "/scan-b.bt"));  // same seed, same bytes
+  const Run info = miner_cli({"map", "info", "--map", a, "--json"});
+  REQUIRE(info.code == 0);
+  CHECK(miner::parse_json(info.out, "stdout")["voxels"]["counts"]["unknown"]["voxels"].get<double>() > 0);
+  // The query is solvable in the scan itself (unknown space an obstacle).
+  const Run plan = miner_cli({"astar", "--map", a});
+  INFO(plan.err);
+  CHECK(plan.code == 0);
+  const Run self = miner_cli({"map", "gen", "--preset", "scan", "--base", "scan", "--out", dir() + "/x.json"});
+  CHECK(self.code == 1);
+  CHECK_THAT(self.err, Contains("base") && Contains("rooms"));
+  const Run other = miner_cli({"map", "gen", "--preset", "sim", "--base", "rooms", "--out", dir() + "/x.json"});
+  CHECK(other.code == 1);
+  CHECK_THAT(other.err, Contains("base"));
+}
+
 TEST_CASE("astar prints a path, --json gives the documented fields, --out writes them", "[REQ-CLI-001][REQ-WORLD-007]") {
   const std::string map = write("pillar.json", kPillarMap);
   const Run human = miner_cli({"astar", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5"});
@@ -114,9 +142,15 @@ TEST_CASE("astar prints a path, --json gives the documented fields, --out writes
 }
 
 TEST_CASE("astar without --start/--goal uses the map's query, or says it needs them", "[REQ-CLI-001]") {
-  const std::string gen = dir() + "/query-map.json";
-  REQUIRE(miner_cli({"map", "gen", "--preset", "indoor", "--seed", "4", "--out", gen}).code == 0);
-  CHECK(miner_cli({"astar", "--map", gen}).code == 0);
+  // A map that carries its query (as every generated map does): astar plans it as given.
+  const std::string with_query = write("query-map.json", R"({"format": "miner-map-v1",
+    "bounds": {"min": [0,0,0], "max": [10,10,10]}, "resolution": 1.0,
+    "obstacles": [{"type": "box", "min": [4,4,0], "max": [6,6,10]}],
+    "query": {"start": [1,5,5], "goal": [9,5,5], "robot_radius": 0.3}})");
+  const Run q = miner_cli({"astar", "--map", with_query});
+  CHECK(q.code == 0);
+  CHECK_THAT(q.out, Contains("robot radius 0.3 m"));
+  CHECK_THAT(q.out, Contains("goal (9, 5, 5)"));
   const std::string plain = write("plain.json", kPillarMap);
   const Run r = miner_cli({"astar", "--map", plain});
   CHECK(r.code == 1);

@@ -16,6 +16,12 @@ namespace miner {
 /// (master seed, stream) into well-spread engine seeds.
 std::uint64_t splitmix64(std::uint64_t x);
 
+/// The stream of retry `attempt` of a seeded draw (a generator that redraws until its map is
+/// solvable): 0 for the first try, SplitMix64(attempt) after it. Rng(seed, attempt) would make
+/// retry a of seed s the first try of seed s ^ a, so two small user seeds would give the same
+/// map whenever one of them needed a retry; the mixed stream keeps every (seed, attempt) apart.
+inline std::uint64_t retry_stream(std::uint64_t attempt) { return attempt == 0 ? 0 : splitmix64(attempt); }
+
 /// Area of Rng::normal_ziggurat()'s top layer over the common layer area v: 1 when the
 /// published (r, v) close the ziggurat with the recurrence computed here (a test checks it).
 double ziggurat_top_layer_area();

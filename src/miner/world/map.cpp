@@ -287,6 +287,9 @@ Json Map::to_json() const {
                     {"robot_radius", query_->robot_radius}};
   }
   if (source_) {
+    if (source_->file.empty())
+      throw Error("map: its voxels were made in memory and have no file to reference; save() it as JSON, which "
+                  "writes them to a .bt beside it");
     doc["voxels"] = {{"file", source_->file}, {"sha256", source_->sha256}, {"unknown", to_string(source_->unknown)}};
   }
   return doc;
@@ -328,6 +331,18 @@ void Map::save_octomap(const std::string& path) const { write_octree_bt(to_voxel
 void Map::save(const std::string& path) const {
   if (path.size() >= 3 && path.compare(path.size() - 3, 3, ".bt") == 0) {
     save_octomap(path);
+  } else if (source_ && source_->file.empty()) {
+    // The voxels first, then the document that names them: a reader never sees a reference to a
+    // file that is not there yet.
+    const std::filesystem::path bt = std::filesystem::path(path).replace_extension(".bt");
+    const std::string bytes = octree_bt_bytes(*source_->layer);
+    write_file_atomic(bt.string(), bytes);
+    VoxelSource saved = *source_;
+    saved.file = std::filesystem::absolute(bt).lexically_normal().string();
+    saved.sha256 = sha256_hex(bytes);
+    Json doc = Map(bounds_, resolution_, obstacles_, query_, std::move(saved)).to_json();
+    doc["voxels"]["file"] = bt.filename().string();  // relative: the pair moves together
+    write_file_atomic(path, dump_json(doc));
   } else {
     write_file_atomic(path, dump_json(to_json()));
   }

@@ -80,9 +80,12 @@ class Map {
   /// An OctoMap file as a voxel map (world::read_octree), bounded by its known leaves.
   static Map load_octomap(const std::string& path);
 
-  /// The document; a voxel map references its file by absolute path and SHA-256.
+  /// The document; a voxel map references its file by absolute path and SHA-256. A voxel map
+  /// made in memory (a generated scan) has no file yet: throws miner::Error (save() writes one).
   Json to_json() const;
-  /// Writes the map as JSON (atomic), or as an OctoMap `.bt` if `path` ends in .bt.
+  /// Writes the map as JSON (atomic), or as an OctoMap `.bt` if `path` ends in .bt. A voxel
+  /// map made in memory saved as JSON writes its voxels first to the `.bt` of the same stem
+  /// beside it, referenced by file name and SHA-256 (REQ-WORLD-019).
   void save(const std::string& path) const;
   /// The map as voxels at its resolution on the lattice of its bounds: a voxel is occupied if
   /// the grid of VoxelGrid(map, 0) holds it, unknown if the voxel layer says so, else free.

@@ -99,7 +99,7 @@ std::vector<Box> indoor_obstacles(Rng& rng, const GeneratorPreset& p, int count,
 }  // namespace
 
 std::vector<std::string> generator_preset_names() {
-  return {"sim", "indoor", "cluttered", "rooms", "forest", "multilevel"};
+  return {"sim", "indoor", "cluttered", "rooms", "forest", "multilevel", "scan"};
 }
 
 bool is_family(const GeneratorPreset& preset) { return !preset.resolutions.empty(); }
@@ -142,6 +142,20 @@ GeneratorPreset generator_preset(const std::string& name) {
   if (name == "rooms") return family(name, {20, 15, 3}, {60, 40, 4.5}, {0.1, 0.2}, 0.2);
   if (name == "forest") return family(name, {20, 20, 8}, {150, 150, 25}, {0.2, 0.25, 0.5, 1.0}, 0.3);
   if (name == "multilevel") return family(name, {20, 20, 7}, {50, 50, 16}, {0.1, 0.2, 0.25, 0.5}, 0.25);
+  if (name == "scan") {
+    // Bounds, resolution and query come from each map's base and its mapping run; the radius
+    // is the smallest of the bases' (REQ-WORLD-019).
+    GeneratorPreset p;
+    p.name = name;
+    p.bounds = Box{Eigen::Vector3d::Zero(), Eigen::Vector3d(150, 150, 40)};
+    p.resolution = 0.0;
+    p.min_obstacles = p.max_obstacles = 0;
+    p.min_side = p.max_side = 0.0;
+    p.robot_radius = 0.2;
+    p.keep_free = 0.0;
+    p.quantum = 0.05;
+    return p;
+  }
   if (name == "sim") {
     return {"sim",
             Box{{0, 0, 0}, {100, 100, 40}},
@@ -187,7 +201,9 @@ Map generate_map(const GeneratorPreset& preset, std::uint64_t seed, const Genera
   if (obstacle_count && *obstacle_count < 0) {
     throw Error("obstacles: count must not be negative, got " + std::to_string(*obstacle_count));
   }
-  if (!is_family(preset) && (overrides.size || overrides.resolution)) {
+  if (overrides.base && preset.name != "scan")
+    throw Error("base: only the scan preset flies over a base map, not \"" + preset.name + "\"");
+  if (!is_family(preset) && preset.name != "scan" && (overrides.size || overrides.resolution)) {
     throw Error("size/resolution: preset \"" + preset.name + "\" has fixed bounds and resolution; "
                 "the map families (cluttered, rooms, forest, multilevel) take them");
   }
@@ -198,9 +214,10 @@ Map generate_map(const GeneratorPreset& preset, std::uint64_t seed, const Genera
   }
   if (overrides.resolution && !(*overrides.resolution >= 0.01 && *overrides.resolution <= 10.0))
     throw Error("resolution: must be between 0.01 and 10 m");
+  if (preset.name == "scan") return generate_scan_map(preset, seed, overrides).map;
   if (is_family(preset)) {
     for (int attempt = 0; attempt < kMaxGeneratorAttempts; ++attempt) {
-      Rng rng(seed, static_cast<std::uint64_t>(attempt));
+      Rng rng(seed, retry_stream(static_cast<std::uint64_t>(attempt)));
       Eigen::Vector3d extent;
       for (int k = 0; k < 3; ++k) {
         extent[k] = quantize(rng.uniform(preset.min_extent[k], preset.bounds.max[k]), 0.5);
@@ -229,7 +246,7 @@ Map generate_map(const GeneratorPreset& preset, std::uint64_t seed, const Genera
                      " attempts for seed " + std::to_string(seed) + " (too many obstacles, or too small a size?)");
   }
   for (int attempt = 0; attempt < kMaxGeneratorAttempts; ++attempt) {
-    Rng rng(seed, static_cast<std::uint64_t>(attempt));
+    Rng rng(seed, retry_stream(static_cast<std::uint64_t>(attempt)));
     const Query query{quantize(uniform_in(rng, preset.start_region), preset.quantum),
                       quantize(uniform_in(rng, preset.goal_region), preset.quantum),
                       preset.robot_radius};

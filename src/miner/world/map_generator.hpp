@@ -14,6 +14,8 @@
 ///  - "multilevel": 2-4 storeys of slabs with stair/atrium openings, bridges across
 ///    them, overhangs, partition walls and a roof, start on the ground floor and goal
 ///    on the top one.
+/// And "scan" (REQ-WORLD-019, scan_family.cpp): the voxel map a simulated mapping run
+/// leaves over a map of another preset (free, occupied, unknown; bounded by what it saw).
 /// Every generated map carries its query (start, goal, robot radius) and is checked to
 /// be solvable by A* for that radius; the same (preset, seed, overrides) gives the same bytes.
 
@@ -24,6 +26,7 @@
 
 #include "miner/core/rng.hpp"
 #include "miner/world/map.hpp"
+#include "miner/world/scan.hpp"
 
 namespace miner::world {
 
@@ -50,6 +53,7 @@ struct GeneratorOverrides {
   std::optional<int> obstacles;           ///< count (sim, indoor, cluttered, forest trunks)
   std::optional<Eigen::Vector3d> size;    ///< extents in m (families only)
   std::optional<double> resolution;       ///< m (families only)
+  std::optional<std::string> base;        ///< "scan": the preset the mapping run flies over
 };
 
 /// Largest grid axis a family map gets when its resolution is drawn (A* and the
@@ -67,6 +71,16 @@ Map generate_map(const GeneratorPreset& preset, std::uint64_t seed,
                  std::optional<int> obstacle_count = std::nullopt);
 Map generate_map(const GeneratorPreset& preset, std::uint64_t seed, const GeneratorOverrides& overrides);
 
+/// One "scan" map (REQ-WORLD-019) and how it was made.
+struct ScanMap {
+  Map map;                ///< the run's voxels alone, with the base map's query at the preset's radius
+  std::string base;       ///< the preset the run flew over
+  ScanOptions sensor;     ///< the sensor drawn for it
+};
+/// The "scan" preset's map for `seed` (generate_map returns its `map`); throws NoSolution when
+/// no attempt leaves a solvable query, miner::Error naming a bad override.
+ScanMap generate_scan_map(const GeneratorPreset& preset, std::uint64_t seed, const GeneratorOverrides& overrides);
+
 /// Whether the preset is one of the REQ-WORLD-011 families (extents drawn per map).
 bool is_family(const GeneratorPreset& preset);
 
@@ -78,6 +92,7 @@ struct FamilyDraw {
 };
 FamilyDraw draw_family(const GeneratorPreset& preset, Rng& rng, const Box& bounds,
                        std::optional<int> obstacles);
+
 }  // namespace detail
 
 inline constexpr int kMaxGeneratorAttempts = 16;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <set>
 #include <vector>
 
 #include "miner/core/rng.hpp"
@@ -19,6 +20,17 @@ TEST_CASE("Same seed and stream give the same sequence and other streams differ"
   }
   CHECK(differs_c);
   CHECK(differs_d);
+}
+
+TEST_CASE("Retries of small seeds never share a stream: no seed's retry is another seed's draw", "[REQ-CORE-001]") {
+  // A generator that redraws seeds Rng(seed, retry_stream(attempt)); with the plain attempt as
+  // the stream, retry 3 of seed 1 was the first draw of seed 2 (1 ^ 3 == 2 ^ 0).
+  std::set<std::uint64_t> first_outputs;
+  for (std::uint64_t seed = 0; seed < 256; ++seed)
+    for (std::uint64_t attempt = 0; attempt < 16; ++attempt)
+      first_outputs.insert(Rng(seed, miner::retry_stream(attempt)).next_u64());
+  CHECK(first_outputs.size() == 256u * 16u);
+  CHECK(miner::retry_stream(0) == 0);  // a first try keeps the stream it always had
 }
 
 TEST_CASE("SplitMix64 matches its published reference values", "[REQ-CORE-001]") {

@@ -26,11 +26,11 @@ std::string temp_dir() {
 heuristic::DatasetOptions small_options() {
   heuristic::DatasetOptions o;
   o.preset = "indoor";
-  o.count = 6;
-  o.test_count = 2;
-  o.val_fraction = 0.34;
+  o.count = 4;  // 3 train (two shards of 2 and 1), 1 val, 1 test: every split and a partial shard
+  o.test_count = 1;
+  o.val_fraction = 0.25;
   o.seed = 5;
-  o.shard_size = 3;
+  o.shard_size = 2;
   return o;
 }
 
@@ -158,25 +158,27 @@ TEST_CASE("The dataset has its splits, unseen test seeds and the same bytes for 
   auto parallel = o;
   parallel.jobs = 3;
   heuristic::write_dataset(parallel, b, nullptr);
-  CHECK(doc["splits"]["train"]["count"] == 4);
-  CHECK(doc["splits"]["val"]["count"] == 2);
-  CHECK(doc["splits"]["test"]["count"] == 2);
-  CHECK(doc["splits"]["train"]["shards"].size() == 2);  // shard size 3
+  CHECK(doc["splits"]["train"]["count"] == 3);
+  CHECK(doc["splits"]["val"]["count"] == 1);
+  CHECK(doc["splits"]["test"]["count"] == 1);
+  CHECK(doc["splits"]["train"]["shards"].size() == 2);  // shard size 2
   for (const char* f : {"dataset.json", "train-00000.bin", "train-00001.bin", "val-00000.bin", "test-00000.bin",
                         "train-index.json", "test-index.json"})
     CHECK(read_bytes(a + "/" + f) == read_bytes(b + "/" + f));
   const auto train = heuristic::read_split(a, "train"), val = heuristic::read_split(a, "val"),
              test = heuristic::read_split(a, "test");
-  REQUIRE(train.size() == 4);
+  REQUIRE(train.size() == 3);
+  REQUIRE(val.size() == 1);
+  REQUIRE(test.size() == 1);
   std::set<std::uint64_t> seen;
   for (const auto* split : {&train, &val})
     for (const auto& s : *split) seen.insert(s.map_seed);
   for (const auto& s : test) CHECK(seen.count(s.map_seed) == 0);
   // What is read back is what make_sample produces.
-  const heuristic::Sample again = heuristic::make_sample(o, 5);  // k = 5: the second val sample
-  CHECK(val[1].target == again.target);
-  CHECK(val[1].environment == again.environment);
-  CHECK(val[1].start == again.start);
+  const heuristic::Sample again = heuristic::make_sample(o, 3);  // k = 3: the val sample
+  CHECK(val[0].target == again.target);
+  CHECK(val[0].environment == again.environment);
+  CHECK(val[0].start == again.start);
   // A truncated shard is refused naming the file and the sizes.
   std::filesystem::resize_file(a + "/test-00000.bin", 100);
   CHECK_THROWS_WITH(heuristic::read_split(a, "test"), Contains("test-00000.bin") && Contains("expected"));

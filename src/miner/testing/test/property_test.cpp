@@ -31,6 +31,25 @@ TEST_CASE("A passing property passes through miner::testing::property", "[REQ-HA
   miner::testing::property("addition commutes", [](int a, int b) { RC_ASSERT(a + 0LL + b == b + 0LL + a); });
 }
 
+TEST_CASE("A property with its own case count runs that many cases", "[REQ-HARNESS-003]") {
+  const bool user = miner::testing::user_rc_params();
+  miner::testing::user_rc_params() = false;
+  int runs = 0;
+  miner::testing::property("seven cases", miner::testing::Cases{7, "a test of the count"}, [&runs](int) { ++runs; });
+  CHECK(runs == 7);
+  miner::testing::user_rc_params() = user;
+}
+
+TEST_CASE("With the user's RC_PARAMS a property's own case count gives way", "[REQ-HARNESS-003]") {
+  // The configured count wins (100 by default), so a replay line runs the cases the failure did.
+  const bool user = miner::testing::user_rc_params();
+  miner::testing::user_rc_params() = true;
+  int runs = 0;
+  miner::testing::property("the configured count", miner::testing::Cases{7, "a test of the count"}, [&runs](int) { ++runs; });
+  CHECK(runs == rc::detail::configuration().testParams.maxSuccess);
+  miner::testing::user_rc_params() = user;
+}
+
 // Hidden (run only by name): a property that must fail, so the ctest test
 // "harness: a failing property prints its seed and replay command" can check the
 // failure report.

@@ -67,7 +67,7 @@ TEST_CASE("Indoor maps: 15-20 pillars of 0.6 x 1.2 m on the floor and a 1 m hoop
 
 TEST_CASE("Generator input errors: unknown preset, negative count, impossible clutter", "[REQ-WORLD-009]") {
   CHECK_THROWS_WITH(generator_preset("swamp"),
-                    Contains("unknown map preset \"swamp\" (known: sim, indoor, cluttered, rooms, forest, multilevel)"));
+                    Contains("unknown map preset \"swamp\" (known: sim, indoor, cluttered, rooms, forest, multilevel, scan)"));
   CHECK_THROWS_WITH(generate_map(generator_preset("sim"), 1, -3), Contains("obstacles: count must not be negative"));
   const Map empty = generate_map(generator_preset("sim"), 1, 0);
   CHECK(empty.obstacles().empty());

@@ -1,42 +1,79 @@
 #!/usr/bin/env bash
+# cites: REQ-HARNESS-006
 # ci/fuzz.sh — builds MINER's libFuzzer targets with clang (ASan + UBSan + libFuzzer) and runs
-# each for SECONDS on a scratch copy of its seed corpus (fixtures/fuzz/<target>/), so the
-# repository is never written. A crash, a sanitizer report, a timeout (> 10 s on one input) or
-# an out-of-memory (> 2 GB) fails the run and leaves the input in build/fuzz/artifacts/.
+# each on a scratch copy of its seed corpus (fixtures/fuzz/<target>/), so the repository is
+# never written. A crash, a sanitizer report, an exception other than miner::Error, a timeout
+# (> 10 s on one input) or an out-of-memory (> 2 GB) fails the run and leaves the input in
+# build/fuzz/artifacts/; every finding becomes a regression test (the input under
+# fixtures/fuzz/<target>/ and a unit test of the fault).
 #
-#   bash ci/fuzz.sh [SECONDS]     # default 15 per target (the CI smoke run); hours for a campaign
+#   bash ci/fuzz.sh [SECONDS [RUNS]]   # per target: stop after SECONDS or RUNS executions,
+#                                      # whichever comes first (default 6 s: the CI smoke run,
+#                                      # ~55 s for all targets; ctest -L fuzz: 1e6 runs each)
 #
-# Targets (src/fuzz/): octree (MINER's .bt/.ot reader, REQ-WORLD-014), point_cloud (PLY/PCD,
-# REQ-WORLD-018), map_json (map documents, REQ-WORLD-001/002). Needs clang and
-# libclang-rt-14-dev (ci/setup.sh installs them).
+# Targets (src/fuzz/fuzz_<target>.cpp): octree (.bt/.ot, REQ-WORLD-014), point_cloud (PLY/PCD,
+# REQ-WORLD-018), map_json (REQ-WORLD-001/002), scenario (REQ-FLIGHT-007), vehicle
+# (REQ-FLIGHT-001), problem (REQ-TRAJ-006/007), region (REQ-PLAN-005), tensors (sGAN weights
+# and reference files, REQ-HEUR-006), campaign (bench merge shards, REQ-REPORT-006).
+# Needs clang, libclang-rt-14-dev and libomp-14-dev (ci/setup.sh installs them). Prints each
+# target's executions and corpus coverage, and writes them to build/fuzz/summary.txt.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-seconds=${1:-15}
+seconds=${1:-6}
+runs=${2:--1}
+targets=(octree point_cloud map_json scenario vehicle problem region tensors campaign)
 out=build/fuzz
 mkdir -p "$out/obj" "$out/artifacts"
-flags=(-std=c++17 -O1 -g -fno-omit-frame-pointer -Isrc -isystem /usr/include/eigen3)
+ompl_include=$(ls -d /usr/include/ompl-* | head -1)
+flags=(-std=c++17 -O1 -g -fno-omit-frame-pointer -Isrc -isystem /usr/include/eigen3 -isystem "$ompl_include"
+       -DEIGEN_MALLOC_ALREADY_ALIGNED=1 -DMINER_WITH_OMPL=1 -DGFLAGS_IS_A_DLL=0 -DGLOG_CUSTOM_PREFIX_SUPPORT)
 lib_san=(-fsanitize=fuzzer-no-link,address,undefined)
-sources=(src/miner/core/*.cpp src/miner/world/*.cpp)
-# Objects of the library code, rebuilt when their source is newer, two at a time.
+# The library code the parsers live in (the linker takes from the archive only what a target uses).
+sources=(src/miner/core/*.cpp src/miner/world/*.cpp src/miner/traj/*.cpp src/miner/plan/*.cpp
+         src/miner/flight/*.cpp src/miner/heuristic/*.cpp src/miner/report/*.cpp src/bench/*.cpp)
+# Objects, rebuilt when their source or any header is newer, two at a time.
 printf '%s\n' "${sources[@]}" | xargs -P 2 -I{} bash -c '
   src={}; obj='"$out"'/obj/$(echo "$src" | tr / _).o
-  if [ ! -f "$obj" ] || [ "$src" -nt "$obj" ] || [ -n "$(find src/miner -name "*.hpp" -newer "$obj" -print -quit)" ]; then
-    clang++ '"${flags[*]}"' '"${lib_san[*]}"' -c "$src" -o "$obj"
+  if [ ! -f "$obj" ] || [ "$src" -nt "$obj" ] || [ -n "$(find src/miner src/bench -name "*.hpp" -newer "$obj" -print -quit)" ]; then
+    clang++ '"${flags[*]}"' '"${lib_san[*]}"' -c "$src" -o "$obj.tmp" && mv "$obj.tmp" "$obj"
   fi'
+# The shipped sGAN weights, compiled in as cmake/EmbedFile.cmake does for the product.
+weights=fixtures/sgan/sgan.bin
+if [ ! -f "$out/obj/builtin_weights.o" ] || [ "$weights" -nt "$out/obj/builtin_weights.o" ]; then
+  { echo "#include <cstddef>"; echo "namespace miner::heuristic {"
+    echo "extern const unsigned char kBuiltinSganWeights[] = {"
+    od -An -v -tx1 "$weights" | sed -E 's/ ([0-9a-f]{2})/0x\1,/g'
+    echo "0x00};"; echo "extern const std::size_t kBuiltinSganWeightsSize = $(stat -c %s "$weights");"; echo "}"
+  } >"$out/builtin_weights.cpp"
+  clang++ -std=c++17 -O0 -c "$out/builtin_weights.cpp" -o "$out/obj/builtin_weights.o"
+fi
+rm -f "$out/libminer_fuzz.a"
+objects=()
+for src in "${sources[@]}"; do objects+=("$out/obj/$(echo "$src" | tr / _).o"); done
+ar rcs "$out/libminer_fuzz.a" "${objects[@]}" "$out/obj/builtin_weights.o"
+libs=(-loctomap -loctomath -lompl -lboost_serialization -lboost_filesystem -lboost_system
+      /usr/lib/x86_64-linux-gnu/libceres.a -lglog -lgflags -lspqr -lcholmod -lamd -lcamd -lccolamd -lcolamd
+      -lsuitesparseconfig -lcxsparse -llapack -lblas -lsundials_cvode -lsundials_nvecserial -ldnnl -lgomp
+      -lpthread -ldl)
 status=0
-for target in octree point_cloud map_json; do
-  clang++ "${flags[@]}" -fsanitize=fuzzer,address,undefined "src/fuzz/fuzz_$target.cpp" "$out"/obj/*.o \
-    -loctomap -loctomath -o "$out/fuzz_$target"
+: >"$out/summary.txt"
+for target in "${targets[@]}"; do
+  clang++ "${flags[@]}" -fsanitize=fuzzer,address,undefined "src/fuzz/fuzz_$target.cpp" "$out/libminer_fuzz.a" \
+    "${libs[@]}" -o "$out/fuzz_$target"
   corpus=$(mktemp -d)
   cp -r "fixtures/fuzz/$target/." "$corpus/"
-  echo "ci/fuzz.sh: $target for ${seconds}s"
-  if ! UBSAN_OPTIONS=halt_on_error=1 "$out/fuzz_$target" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
-      -max_len=65536 -artifact_prefix="$out/artifacts/${target}-" -print_final_stats=1 "$corpus" 2>"$out/$target.log"; then
+  echo "ci/fuzz.sh: $target for ${seconds}s or $runs runs"
+  if ! UBSAN_OPTIONS=halt_on_error=1 "$out/fuzz_$target" -max_total_time="$seconds" -runs="$runs" -timeout=10 \
+      -rss_limit_mb=2048 -max_len=65536 -artifact_prefix="$out/artifacts/${target}-" -print_final_stats=1 \
+      "$corpus" 2>"$out/$target.log"; then
     tail -40 "$out/$target.log" >&2
     echo "ci/fuzz.sh: $target failed (input in $out/artifacts/)" >&2
     status=1
   else
-    grep -E "stat::number_of_executed_units|cov:" "$out/$target.log" | tail -2
+    execs=$(grep -oE "stat::number_of_executed_units: *[0-9]+" "$out/$target.log" | grep -oE "[0-9]+$" || true)
+    cover=$(grep -E "^#[0-9]+[[:space:]]+DONE" "$out/$target.log" | grep -oE "cov: [0-9]+ ft: [0-9]+ corp: [0-9/]+[a-zA-Z]*" | head -1 || true)
+    line="$target: ${execs:-?} executions, ${cover:-no final stats}"
+    echo "$line" | tee -a "$out/summary.txt"
   fi
   rm -rf "$corpus"
 done

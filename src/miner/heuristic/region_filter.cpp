@@ -83,7 +83,10 @@ FilteredRegion filter_region(const std::vector<float>& p, const std::vector<std:
       }
     std::size_t reached = n;
     while (!open.empty()) {
-      const auto [d, u] = open.top();
+      // Named copies, not a structured binding: the lambda below captures them (C++17 does
+      // not allow capturing a binding; g++ accepts it, clang does not).
+      const double d = open.top().first;
+      const std::size_t u = open.top().second;
       open.pop();
       if (d > dist[u]) continue;
       if (from_goal[u]) {

@@ -8,20 +8,28 @@
 # fixtures/fuzz/<target>/ and a unit test of the fault).
 #
 #   bash ci/fuzz.sh [SECONDS [RUNS]]   # per target: stop after SECONDS or RUNS executions,
-#                                      # whichever comes first (default 6 s: the CI smoke run,
-#                                      # ~55 s for all targets; ctest -L fuzz: 1e6 runs each)
+#                                      # whichever comes first (ci/test.sh: 8 s or 20000
+#                                      # runs, the smoke; ctest -L fuzz: 1e6 runs each)
+#
+# The mutation stream is seeded (MINER_FUZZ_SEED, default 20261122), so CI explores the same
+# inputs every time (up to libFuzzer's corpus reduction, which is not bit-for-bit stable);
+# MINER_FUZZ_SEED=0 lets libFuzzer draw a fresh seed (exploration campaigns).
 #
 # Targets (src/fuzz/fuzz_<target>.cpp): octree (.bt/.ot, REQ-WORLD-014), point_cloud (PLY/PCD,
 # REQ-WORLD-018), map_json (REQ-WORLD-001/002), scenario (REQ-FLIGHT-007), vehicle
 # (REQ-FLIGHT-001), problem (REQ-TRAJ-006/007), region (REQ-PLAN-005), tensors (sGAN weights
-# and reference files, REQ-HEUR-006), campaign (bench merge shards, REQ-REPORT-006).
-# Needs clang, libclang-rt-14-dev and libomp-14-dev (ci/setup.sh installs them). Prints each
+# and reference files, REQ-HEUR-006), campaign (bench merge shards, REQ-REPORT-006), dataset
+# (dataset --merge parts and the split reader, REQ-HEUR-001/REQ-REPORT-006), cli (the argument
+# layer of every command, REQ-CLI-001..003). Needs Debian's clang-16, libclang-rt-16-dev,
+# libfuzzer-16-dev and libomp-16-dev (ci/setup.sh installs them; MINER_FUZZ_CXX picks another). Prints each
 # target's executions and corpus coverage, and writes them to build/fuzz/summary.txt.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-6}
 runs=${2:--1}
-targets=(octree point_cloud map_json scenario vehicle problem region tensors campaign)
+seed=${MINER_FUZZ_SEED:-20261122}
+targets=(octree point_cloud map_json scenario vehicle problem region tensors campaign dataset cli)
+cxx=${MINER_FUZZ_CXX:-clang++-16}
 out=build/fuzz
 mkdir -p "$out/obj" "$out/artifacts"
 ompl_include=$(ls -d /usr/include/ompl-* | head -1)
@@ -30,27 +38,33 @@ flags=(-std=c++17 -O1 -g -fno-omit-frame-pointer -Isrc -isystem /usr/include/eig
 lib_san=(-fsanitize=fuzzer-no-link,address,undefined)
 # The library code the parsers live in (the linker takes from the archive only what a target uses).
 sources=(src/miner/core/*.cpp src/miner/world/*.cpp src/miner/traj/*.cpp src/miner/plan/*.cpp
-         src/miner/flight/*.cpp src/miner/heuristic/*.cpp src/miner/report/*.cpp src/bench/*.cpp)
-# Objects, rebuilt when their source or any header is newer, two at a time.
+         src/miner/flight/*.cpp src/miner/heuristic/*.cpp src/miner/report/*.cpp src/bench/*.cpp
+         src/cli/cli.cpp src/cli/*_commands.cpp)
+# Objects, rebuilt when their source or any header is newer, two at a time; all of them when the
+# compiler or the flags change.
+stamp="$("$cxx" --version | head -1) ${flags[*]} ${lib_san[*]}"
+if [ "$(cat "$out/obj/stamp" 2>/dev/null)" != "$stamp" ]; then
+  rm -f "$out"/obj/*.o
+  echo "$stamp" >"$out/obj/stamp"
+fi
 printf '%s\n' "${sources[@]}" | xargs -P 2 -I{} bash -c '
   src={}; obj='"$out"'/obj/$(echo "$src" | tr / _).o
-  if [ ! -f "$obj" ] || [ "$src" -nt "$obj" ] || [ -n "$(find src/miner src/bench -name "*.hpp" -newer "$obj" -print -quit)" ]; then
-    clang++ '"${flags[*]}"' '"${lib_san[*]}"' -c "$src" -o "$obj.tmp" && mv "$obj.tmp" "$obj"
+  if [ ! -f "$obj" ] || [ "$src" -nt "$obj" ] || [ -n "$(find src/miner src/bench src/cli -name "*.hpp" -newer "$obj" -print -quit)" ]; then
+    '"$cxx"' '"${flags[*]}"' '"${lib_san[*]}"' -c "$src" -o "$obj.tmp" && mv "$obj.tmp" "$obj"
   fi'
-# The shipped sGAN weights, compiled in as cmake/EmbedFile.cmake does for the product.
-weights=fixtures/sgan/sgan.bin
-if [ ! -f "$out/obj/builtin_weights.o" ] || [ "$weights" -nt "$out/obj/builtin_weights.o" ]; then
-  { echo "#include <cstddef>"; echo "namespace miner::heuristic {"
-    echo "extern const unsigned char kBuiltinSganWeights[] = {"
-    od -An -v -tx1 "$weights" | sed -E 's/ ([0-9a-f]{2})/0x\1,/g'
-    echo "0x00};"; echo "extern const std::size_t kBuiltinSganWeightsSize = $(stat -c %s "$weights");"; echo "}"
-  } >"$out/builtin_weights.cpp"
-  clang++ -std=c++17 -O0 -c "$out/builtin_weights.cpp" -o "$out/obj/builtin_weights.o"
-fi
+# The sources CMake generates (the shipped sGAN weights, the report's scripts, the default
+# scenario) from a configure-only run of the project, so they are the product's own.
+cmake -S . -B "$out/gen" -DMINER_TESTS=OFF >"$out/gen.log"
+mapfile -t generated < <(find "$out/gen/src" -name "*.cpp" | sort)
+for src in "${generated[@]}"; do
+  obj="$out/obj/gen_$(basename "$src" .cpp).o"
+  if [ ! -f "$obj" ] || [ "$src" -nt "$obj" ]; then "$cxx" -std=c++17 -O0 -Isrc -isystem /usr/include/eigen3 -c "$src" -o "$obj"; fi
+done
 rm -f "$out/libminer_fuzz.a"
 objects=()
 for src in "${sources[@]}"; do objects+=("$out/obj/$(echo "$src" | tr / _).o"); done
-ar rcs "$out/libminer_fuzz.a" "${objects[@]}" "$out/obj/builtin_weights.o"
+for src in "${generated[@]}"; do objects+=("$out/obj/gen_$(basename "$src" .cpp).o"); done
+ar rcs "$out/libminer_fuzz.a" "${objects[@]}"
 libs=(-loctomap -loctomath -lompl -lboost_serialization -lboost_filesystem -lboost_system
       /usr/lib/x86_64-linux-gnu/libceres.a -lglog -lgflags -lspqr -lcholmod -lamd -lcamd -lccolamd -lcolamd
       -lsuitesparseconfig -lcxsparse -llapack -lblas -lsundials_cvode -lsundials_nvecserial -ldnnl -lgomp
@@ -58,12 +72,12 @@ libs=(-loctomap -loctomath -lompl -lboost_serialization -lboost_filesystem -lboo
 status=0
 : >"$out/summary.txt"
 for target in "${targets[@]}"; do
-  clang++ "${flags[@]}" -fsanitize=fuzzer,address,undefined "src/fuzz/fuzz_$target.cpp" "$out/libminer_fuzz.a" \
+  "$cxx" "${flags[@]}" -fsanitize=fuzzer,address,undefined "src/fuzz/fuzz_$target.cpp" "$out/libminer_fuzz.a" \
     "${libs[@]}" -o "$out/fuzz_$target"
   corpus=$(mktemp -d)
   cp -r "fixtures/fuzz/$target/." "$corpus/"
-  echo "ci/fuzz.sh: $target for ${seconds}s or $runs runs"
-  if ! UBSAN_OPTIONS=halt_on_error=1 "$out/fuzz_$target" -max_total_time="$seconds" -runs="$runs" -timeout=10 \
+  echo "ci/fuzz.sh: $target for ${seconds}s or $runs runs, seed $seed"
+  if ! UBSAN_OPTIONS=halt_on_error=1 "$out/fuzz_$target" -max_total_time="$seconds" -runs="$runs" -seed="$seed" -timeout=10 \
       -rss_limit_mb=2048 -max_len=65536 -artifact_prefix="$out/artifacts/${target}-" -print_final_stats=1 \
       "$corpus" 2>"$out/$target.log"; then
     tail -40 "$out/$target.log" >&2

@@ -26,7 +26,7 @@ PACKAGES=(
   catch2               # unit tests (Catch2 v2)
   librapidcheck-dev    # property tests
   gcovr                # coverage reports and thresholds
-  clang libclang-rt-14-dev libomp-14-dev   # libFuzzer targets of the parsers (ci/fuzz.sh; omp.h for sgan.cpp)
+  clang-16 libclang-rt-16-dev libfuzzer-16-dev libomp-16-dev   # libFuzzer targets (ci/fuzz.sh; omp.h for sgan.cpp)
   python3              # traceability checker
   # learned heuristic
   libdnnl-dev          # oneDNN: the sGAN's 3D convolutions in C++ (~20x LibTorch's default CPU path)

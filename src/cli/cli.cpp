@@ -143,7 +143,17 @@ void emit(const OutputOptions& o, const Json& doc, const std::string& human, std
   }
 }
 
-int run_cli(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+namespace {
+
+/// Thrown by the top command's parse-complete callback in Mode::kParseOnly: CLI11 runs it
+/// after every option is converted and validated and before any subcommand's callback, so
+/// the line is checked whole and no command runs. (Replacing the commands' callbacks instead
+/// would free the option structs they own while CLI11 still writes into them.)
+struct ParsedOnly {};
+
+enum class Mode { kRun, kParseOnly };
+
+int cli_main(const std::vector<std::string>& args, std::ostream& out, std::ostream& err, Mode mode) {
   CLI::App app{"miner — MINER-RRT* quadrotor planning and flight stack", "miner"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "miner 0.1.0");
@@ -153,6 +163,7 @@ int run_cli(const std::vector<std::string>& args, std::ostream& out, std::ostrea
   add_plan_commands(app, out);
   add_fly_commands(app, out);
   add_heuristic_commands(app, out);
+  if (mode == Mode::kParseOnly) app.parse_complete_callback([] { throw ParsedOnly{}; });
 
   // An unknown command is named, with the commands there are and the nearest one (CLI11
   // alone says only "A subcommand is required").
@@ -187,6 +198,8 @@ int run_cli(const std::vector<std::string>& args, std::ostream& out, std::ostrea
   std::vector<std::string> reversed(args.rbegin(), args.rend());
   try {
     app.parse(reversed);
+  } catch (const ParsedOnly&) {
+    return 0;
   } catch (const CLI::CallForHelp& e) {
     out << app.help();
     return 0;
@@ -211,6 +224,16 @@ int run_cli(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     return static_cast<int>(ExitCode::kInvalidInput);
   }
   return 0;
+}
+
+}  // namespace
+
+int run_cli(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+  return cli_main(args, out, err, Mode::kRun);
+}
+
+int check_cli_arguments(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+  return cli_main(args, out, err, Mode::kParseOnly);
 }
 
 }  // namespace miner::cli

@@ -23,6 +23,12 @@ namespace miner::cli {
 /// (miner::ExitCode). Never throws: every error becomes "miner: error: ..." on `err`.
 int run_cli(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 
+/// The argument layer alone: parses `miner <args...>` exactly as run_cli does (commands,
+/// options, counts, validators, the unknown-command message) but runs no command. Returns
+/// run_cli's exit code for a refused line and 0 for a line run_cli would start to run. The
+/// fuzz target src/fuzz/fuzz_cli.cpp drives it (REQ-HARNESS-006); never throws, never writes.
+int check_cli_arguments(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+
 /// Options shared by commands that produce a result: --json prints it as JSON instead
 /// of the human text, --out also writes the JSON to a file (atomically).
 struct OutputOptions {

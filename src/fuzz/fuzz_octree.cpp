@@ -1,10 +1,11 @@
 // libFuzzer target: MINER's OctoMap reader (REQ-WORLD-014). Any bytes either parse or raise
 // miner::Error; what parses writes back as .bt bytes that parse to the same voxels.
 //
-// The write-back runs on layers of at most kRoundTripCells voxels: a file of a few bytes may
-// legitimately announce a map of up to kMaxGridCells (2.7e8) voxels, which the writer walks in
-// linear time (~40 s under ASan at -O1), longer than the 10 s per-input limit. That cost is
-// bounded and expected, not a finding; the reader's own bound is still exercised on every input.
+// The reader runs with a bound of kFuzzCells voxels instead of kMaxGridCells (2.7e8): a file of
+// a few bytes may legitimately announce a map that large, which the reader fills and the writer
+// walks in linear time (~40 s under ASan at -O1, over the 10 s per-input limit, and 200
+// executions/s instead of thousands). That cost is bounded and expected, not a finding; the
+// bound's check is the same code with a smaller constant.
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -16,9 +17,8 @@
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string bytes(reinterpret_cast<const char*>(data), size);
   try {
-    const auto layer = miner::world::parse_octree(bytes, "fuzz");
-    constexpr std::size_t kRoundTripCells = std::size_t{1} << 22;
-    if (layer->size() > kRoundTripCells) return 0;
+    constexpr double kFuzzCells = 1 << 22;
+    const auto layer = miner::world::parse_octree(bytes, "fuzz", kFuzzCells);
     if (layer->count(miner::world::VoxelState::kUnknown) == layer->size()) return 0;
     const std::string bt = miner::world::octree_bt_bytes(*layer);
     const auto again = miner::world::parse_octree(bt, "fuzz-again");

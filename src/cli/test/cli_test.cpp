@@ -266,6 +266,32 @@ TEST_CASE("Output paths are checked before any work", "[REQ-CLI-003]") {
   CHECK_THAT(file_as_folder.err, Contains("is a file, not a folder"));
 }
 
+TEST_CASE("The argument layer alone: refusals as run_cli gives them, and no command run", "[REQ-CLI-002][REQ-HARNESS-006]") {
+  const auto check = [](const std::vector<std::string>& args) {
+    std::ostringstream out, err;
+    const int code = miner::cli::check_cli_arguments(args, out, err);
+    return Run{code, out.str(), err.str()};
+  };
+  // A refused line: the same code and message as the command itself.
+  for (const std::vector<std::string>& bad :
+       {std::vector<std::string>{"plna"}, {"plan", "--seed", "-1", "--map", "x.json"}, {"fly", "--out", ""},
+        {"bench", "merge"}, {"astar", "--map", "m.json", "--radius", "-1"}, {"region", "astar", "--dims", "1", "2"}}) {
+    const Run a = check(bad), b = miner_cli(bad);
+    INFO(b.err);
+    CHECK(a.code != 0);
+    CHECK(a.code == b.code);
+    CHECK(a.err == b.err);
+  }
+  // An accepted line runs nothing: the run folder is not written, nothing is printed.
+  const std::string run = dir() + "/parse-only-run";
+  const Run ok = check({"fly", "--out", run, "--seed", "3"});
+  CHECK(ok.code == 0);
+  CHECK(ok.out.empty());
+  CHECK(ok.err.empty());
+  CHECK_FALSE(std::filesystem::exists(run));
+  CHECK(check({"bench", "merge", "a.json", "b.json"}).code == 0);  // the files are read by the command, not the parser
+}
+
 TEST_CASE("Seeds are refused, not wrapped or clamped, when negative or above 2^64 - 1", "[REQ-CLI-002]") {
   const std::string out = dir() + "/seed-map.json";
   for (const char* bad : {"-1", "18446744073709551616", "99999999999999999999999", "1e3", "0x10", ""}) {

@@ -9,11 +9,13 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <set>
 #include <sstream>
 
 #include "miner/core/error.hpp"
 #include "miner/core/progress.hpp"
 #include "miner/core/rng.hpp"
+#include "miner/core/sha256.hpp"
 #include "miner/core/shard.hpp"
 #include "miner/heuristic/grid.hpp"
 #include "miner/plan/heuristic_region.hpp"
@@ -33,6 +35,132 @@ std::string shard_name(const std::string& split, std::size_t i) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%s-%05zu.bin", split.c_str(), i);
   return buf;
+}
+
+/// At most 2^30 samples per split or shard: with <= 2^24 cells a sample, every byte count
+/// (count x 3 x cells < 2^56) is exact in 64 bits.
+constexpr int kMaxSamples = 1 << 30;
+
+/// A file a dataset.json names: one plain name inside the folder. A name such as "../x" would
+/// make a reader read, and a merge write, outside the folder (issue 20).
+std::string plain_file_name(const JsonField& f) {
+  const std::string name = f.string();
+  if (name.empty() || name == "." || name == ".." || name.size() > 255 || name.find('/') != std::string::npos ||
+      name.find('\0') != std::string::npos)
+    f.fail("must be a plain file name inside the dataset folder, got \"" + name + "\"");
+  return name;
+}
+
+int bounded_count(const JsonField& f, int lo) {
+  const int n = f.integer();
+  if (n < lo || n > kMaxSamples)
+    f.fail("must be an integer in [" + std::to_string(lo) + ", " + std::to_string(kMaxSamples) + "], got " +
+           std::to_string(n));
+  return n;
+}
+
+struct ShardRecord {
+  std::string file;
+  std::size_t count = 0;
+  std::string sha256;
+};
+struct SplitLayout {
+  std::size_t count = 0;  // samples of the split in the whole dataset
+  std::string index;
+  std::vector<ShardRecord> shards;  // those in this folder
+  std::size_t samples_here = 0;     // their sum
+};
+/// What dataset.json says, checked: the one place its structure is read (REQ-HEUR-001).
+struct DatasetLayout {
+  Eigen::Vector3i dims;
+  std::size_t cells = 0;
+  SplitLayout splits[3];
+  bool is_part = false;
+  int part_index = 0, part_count = 1;
+};
+
+DatasetLayout read_layout(const Json& doc, const std::string& origin) {
+  const JsonField root(doc, "", origin);
+  root.only_keys({"format", "preset", "seed", "dims", "bounds", "channels", "environment_levels", "dtype", "layout",
+                  "robot_radius", "dilation", "min_separation", "map_seed_rule", "splits", "part"});
+  if (root.at("format").string() != kDatasetFormat)
+    root.at("format").fail(std::string("not a dataset folder (expected \"") + kDatasetFormat + "\")");
+  DatasetLayout L;
+  const JsonField dims = root.at("dims");
+  if (dims.array_size() != 3) dims.fail("expected [nx, ny, nz]");
+  for (int a = 0; a < 3; ++a) {
+    L.dims[a] = dims.at(static_cast<std::size_t>(a)).integer();
+    if (L.dims[a] < 4 || L.dims[a] > 256) dims.at(static_cast<std::size_t>(a)).fail("must be in [4, 256] cells");
+  }
+  L.cells = static_cast<std::size_t>(L.dims.x()) * static_cast<std::size_t>(L.dims.y()) *
+            static_cast<std::size_t>(L.dims.z());
+  if (root.has("part")) {
+    const JsonField part = root.at("part");
+    part.only_keys({"index", "count"});
+    L.is_part = true;
+    L.part_count = part.at("count").integer();
+    L.part_index = part.at("index").integer();
+    if (L.part_count < 1 || L.part_count > kMaxSamples || L.part_index < 0 || L.part_index >= L.part_count)
+      part.fail("needs 0 <= index < count");
+  }
+  const JsonField splits = root.at("splits");
+  splits.only_keys({"train", "val", "test"});
+  for (int sp = 0; sp < 3; ++sp) {
+    const JsonField f = splits.at(kSplits[sp]);
+    f.only_keys({"count", "index", "shards"});
+    SplitLayout& S = L.splits[sp];
+    S.count = static_cast<std::size_t>(bounded_count(f.at("count"), 0));
+    S.index = plain_file_name(f.at("index"));
+    const JsonField shards = f.at("shards");
+    for (std::size_t i = 0; i < shards.array_size(); ++i) {
+      const JsonField r = shards.at(i);
+      r.only_keys({"file", "count", "sha256"});
+      ShardRecord rec{plain_file_name(r.at("file")), static_cast<std::size_t>(bounded_count(r.at("count"), 1)),
+                      r.at("sha256").string()};
+      if (rec.sha256.size() != 64 || rec.sha256.find_first_not_of("0123456789abcdef") != std::string::npos)
+        r.at("sha256").fail("expected 64 lower-case hex digits");
+      S.samples_here += rec.count;
+      S.shards.push_back(std::move(rec));
+    }
+    if (L.is_part ? S.samples_here > S.count : S.samples_here != S.count)
+      f.fail("its shards hold " + std::to_string(S.samples_here) + " samples, the split " + std::to_string(S.count));
+  }
+  return L;
+}
+
+/// A shard's bytes, checked against its record: 3 grids per sample and the recorded SHA-256.
+std::string read_shard(const std::string& dir, const ShardRecord& r, std::size_t cells) {
+  const std::string path = dir + "/" + r.file;
+  std::string bytes = read_file_bytes(path, "dataset shard");
+  const std::size_t expected = r.count * 3 * cells;
+  if (bytes.size() != expected)
+    throw Error(path + ": expected " + std::to_string(expected) + " bytes (" + std::to_string(r.count) +
+                " samples of 3 x " + std::to_string(cells) + "), found " + std::to_string(bytes.size()));
+  if (sha256_hex(bytes) != r.sha256)
+    throw Error(path + ": its SHA-256 differs from the one dataset.json records (the file was changed)");
+  return bytes;
+}
+
+/// A split's index entries, checked: one per sample of the folder's shards, each with its k.
+std::vector<Json> read_index(const std::string& dir, const SplitLayout& S) {
+  const std::string path = dir + "/" + S.index;
+  const Json index = read_json_file(path);
+  const JsonField f(index, "", path);
+  if (f.array_size() != S.samples_here)
+    f.fail("has " + std::to_string(f.array_size()) + " entries, the shards " + std::to_string(S.samples_here) +
+           " samples");
+  std::vector<Json> out;
+  for (std::size_t i = 0; i < f.array_size(); ++i) {
+    const JsonField e = f.at(i);
+    e.only_keys({"k", "map_seed", "start", "goal", "astar_cost"});
+    for (const char* key : {"k", "map_seed"})
+      if (!e.at(key).value().is_number_unsigned()) e.at(key).fail("expected an integer in [0, 2^64 - 1]");
+    e.at("start").vec3();
+    e.at("goal").vec3();
+    e.at("astar_cost").number();
+    out.push_back(e.value());
+  }
+  return out;
 }
 
 }  // namespace
@@ -110,7 +238,7 @@ Json write_dataset(const DatasetOptions& o, const std::string& dir, std::ostream
     auto flush = [&] {
       if (in_shard == 0) return;
       const std::string name = shard_name(kSplits[sp], static_cast<std::size_t>(file_number));
-      shards.push_back({{"file", name}, {"count", in_shard}});
+      shards.push_back({{"file", name}, {"count", in_shard}, {"sha256", sha256_hex(shard)}});
       files.emplace_back(name, std::move(shard));
       shard.clear();
       in_shard = 0;
@@ -184,10 +312,11 @@ Json write_dataset(const DatasetOptions& o, const std::string& dir, std::ostream
 Json merge_dataset_parts(const std::vector<std::string>& parts, const std::string& dir) {
   if (parts.empty()) throw Error("dataset merge: no part folders");
   std::vector<Json> docs;
+  std::vector<DatasetLayout> layouts;
   for (const auto& p : parts) {
     docs.push_back(read_json_file(p + "/dataset.json"));
-    if (docs.back().value("format", "") != kDatasetFormat) throw Error(p + ": not a miner-dataset-v1 folder");
-    if (!docs.back().contains("part")) throw Error(p + ": not a part folder (made without --shard)");
+    layouts.push_back(read_layout(docs.back(), p + "/dataset.json"));
+    if (!layouts.back().is_part) throw Error(p + ": not a part folder (made without --shard)");
   }
   const auto common = [](Json d) {
     d.erase("part");
@@ -204,28 +333,28 @@ Json merge_dataset_parts(const std::vector<std::string>& parts, const std::strin
   Json doc = docs.front();
   doc.erase("part");
   std::vector<std::pair<std::string, std::string>> files;
-  const JsonField dims_field(doc.at("dims"), "dims", parts.front() + "/dataset.json");
-  const std::uint64_t cells = plan::HeuristicRegion::cell_count(
-      Eigen::Vector3i(dims_field.at(std::size_t{0}).integer(), dims_field.at(std::size_t{1}).integer(),
-                      dims_field.at(std::size_t{2}).integer()));
-  for (const char* split : kSplits) {
+  std::set<std::string> names;  // every file of the merged folder, once
+  for (int sp = 0; sp < 3; ++sp) {
+    const char* split = kSplits[sp];
     std::vector<std::pair<std::string, Json>> shards;  // file name -> shard record, from every part
     std::vector<Json> index;
+    std::set<std::uint64_t> ks;
     for (std::size_t p = 0; p < parts.size(); ++p) {
-      const Json& sp = docs[p]["splits"][split];
-      for (const auto& shard : sp["shards"]) {
-        const std::string name = shard["file"].get<std::string>();
-        shards.emplace_back(name, shard);
-        std::string bytes = read_file_bytes(parts[p] + "/" + name, "dataset shard");
-        // A truncated or padded shard is refused, not copied (issue 20): 3 grids per sample.
-        const std::uint64_t expected = shard["count"].get<std::uint64_t>() * 3u * cells;
-        if (bytes.size() != expected)
-          throw Error(parts[p] + "/" + name + ": expected " + std::to_string(expected) + " bytes (" +
-                      std::to_string(shard["count"].get<std::uint64_t>()) + " samples of 3 x " + std::to_string(cells) +
-                      "), found " + std::to_string(bytes.size()));
-        files.emplace_back(name, std::move(bytes));
+      const SplitLayout& S = layouts[p].splits[sp];
+      for (std::size_t i = 0; i < S.shards.size(); ++i) {
+        const ShardRecord& r = S.shards[i];
+        if (!names.insert(r.file).second)
+          throw Error(parts[p] + "/dataset.json: splits." + split + ".shards[" + std::to_string(i) + "].file: \"" +
+                      r.file + "\" is named by another part or split too");
+        // A truncated, padded or altered shard is refused, not copied (issue 20).
+        files.emplace_back(r.file, read_shard(parts[p], r, layouts[p].cells));
+        shards.emplace_back(r.file, docs[p]["splits"][split]["shards"][i]);
       }
-      for (const auto& e : read_json_file(parts[p] + "/" + sp["index"].get<std::string>())) index.push_back(e);
+      for (Json& e : read_index(parts[p], S)) {
+        if (!ks.insert(e["k"].get<std::uint64_t>()).second)
+          throw Error(parts[p] + "/" + S.index + ": sample k = " + e["k"].dump() + " appears in two parts");
+        index.push_back(std::move(e));
+      }
     }
     std::sort(shards.begin(), shards.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
     std::sort(index.begin(), index.end(),
@@ -233,13 +362,18 @@ Json merge_dataset_parts(const std::vector<std::string>& parts, const std::strin
     Json list = Json::array();
     for (const auto& s : shards) list.push_back(s.second);
     doc["splits"][split]["shards"] = list;
-    std::uint64_t samples = 0;
-    for (const auto& s : shards) samples += s.second["count"].get<std::uint64_t>();
-    if (samples != doc["splits"][split]["count"].get<std::uint64_t>() || index.size() != samples)
-      throw Error("dataset merge: split " + std::string(split) + " has " + std::to_string(samples) + " samples, expected " +
-                  std::to_string(doc["splits"][split]["count"].get<std::uint64_t>()));
-    files.emplace_back(std::string(split) + "-index.json", dump_json(Json(index)));
+    const std::size_t expected = layouts.front().splits[sp].count;
+    if (index.size() != expected)
+      throw Error("dataset merge: split " + std::string(split) + " has " + std::to_string(index.size()) +
+                  " samples in its parts, expected " + std::to_string(expected));
+    const std::string index_name = layouts.front().splits[sp].index;
+    if (!names.insert(index_name).second || index_name == "dataset.json")
+      throw Error(parts.front() + "/dataset.json: splits." + std::string(split) + ".index: \"" + index_name +
+                  "\" is the name of another file of the dataset");
+    files.emplace_back(index_name, dump_json(Json(index)));
   }
+  if (names.count("dataset.json"))
+    throw Error("dataset merge: a shard is named dataset.json, the name of the dataset's description");
   // Shard files in the unsharded run's order (split by split), then dataset.json.
   files.emplace_back("dataset.json", dump_json(doc));
   write_folder_atomic(dir, files);
@@ -247,34 +381,28 @@ Json merge_dataset_parts(const std::vector<std::string>& parts, const std::strin
 }
 
 std::vector<Sample> read_split(const std::string& dir, const std::string& split) {
-  const Json doc = read_json_file(dir + "/dataset.json");
-  const JsonField root(doc, "", dir + "/dataset.json");
-  if (root.at("format").string() != kDatasetFormat) root.at("format").fail("not a miner-dataset-v1 folder");
-  const JsonField dims_field = root.at("dims");
-  const Eigen::Vector3i dims(dims_field.at(0).integer(), dims_field.at(1).integer(), dims_field.at(2).integer());
-  const std::size_t cells = static_cast<std::size_t>(dims.prod());
-  const JsonField sp = root.at("splits").at(split);
-  const Json index = read_json_file(dir + "/" + sp.at("index").string());
+  const int sp = static_cast<int>(std::find_if(std::begin(kSplits), std::end(kSplits),
+                                               [&](const char* s) { return split == s; }) -
+                                  std::begin(kSplits));
+  if (sp == 3) throw Error("dataset: no split \"" + split + "\" (train, val, test)");
+  const DatasetLayout L = read_layout(read_json_file(dir + "/dataset.json"), dir + "/dataset.json");
+  const SplitLayout& S = L.splits[sp];
+  const std::vector<Json> index = read_index(dir, S);
   std::vector<Sample> out;
-  for (std::size_t i = 0; i < sp.at("shards").array_size(); ++i) {
-    const JsonField shard = sp.at("shards").at(i);
-    const std::string path = dir + "/" + shard.at("file").string();
-    const auto n = static_cast<std::size_t>(shard.at("count").integer());
-    const std::string bytes = read_file_bytes(path, "the dataset shard");
-    if (bytes.size() != n * 3 * cells)
-      throw Error(path + ": expected " + std::to_string(n * 3 * cells) + " bytes (" + std::to_string(n) +
-                  " samples of 3 x " + std::to_string(cells) + "), found " + std::to_string(bytes.size()));
-    for (std::size_t s = 0; s < n; ++s) {
+  for (const ShardRecord& r : S.shards) {
+    const std::string bytes = read_shard(dir, r, L.cells);
+    for (std::size_t s = 0; s < r.count; ++s) {
+      const Json& meta = index[out.size()];
+      const JsonField f(meta, split + "-index[" + std::to_string(out.size()) + "]", dir + "/" + S.index);
       Sample sample;
-      const JsonField meta(index.at(out.size()), split + "-index[" + std::to_string(out.size()) + "]", dir);
-      sample.map_seed = index.at(out.size()).at("map_seed").get<std::uint64_t>();
-      sample.start = meta.at("start").vec3();
-      sample.goal = meta.at("goal").vec3();
-      sample.astar_cost = meta.at("astar_cost").number();
-      const auto* base = reinterpret_cast<const std::uint8_t*>(bytes.data()) + s * 3 * cells;
-      sample.environment.assign(base, base + cells);
-      sample.state.assign(base + cells, base + 2 * cells);
-      sample.target.assign(base + 2 * cells, base + 3 * cells);
+      sample.map_seed = meta.at("map_seed").get<std::uint64_t>();
+      sample.start = f.at("start").vec3();
+      sample.goal = f.at("goal").vec3();
+      sample.astar_cost = f.at("astar_cost").number();
+      const auto* base = reinterpret_cast<const std::uint8_t*>(bytes.data()) + s * 3 * L.cells;
+      sample.environment.assign(base, base + L.cells);
+      sample.state.assign(base + L.cells, base + 2 * L.cells);
+      sample.target.assign(base + 2 * L.cells, base + 3 * L.cells);
       out.push_back(std::move(sample));
     }
   }

@@ -222,13 +222,23 @@ std::string exact_decimal(double v) {
 
 }  // namespace
 
-std::shared_ptr<const VoxelLayer> parse_octree(const std::string& bytes, const std::string& origin) {
+std::shared_ptr<const VoxelLayer> parse_octree(const std::string& bytes, const std::string& origin,
+                                               double max_cells) {
   const Header h = parse_header(bytes, origin);
-  return layer_from_leaves(read_leaves(bytes, h, origin), h.res, origin);
+  return layer_from_leaves(read_leaves(bytes, h, origin), h.res, origin, max_cells);
+}
+
+std::shared_ptr<const VoxelLayer> parse_octree(const std::string& bytes, const std::string& origin) {
+  return parse_octree(bytes, origin, kMaxGridCells);
 }
 
 std::shared_ptr<const VoxelLayer> layer_from_leaves(const std::vector<OctreeLeaf>& leaves, double resolution,
                                                     const std::string& origin) {
+  return layer_from_leaves(leaves, resolution, origin, kMaxGridCells);
+}
+
+std::shared_ptr<const VoxelLayer> layer_from_leaves(const std::vector<OctreeLeaf>& leaves, double resolution,
+                                                    const std::string& origin, double max_cells) {
   if (leaves.empty()) fail(origin, "the tree has no known leaf");
   std::array<std::int64_t, 3> lo{}, hi{};
   lo.fill(INT64_MAX);
@@ -242,10 +252,10 @@ std::shared_ptr<const VoxelLayer> layer_from_leaves(const std::vector<OctreeLeaf
   }
   const double cells = static_cast<double>(hi[0] - lo[0]) * static_cast<double>(hi[1] - lo[1]) *
                        static_cast<double>(hi[2] - lo[2]);
-  if (cells > kMaxGridCells) {
+  if (cells > max_cells) {
     std::ostringstream os;
     os << "the known leaves span " << hi[0] - lo[0] << " x " << hi[1] - lo[1] << " x " << hi[2] - lo[2]
-       << " voxels, more than the " << kMaxGridCells << " a map may hold";
+       << " voxels, more than the " << max_cells << " a map may hold";
     fail(origin, os.str());
   }
   const Eigen::Vector3i dims(static_cast<int>(hi[0] - lo[0]), static_cast<int>(hi[1] - lo[1]),

@@ -41,14 +41,22 @@ struct OctreeLeaf {
   VoxelState state;
 };
 /// The layer of a set of leaves: bounded by their extent, unknown between them. Throws
-/// (prefixed by `origin`) when the extent exceeds kMaxGridCells or no leaf is given.
+/// (prefixed by `origin`) when the extent exceeds `max_cells` (default kMaxGridCells) or no
+/// leaf is given.
+std::shared_ptr<const VoxelLayer> layer_from_leaves(const std::vector<OctreeLeaf>& leaves, double resolution,
+                                                    const std::string& origin, double max_cells);
 std::shared_ptr<const VoxelLayer> layer_from_leaves(const std::vector<OctreeLeaf>& leaves, double resolution,
                                                     const std::string& origin);
 
 /// Reads a .bt or .ot file into a layer whose voxels are unknown outside the tree's leaves and
 /// whose bounds are the leaves' extent.
 std::shared_ptr<const VoxelLayer> read_octree(const std::string& path);
-/// Parses the bytes of a .bt or .ot file; `origin` names it in messages.
+/// Parses the bytes of a .bt or .ot file; `origin` names it in messages. A tree whose known
+/// leaves span more than `max_cells` voxels is refused (the fuzz target lowers the bound so its
+/// executions stay fast; the check is the same).
+std::shared_ptr<const VoxelLayer> parse_octree(const std::string& bytes, const std::string& origin,
+                                               double max_cells);
+/// parse_octree bounded by kMaxGridCells, the bound of every map.
 std::shared_ptr<const VoxelLayer> parse_octree(const std::string& bytes, const std::string& origin);
 
 /// The .bt bytes of a layer (free and occupied voxels; unknown ones are left out). Throws

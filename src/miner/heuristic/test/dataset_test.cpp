@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "miner/core/error.hpp"
+#include "miner/core/json_io.hpp"
 #include "miner/core/progress.hpp"
 #include "miner/heuristic/dataset.hpp"
 
@@ -182,6 +183,81 @@ TEST_CASE("The dataset has its splits, unseen test seeds and the same bytes for 
   // A truncated shard is refused naming the file and the sizes.
   std::filesystem::resize_file(a + "/test-00000.bin", 100);
   CHECK_THROWS_WITH(heuristic::read_split(a, "test"), Contains("test-00000.bin") && Contains("expected"));
+}
+
+TEST_CASE("A dataset folder that contradicts itself is refused naming the file and field",
+          "[REQ-HEUR-001][REQ-REPORT-006]") {
+  namespace fs = std::filesystem;
+  auto o = small_options();
+  o.dims = Eigen::Vector3i(8, 8, 4);
+  o.shard_count = 2;
+  const std::string root = temp_dir() + "/lies";
+  fs::remove_all(root);
+  const std::string p0 = root + "/p0", p1 = root + "/p1";
+  o.shard_index = 0;
+  heuristic::write_dataset(o, p0, nullptr);  // train-00000 (2 samples), val-00000, test-00000
+  o.shard_index = 1;
+  heuristic::write_dataset(o, p1, nullptr);  // train-00001 (1 sample)
+  heuristic::merge_dataset_parts({p0, p1}, root + "/honest");
+  CHECK(heuristic::read_split(root + "/honest", "train").size() == 3);
+  const auto edit_json = [](const std::string& path, const auto& change) {
+    miner::Json d = miner::read_json_file(path);
+    change(d);
+    miner::write_file_atomic(path, miner::dump_json(d));
+  };
+  int n = 0;
+  // Copies the honest parts, breaks the copy, and expects the merge to refuse it naming `what`
+  // without writing the output folder.
+  const auto refused = [&](const auto& break_it, const std::string& what) {
+    const std::string q0 = root + "/q0-" + std::to_string(n), q1 = root + "/q1-" + std::to_string(n);
+    const std::string out = root + "/out-" + std::to_string(n++);
+    fs::copy(p0, q0);
+    fs::copy(p1, q1);
+    break_it(q0, q1);
+    CHECK_THROWS_WITH(heuristic::merge_dataset_parts({q0, q1}, out), Contains(what));
+    CHECK_FALSE(fs::exists(out));
+    return q0;
+  };
+  // A shard name that leaves the folder: neither read nor written outside it.
+  fs::copy_file(p0 + "/train-00000.bin", root + "/escape.bin");
+  refused(
+      [&](const std::string& q0, const std::string&) {
+        edit_json(q0 + "/dataset.json", [](miner::Json& d) { d["splits"]["train"]["shards"][0]["file"] = "../escape.bin"; });
+      },
+      "splits.train.shards[0].file: must be a plain file name");
+  // One byte changed, the size kept: the recorded SHA-256 catches it, in a merge and a read.
+  const std::string altered = refused(
+      [&](const std::string& q0, const std::string&) {
+        std::fstream f(q0 + "/train-00000.bin", std::ios::in | std::ios::out | std::ios::binary);
+        f.seekp(5);
+        f.put('\x07');
+      },
+      "train-00000.bin: its SHA-256 differs");
+  CHECK_THROWS_WITH(heuristic::read_split(altered, "train"), Contains("SHA-256"));
+  // A misspelt key is not ignored.
+  refused(
+      [&](const std::string& q0, const std::string&) {
+        edit_json(q0 + "/dataset.json", [](miner::Json& d) { d["splits"]["val"]["shard"] = miner::Json::array(); });
+      },
+      "did you mean \"shards\"");
+  // The same sample claimed by both parts.
+  refused(
+      [&](const std::string&, const std::string& q1) {
+        edit_json(q1 + "/train-index.json", [](miner::Json& d) { d[0]["k"] = 0; });
+      },
+      "sample k = 0 appears in two parts");
+  // An index that does not match its shards.
+  refused(
+      [&](const std::string& q0, const std::string&) {
+        edit_json(q0 + "/train-index.json", [](miner::Json& d) { d.erase(d.size() - 1); });
+      },
+      "train-index.json: (top level): has 1 entries, the shards 2 samples");
+  // A negative map seed (nlohmann would wrap it on reading).
+  refused(
+      [&](const std::string& q0, const std::string&) {
+        edit_json(q0 + "/test-index.json", [](miner::Json& d) { d[0]["map_seed"] = -1; });
+      },
+      "map_seed: expected an integer in [0, 2^64 - 1]");
 }
 
 TEST_CASE("Bad dataset options are refused naming the option", "[REQ-HEUR-003]") {

@@ -13,7 +13,8 @@
 #
 # The mutation stream is seeded (MINER_FUZZ_SEED, default 20261122), so CI explores the same
 # inputs every time (up to libFuzzer's corpus reduction, which is not bit-for-bit stable);
-# MINER_FUZZ_SEED=0 lets libFuzzer draw a fresh seed (exploration campaigns).
+# MINER_FUZZ_SEED=0 lets libFuzzer draw a fresh seed (exploration campaigns); MINER_FUZZ_TARGETS
+# ("dataset cli") runs a subset.
 #
 # Targets (src/fuzz/fuzz_<target>.cpp): octree (.bt/.ot, REQ-WORLD-014), point_cloud (PLY/PCD,
 # REQ-WORLD-018), map_json (REQ-WORLD-001/002), scenario (REQ-FLIGHT-007), vehicle
@@ -29,6 +30,7 @@ seconds=${1:-6}
 runs=${2:--1}
 seed=${MINER_FUZZ_SEED:-20261122}
 targets=(octree point_cloud map_json scenario vehicle problem region tensors campaign dataset cli)
+if [ -n "${MINER_FUZZ_TARGETS:-}" ]; then read -r -a targets <<<"$MINER_FUZZ_TARGETS"; fi  # a subset
 cxx=${MINER_FUZZ_CXX:-clang++-16}
 out=build/fuzz
 mkdir -p "$out/obj" "$out/artifacts"

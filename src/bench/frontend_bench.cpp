@@ -403,8 +403,12 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
     const JsonField records = root.at("run_records");
     for (std::size_t k = 0; k < records.array_size(); ++k) {
       const JsonField r = records.at(k);
+      r.only_keys({"planner", "run", "solved", "cost", "iterations", "first", "target"});
       (void)r.at("planner").string();
       (void)r.at("run").integer();
+      // A cost is a path length: finite and >= 0 (issue 20: a cost of -5 was averaged in).
+      if (r.has("cost") && r.at("cost").value().is_number() && !(r.at("cost").number() >= 0.0))
+        r.at("cost").fail("a path cost must be >= 0");
       try {
         runs.push_back(run_from(parts[p]["run_records"][k]));
       } catch (const nlohmann::json::exception& e) {
@@ -452,6 +456,30 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
   }
   std::vector<std::string> order;
   for (const auto& s : parts.front().at("planners")) order.push_back(s.at("planner").get<std::string>());
+  // Every record belongs to the campaign (a planner it ran, a run r < runs, in the part that
+  // runs it: r % N == i), and every (planner, run) of the campaign has its record (issue 20: a
+  // part missing a record merged into "5 runs" of 6).
+  const int campaign_runs = JsonField(parts.front(), "", names.front()).at("runs").integer();
+  for (std::size_t p = 0; p < parts.size(); ++p) {
+    const auto& records = parts[p].at("run_records");
+    const int index = parts[p].at("shard").at("index").get<int>(), count = parts[p].at("shard").at("count").get<int>();
+    for (std::size_t k = 0; k < records.size(); ++k) {
+      const std::string planner = records[k].at("planner").get<std::string>();
+      const int run = records[k].at("run").get<int>();
+      const std::string where = names[p] + ": run_records[" + std::to_string(k) + "]";
+      if (std::find(order.begin(), order.end(), planner) == order.end())
+        throw Error("merge: " + where + ".planner: \"" + planner + "\" is not a planner of this campaign");
+      if (run < 0 || run >= campaign_runs || run % count != index)
+        throw Error("merge: " + where + ".run: run " + std::to_string(run) + " is not a run of part " +
+                    std::to_string(index) + "/" + std::to_string(count) + " of a campaign of " +
+                    std::to_string(campaign_runs) + " runs");
+    }
+  }
+  for (const auto& planner : order)
+    for (int run = 0; run < campaign_runs; ++run)
+      if (!seen.count({planner, run}))
+        throw Error("merge: planner " + planner + " run " + std::to_string(run) + " has no record in any part (part " +
+                    std::to_string(run % static_cast<int>(parts.size())) + " is incomplete)");
   const auto rank = [&](const std::string& planner) {
     return std::find(order.begin(), order.end(), planner) - order.begin();
   };

@@ -64,7 +64,8 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   bench_cmd->require_subcommand(1);
   auto o = std::make_shared<BackendOptions>();
   CLI::App* b = bench_cmd->add_subcommand("backend", "MINCO vs dense LU, closed form and KKT QP (paper Table II)");
-  b->add_option("--segments", o->bench.segments, "segment counts M")->capture_default_str()->delimiter(',');
+  b->add_option("--segments", o->bench.segments, "segment counts M")->capture_default_str()->delimiter(',')
+      ->check(CLI::Range(1, 1000000));
   b->add_option("--orders", o->bench.orders, "orders s (3 jerk, 4 snap)")->capture_default_str()->delimiter(',');
   b->add_option("--methods", o->bench.methods, "minco, dense-lu, closed-form, kkt-qp")->capture_default_str()->delimiter(',');
   b->add_option("--max-dense-segments", o->bench.max_dense_segments, "skip the O(M^3) baselines above this M")
@@ -87,13 +88,13 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   fc->add_option("--planners", f->bench.planners,
                  "planners (default: rrtstar,informed,guided,miner and every ompl:* planner)")
       ->delimiter(',');
-  fc->add_option("--runs", f->bench.runs, "runs per planner")->check(kPositive)->capture_default_str();
+  fc->add_option("--runs", f->bench.runs, "runs per planner")->check(kRunsRange)->capture_default_str();
   fc->add_option("--seed", f->bench.seed, "master seed (run k uses stream k)")->capture_default_str()->check(kUnsigned64);
   fc->add_option("--target-factor", f->bench.target_factor, "target cost = this x the A* reference cost")
       ->check(kPositive)
       ->capture_default_str();
   fc->add_option("--max-iterations", f->bench.max_iterations, "iteration budget per run")
-      ->check(kPositive)
+      ->check(kIterationsRange)
       ->capture_default_str();
   fc->add_option("--time-limit", f->bench.time_limit_s, "wall-clock cap per run in s")
       ->check(kPositive)
@@ -109,7 +110,8 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   fc->add_option("--region-dims", f->region_dims, "A*-dilated region grid")->expected(3)->check(kPositive);
   fc->add_option("--throughput-iterations", f->bench.throughput_iterations,
                  "iterations of the rrtstar vs ompl:RRTstar throughput check (0: skip)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(CLI::Range(0, kMaxIterations));
   fc->add_option("--ompl-log", f->ompl_log, "also write OMPL's benchmark log format to this file")->check(kOutputFile);
   fc->add_option("--shard", f->shard, "i/N: run only runs r with r % N == i (join the parts with `miner bench merge`)");
   fc->add_flag("--quiet", f->quiet, "no progress bar on stderr");
@@ -130,7 +132,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   hc->add_option("--weights", h->bench.weights, "sGAN weights (default: the shipped fixtures/sgan/sgan.bin)");
   hc->add_option("--seed", h->bench.seed, "noise seed (sample k: seed + k) and planner seed")->capture_default_str()->check(kUnsigned64);
   hc->add_option("--iterations", h->bench.max_iterations, "planner iteration budget per query")
-      ->check(kPositive)
+      ->check(kIterationsRange)
       ->capture_default_str();
   hc->add_option("--target-factor", h->bench.target_factor, "target cost = this x the sample's A* cost")
       ->capture_default_str();
@@ -176,12 +178,12 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
       ->delimiter(',')->capture_default_str();
   pc->add_option("--planners", p->bench.planners, "front-end planners")->delimiter(',')->capture_default_str();
   pc->add_option("--runs", p->bench.runs, "front-end runs per planner and map")->capture_default_str()
-      ->check(kPositive);
+      ->check(kRunsRange);
   pc->add_option("--seed", p->bench.seed, "seed of every campaign")->capture_default_str()->check(kUnsigned64);
   pc->add_option("--time-limit", p->bench.time_limit_s, "seconds per front-end run")->capture_default_str()
       ->check(kPositive);
   pc->add_option("--iterations", p->bench.max_iterations, "front-end iteration budget")->capture_default_str()
-      ->check(kPositive);
+      ->check(kIterationsRange);
   pc->add_option("--weights", p->bench.weights, "sGAN weights (default: the shipped ones)");
   pc->add_option("--heuristic-data", p->bench.heuristic_data, "a `miner dataset` folder (default: generate unseen maps)");
   pc->add_option("--heuristic-samples", p->bench.heuristic_samples, "unseen maps for the heuristic table")
@@ -242,12 +244,12 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   sc->add_option("--suite", su->suite, "suite file (miner-bench-suite-v1: maps, steps, band)")->capture_default_str();
   sc->add_option("--planners", su->bench.planners, "planners")->delimiter(',')->capture_default_str();
   sc->add_option("--runs", su->bench.runs, "runs per planner, map and steering step")->capture_default_str()
-      ->check(kPositive);
+      ->check(kRunsRange);
   sc->add_option("--seed", su->bench.seed, "seed of every campaign")->capture_default_str()->check(kUnsigned64);
   sc->add_option("--time-limit", su->bench.time_limit_s, "seconds per run")->capture_default_str()
       ->check(kPositive);
   sc->add_option("--iterations", su->bench.max_iterations, "iteration budget per run")->capture_default_str()
-      ->check(kPositive);
+      ->check(kIterationsRange);
   sc->add_option("--weights", su->bench.weights, "sGAN weights (default: the shipped ones)");
   sc->add_option("--results", su->results, "the Markdown file to write")->capture_default_str()->check(kOutputFileNewFolder);
   sc->add_option("--figures", su->figures, "folder for the box plots (default: <results folder>/suite)")
@@ -290,11 +292,12 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
       "voxels", "voxel map costs: load time, memory, point/segment/ray queries per second, A* grid and sGAN encoding");
   vc->add_option("--map", vo->map, "map file (.bt, .ot or .json)")->required();
   vc->add_option("--radius", vo->bench.robot_radius, "robot radius in m")->capture_default_str()->check(kFiniteNonNegative);
-  vc->add_option("--queries", vo->bench.queries, "random queries of each kind")->capture_default_str()->check(kPositive);
+  vc->add_option("--queries", vo->bench.queries, "random queries of each kind")->capture_default_str()
+      ->check(CLI::Range(1, 10000000));
   vc->add_option("--segment-length", vo->bench.segment_length, "segment query length in m")->capture_default_str()
       ->check(kPositive);
   vc->add_option("--repeats", vo->bench.repeats, "timed loads, grid builds and encodings (median)")->capture_default_str()
-      ->check(kPositive);
+      ->check(CLI::Range(1, 1000));
   vc->add_option("--seed", vo->bench.seed, "seed of the random queries")->capture_default_str()->check(kUnsigned64);
   add_output_options(vc, vo->output);
   vc->callback([vo, &out] {

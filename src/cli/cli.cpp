@@ -1,5 +1,6 @@
 #include "cli/cli.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -7,6 +8,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include "miner/core/error.hpp"
@@ -35,6 +37,45 @@ const CLI::Validator kUnsigned64(
     },
     "UINT64");
 
+const CLI::Validator kIterationsRange = CLI::Range(1, kMaxIterations);
+const CLI::Validator kRunsRange = CLI::Range(1, kMaxRuns);
+
+const CLI::Validator kDecimalInteger(
+    [](std::string& text) -> std::string {
+      const std::size_t sign = !text.empty() && text[0] == '-' ? 1 : 0;
+      const std::string digits = text.substr(sign);
+      if (digits.empty() || digits.find_first_not_of("0123456789") != std::string::npos)
+        return "must be a decimal integer, got " + text;
+      // CLI11 converts with strtoll(..., 0): a leading zero would make "010" octal 8.
+      const std::string trimmed = digits.substr(std::min(digits.find_first_not_of('0'), digits.size() - 1));
+      text = (sign && trimmed != "0" ? "-" : "") + trimmed;
+      return {};
+    },
+    "");
+
+namespace {
+
+/// Whether a file can be created in `folder`: a real probe (create, then remove, a hidden file),
+/// because access(W_OK) says yes to root in /proc and on read-only mounts (issue 20: `--out
+/// /proc/x` passed and failed after the work). Empty when it can, else the reason.
+std::string probe_writable(const std::filesystem::path& folder) {
+  const std::filesystem::path probe = folder / (".miner-probe-" + std::to_string(::getpid()));
+  const int fd = ::open(probe.c_str(), O_CREAT | O_EXCL | O_WRONLY, 0600);
+  if (fd < 0) return "the folder " + folder.string() + " is not writable";
+  ::close(fd);
+  ::unlink(probe.c_str());
+  return {};
+}
+
+/// The nearest existing ancestor of `p` (p itself if it exists).
+std::filesystem::path nearest_existing(std::filesystem::path p) {
+  std::error_code ec;
+  while (!p.empty() && !std::filesystem::exists(p, ec) && p != p.parent_path()) p = p.parent_path();
+  return p;
+}
+
+}  // namespace
+
 const CLI::Validator kOutputFile(
     [](std::string& text) -> std::string {
       namespace fs = std::filesystem;
@@ -44,8 +85,7 @@ const CLI::Validator kOutputFile(
       if (fs::is_directory(p, ec)) return text + " is a folder, not a file";
       const fs::path parent = p.parent_path().empty() ? fs::path(".") : p.parent_path();
       if (!fs::is_directory(parent, ec)) return "the folder " + parent.string() + " does not exist";
-      if (::access(parent.c_str(), W_OK) != 0) return "the folder " + parent.string() + " is not writable";
-      return {};
+      return probe_writable(parent);
     },
     "OUTPUT FILE");
 
@@ -56,13 +96,11 @@ const CLI::Validator kOutputFolder(
       std::error_code ec;
       fs::path p = fs::absolute(fs::path(text), ec);
       if (fs::exists(p, ec) && !fs::is_directory(p, ec)) return text + " is a file, not a folder";
-      // The folder and its missing parents are created next to the nearest existing ancestor.
-      fs::path ancestor = p.parent_path();
-      while (!ancestor.empty() && !fs::exists(ancestor, ec) && ancestor != ancestor.parent_path())
-        ancestor = ancestor.parent_path();
+      // The folder is written beside itself and moved in place; missing parents are created
+      // in the nearest existing ancestor.
+      const fs::path ancestor = nearest_existing(p.parent_path());
       if (!fs::is_directory(ancestor, ec)) return ancestor.string() + " is not a folder";
-      if (::access(ancestor.c_str(), W_OK) != 0) return "the folder " + ancestor.string() + " is not writable";
-      return {};
+      return probe_writable(ancestor);
     },
     "OUTPUT FOLDER");
 
@@ -72,8 +110,11 @@ const CLI::Validator kOutputFileNewFolder(
       if (text.empty()) return "an output file needs a name";
       std::error_code ec;
       if (fs::is_directory(fs::path(text), ec)) return text + " is a folder, not a file";
-      std::string parent = fs::absolute(fs::path(text), ec).parent_path().string();
-      return kOutputFolder(parent);
+      const fs::path folder = fs::absolute(fs::path(text), ec).parent_path();
+      if (fs::exists(folder, ec) && !fs::is_directory(folder, ec)) return folder.string() + " is a file, not a folder";
+      const fs::path ancestor = nearest_existing(folder);
+      if (!fs::is_directory(ancestor, ec)) return ancestor.string() + " is not a folder";
+      return probe_writable(ancestor);
     },
     "OUTPUT FILE");
 
@@ -147,9 +188,50 @@ namespace {
 
 /// Thrown by the top command's parse-complete callback in Mode::kParseOnly: CLI11 runs it
 /// after every option is converted and validated and before any subcommand's callback, so
-/// the line is checked whole and no command runs. (Replacing the commands' callbacks instead
+/// the line is checked whole (check_outputs_against_inputs included) and no command runs. (Replacing the commands' callbacks instead
 /// would free the option structs they own while CLI11 still writes into them.)
 struct ParsedOnly {};
+
+/// Every integer option of `app` and its subcommands reads decimal digits only (kDecimalInteger).
+void decimal_integers(CLI::App* app) {
+  for (CLI::Option* o : app->get_options()) {
+    const std::string type = o->get_type_name();
+    if (type.rfind("INT", 0) == 0 || type.rfind("UINT", 0) == 0) o->transform(kDecimalInteger);  // first, may edit
+  }
+  for (CLI::App* sub : app->get_subcommands([](CLI::App*) { return true; })) decimal_integers(sub);
+}
+
+/// No output may be, or hold, one of the command's inputs (issue 20: `astar --map m.json --out
+/// m.json` replaced the map with the answer; `dataset --merge d/a d/b --out d` deleted the
+/// parts). Outputs are the options checked by kOutputFile/kOutputFolder/kOutputFileNewFolder;
+/// inputs are the values of every other option that name an existing file or folder.
+void check_outputs_against_inputs(CLI::App* app) {
+  namespace fs = std::filesystem;
+  std::vector<std::pair<std::string, fs::path>> outputs, inputs;  // (option, path)
+  std::vector<CLI::App*> chain{app};
+  for (std::size_t i = 0; i < chain.size(); ++i)
+    for (CLI::App* sub : chain[i]->get_subcommands()) chain.push_back(sub);
+  std::error_code ec;
+  for (CLI::App* cmd : chain)
+    for (const CLI::Option* o : cmd->get_options()) {
+      if (o->count() == 0) continue;
+      const bool output = o->get_type_name().find("OUTPUT") != std::string::npos;
+      for (const std::string& value : o->results()) {
+        if (value.empty()) continue;
+        const fs::path path = fs::weakly_canonical(fs::absolute(fs::path(value), ec), ec);
+        if (ec) continue;
+        if (output) outputs.emplace_back(o->get_name(), path);
+        else if (fs::exists(path, ec)) inputs.emplace_back(o->get_name(), path);
+      }
+    }
+  for (const auto& [out_name, out] : outputs)
+    for (const auto& [in_name, in] : inputs) {
+      const auto [o, i] = std::mismatch(out.begin(), out.end(), in.begin(), in.end());
+      if (o == out.end())
+        throw CLI::ValidationError(out_name, out.string() + " is, or holds, the input " + in.string() + " (" + in_name +
+                                                 "): the command would replace its own input");
+    }
+}
 
 enum class Mode { kRun, kParseOnly };
 
@@ -163,7 +245,11 @@ int cli_main(const std::vector<std::string>& args, std::ostream& out, std::ostre
   add_plan_commands(app, out);
   add_fly_commands(app, out);
   add_heuristic_commands(app, out);
-  if (mode == Mode::kParseOnly) app.parse_complete_callback([] { throw ParsedOnly{}; });
+  decimal_integers(&app);
+  app.parse_complete_callback([&app, mode] {
+    check_outputs_against_inputs(&app);
+    if (mode == Mode::kParseOnly) throw ParsedOnly{};
+  });
 
   // An unknown command is named, with the commands there are and the nearest one (CLI11
   // alone says only "A subcommand is required").

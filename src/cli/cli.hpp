@@ -45,9 +45,22 @@ extern const CLI::Validator kFiniteNonNegative;
 /// An unsigned 64-bit integer written as decimal digits only: "-1" is refused (CLI11 would
 /// wrap it to 2^64 - 1) and so is anything above 2^64 - 1 (never clamped). REQ-CLI-002.
 extern const CLI::Validator kUnsigned64;
+/// An integer in decimal digits, with an optional '-': CLI11 reads integers with base 0, so
+/// "010" was octal 8, "0x10" 16 and "+3" 3 (issue 20). Leading zeros are dropped ("010" is
+/// 10). Every INT/UINT option of every command gets it (run_cli adds it). REQ-CLI-002.
+extern const CLI::Validator kDecimalInteger;
 /// A finite number > 0, with a short message ("must be a finite number > 0, got -3"):
 /// CLI11's PositiveNumber prints the largest double with all its 309 digits. REQ-CLI-002.
 extern const CLI::Validator kPositive;
+/// Resource bounds of the command line (issue 20: bounded work, named in --help). An iteration
+/// budget above 1e7 holds a tree of ~1 GB; more than 1e5 runs of a campaign, or 1e4 boxes
+/// placed by a generator whose placement is quadratic, run for hours.
+inline constexpr int kMaxIterations = 10000000;
+inline constexpr int kMaxRuns = 100000;
+inline constexpr int kMaxObstacles = 10000;
+/// CLI::Range(1, kMaxIterations) and CLI::Range(1, kMaxRuns).
+extern const CLI::Validator kIterationsRange;
+extern const CLI::Validator kRunsRange;
 /// Output paths checked when the command line is parsed, before any work (issue 20: a bad
 /// --ompl-log used to fail after the whole campaign). kOutputFile: the folder that will hold
 /// the file exists and is writable, and the path is not a folder. kOutputFolder: the path is

@@ -133,9 +133,10 @@ void add_fly_commands(CLI::App& app, std::ostream& out) {
   auto b = std::make_shared<SimBenchCliOptions>();
   CLI::App* sim = bench_cmd->add_subcommand("sim", "real-time factor of the full flight loop on one core");
   add_scenario_options(sim, b->scenario);
-  sim->add_option("--runs", b->bench.runs, "flights to time")->capture_default_str()->check(kPositive);
+  sim->add_option("--runs", b->bench.runs, "flights to time")->capture_default_str()->check(kRunsRange);
+  // CVODE refuses (and leaks) below ~1e-15; above 1e-2 the flight is not integrated at all.
   sim->add_option("--rtol", b->bench.relative_tolerance, "CVODE relative tolerance")->capture_default_str()
-      ->check(kPositive);
+      ->check(CLI::Range(1e-12, 1e-2));
   add_output_options(sim, b->output);
   sim->callback([b, &out] {
     const auto r = bench::run_sim_bench(resolve_scenario(b->scenario), b->bench);

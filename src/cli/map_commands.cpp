@@ -1,5 +1,6 @@
 // `miner map gen|info|convert` and `miner astar` (REQ-CLI-*, REQ-WORLD-*).
 #include <cmath>
+#include <limits>
 #include <filesystem>
 #include <iomanip>
 #include <memory>
@@ -31,7 +32,7 @@ struct GenOptions {
   std::uint64_t seed = 1;
   int obstacles = -1;
   std::vector<double> size;
-  double resolution = 0.0;
+  double resolution = std::numeric_limits<double>::quiet_NaN();  // NaN: not given (0 is refused, not ignored)
   std::string base;
   std::string out;
 };
@@ -41,7 +42,7 @@ void run_gen(const GenOptions& o, std::ostream& out) {
   world::GeneratorOverrides overrides;
   if (o.obstacles >= 0) overrides.obstacles = o.obstacles;
   if (!o.size.empty()) overrides.size = Eigen::Vector3d(o.size[0], o.size[1], o.size[2]);
-  if (o.resolution != 0.0) overrides.resolution = o.resolution;
+  if (!std::isnan(o.resolution)) overrides.resolution = o.resolution;
   if (!o.base.empty()) overrides.base = o.base;
   if (preset.name == "scan") {
     const world::ScanMap scan = world::generate_scan_map(preset, o.seed, overrides);
@@ -282,9 +283,10 @@ void add_map_commands(CLI::App& app, std::ostream& out) {
   g->add_option("--base", gen->base, "scan: the preset the mapping run flies over (default: drawn per map)");
   g->add_option("--seed", gen->seed, "random seed")->capture_default_str()->check(kUnsigned64);
   g->add_option("--obstacles", gen->obstacles, "number of obstacles (default: the preset's range)")
-      ->check(kFiniteNonNegative);
+      ->check(CLI::Range(0, kMaxObstacles));
   g->add_option("--size", gen->size, "families: extents X Y Z in m instead of drawn ones")->expected(3);
-  g->add_option("--resolution", gen->resolution, "families: grid resolution in m instead of the drawn one");
+  g->add_option("--resolution", gen->resolution, "families: grid resolution in m instead of the drawn one")
+      ->check(kFinite);
   g->add_option("--out", gen->out, "output file (.json, or .bt for OctoMap)")->required()->check(kOutputFile);
   g->callback([gen, &out] { run_gen(*gen, out); });
 

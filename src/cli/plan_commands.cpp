@@ -190,7 +190,7 @@ void add_plan_commands(CLI::App& app, std::ostream& out) {
   p->add_option("--weights", po->weights, "sGAN weights file (default: the shipped fixtures/sgan/sgan.bin)");
   add_region_grid_options(p, po->grid);
   p->add_option("--iterations", po->planner_options.max_iterations, "iteration budget (Alg. 1's N)")
-      ->check(kPositive)
+      ->check(kIterationsRange)
       ->capture_default_str();
   p->add_flag("--first", po->planner_options.stop_at_first, "stop at the first solution (Alg. 1 Line 24)");
   p->add_option("--target-cost", po->target_cost, "stop once the path cost is <= this (m)")

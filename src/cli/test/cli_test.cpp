@@ -2,6 +2,7 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <initializer_list>
 #include <sstream>
@@ -264,6 +265,75 @@ TEST_CASE("Output paths are checked before any work", "[REQ-CLI-003]") {
   const Run file_as_folder = miner_cli({"fly", "--out", map});
   CHECK(file_as_folder.code == 2);
   CHECK_THAT(file_as_folder.err, Contains("is a file, not a folder"));
+}
+
+TEST_CASE("Resource bounds: counts, budgets and tolerances outside their range are usage errors", "[REQ-CLI-002]") {
+  const std::string map = write("pillar-bounds.json", kPillarMap);
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases{
+      {{"bench", "backend", "--segments", "2147483647"}, "--segments"},  // overflowed segments * 10
+      {{"bench", "backend", "--segments", "100000000"}, "--segments"},   // ran for ever
+      {{"map", "gen", "--preset", "cluttered", "--obstacles", "2000000000", "--out", dir() + "/b.json"}, "--obstacles"},
+      {{"bench", "voxels", "--map", map, "--queries", "18446744073709551615"}, "--queries"},
+      {{"bench", "voxels", "--map", map, "--repeats", "2147483647"}, "--repeats"},
+      {{"bench", "sim", "--runs", "2000000000"}, "--runs"},
+      {{"bench", "sim", "--rtol", "1e-300"}, "--rtol"},
+      {{"plan", "--map", map, "--iterations", "2000000000"}, "--iterations"},
+      {{"bench", "frontend", "--map", map, "--throughput-iterations", "18446744073709551615"}, "--throughput-iterations"},
+      {{"map", "gen", "--preset", "cluttered", "--resolution", "nan", "--out", dir() + "/b.json"}, "--resolution"}};
+  for (const auto& [args, option] : cases) {
+    const Run r = miner_cli(args);
+    INFO(r.err);
+    CHECK(r.code == 2);
+    CHECK_THAT(r.err, Contains(option));
+  }
+  // --resolution 0 is a resolution (refused by the generator's range), not "not given".
+  const Run zero = miner_cli({"map", "gen", "--preset", "cluttered", "--resolution", "0", "--out", dir() + "/z.json"});
+  CHECK(zero.code != 0);
+  CHECK_THAT(zero.err, Contains("resolution"));
+  CHECK_FALSE(std::filesystem::exists(dir() + "/z.json"));
+}
+
+TEST_CASE("No output replaces an input, and outputs are probed for writing before the work", "[REQ-CLI-003]") {
+  const std::string map = write("pillar-self.json", kPillarMap);
+  const Run self = miner_cli({"astar", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5", "--out", map});
+  CHECK(self.code == 2);
+  CHECK_THAT(self.err, Contains("the command would replace its own input"));
+  CHECK(miner::read_json_file(map)["format"] == "miner-map-v1");
+  // An output folder that holds an input (the parts of a merge, a scenario in the run folder).
+  const std::string holder = dir() + "/holder";
+  std::filesystem::create_directories(holder);
+  const std::string scenario = holder + "/s.json";
+  std::ofstream(scenario) << "{}\n";  // refused before it is read
+  const Run inside = miner_cli({"fly", "--scenario", scenario, "--out", holder});
+  CHECK(inside.code == 2);
+  CHECK_THAT(inside.err, Contains("is, or holds, the input"));
+  CHECK(std::filesystem::exists(scenario));
+  // A folder that says it is writable but is not (root in /proc): refused at once.
+  if (std::filesystem::is_directory("/proc/self")) {
+    const Run proc = miner_cli({"astar", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5", "--out", "/proc/x"});
+    CHECK(proc.code == 2);
+    CHECK_THAT(proc.err, Contains("/proc is not writable"));
+  }
+}
+
+TEST_CASE("Integer options are decimal: no octal, hex, sign or exponent", "[REQ-CLI-002]") {
+  const std::string map = write("pillar-int.json", kPillarMap);
+  const std::string out = dir() + "/int-region.json";
+  const auto region = [&](const std::string& nx) {
+    return miner_cli({"region", "astar", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5", "--dims", nx,
+                      "8", "4", "--out", out});
+  };
+  // "010" is ten cells, not octal eight.
+  const Run ten = region("010");
+  INFO(ten.err);
+  REQUIRE(ten.code == 0);
+  CHECK(miner::read_json_file(out)["dims"][0] == 10);
+  for (const char* bad : {"0x8", "+8", "8e0", " 8", "8 ", "", "-", "0b11"}) {
+    const Run r = region(bad);
+    INFO(bad);
+    CHECK(r.code == 2);
+    CHECK_THAT(r.err, Contains("--dims: must be a decimal integer, got"));
+  }
 }
 
 TEST_CASE("The argument layer alone: refusals as run_cli gives them, and no command run", "[REQ-CLI-002][REQ-HARNESS-006]") {
@@ -606,6 +676,22 @@ TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[RE
     const Run refused = miner_cli({"bench", "merge", parts[0], parts[1], dup});
     CHECK(refused.code == 1);
     CHECK_THAT(refused.err, Contains("a duplicated record"));
+    // A record missing, a planner the campaign never ran, a negative cost, an unknown key.
+    const auto doctor = [&](const std::function<void(miner::Json&)>& change, const std::string& why) {
+      miner::Json d = miner::parse_json(s1.str(), parts[2]);
+      change(d);
+      const std::string path = dir() + "/doctored.json";
+      std::ofstream(path) << d.dump();
+      const Run r = miner_cli({"bench", "merge", parts[0], parts[1], path});
+      INFO(why);
+      CHECK(r.code == 1);
+      CHECK_THAT(r.err, Contains(why));
+    };
+    doctor([](miner::Json& d) { d["run_records"].erase(0); }, "has no record in any part");
+    doctor([](miner::Json& d) { d["run_records"][0]["planner"] = "bogus"; }, "\"bogus\" is not a planner of this campaign");
+    doctor([](miner::Json& d) { d["run_records"][0]["run"] = 7; }, "is not a run of part 2/3");
+    doctor([](miner::Json& d) { d["run_records"][0]["cost"] = -5.0; }, "a path cost must be >= 0");
+    doctor([](miner::Json& d) { d["run_records"][0]["costs"] = 1.0; }, "did you mean \"cost\"");
   }
   // Missing, repeated and foreign parts, and malformed shards, are refused.
   CHECK(miner_cli({"bench", "merge", parts[0], parts[1]}).code == 1);

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <set>
 #include <fstream>
 #include <sstream>
 
@@ -48,8 +49,40 @@ Json parse_json(const std::string& text, const std::string& origin) {
       --depth;
     }
   }
+  // An object that names a key twice is refused (issue 20: the JSON library keeps the last
+  // one, so `"resolution": 0.25, "resolution": 0.5` silently read 0.5).
+  std::vector<std::set<std::string>> keys;  // the keys of each open object
+  std::vector<std::string> path;            // the key each open object was reached by
+  std::string last_key;
+  const Json::parser_callback_t no_duplicates = [&](int, Json::parse_event_t event, Json& parsed) {
+    switch (event) {
+      case Json::parse_event_t::object_start:
+        keys.emplace_back();
+        path.push_back(last_key);
+        break;
+      case Json::parse_event_t::key:
+        last_key = parsed.get<std::string>();
+        if (!keys.back().insert(last_key).second) {
+          std::string where;
+          for (std::size_t i = 1; i < path.size(); ++i) where += (path[i].empty() ? "[]" : path[i]) + ".";
+          throw Error(origin + ": " + where + last_key + ": the key appears twice in one object (which one is meant?)");
+        }
+        break;
+      case Json::parse_event_t::object_end:
+        keys.pop_back();
+        path.pop_back();
+        last_key.clear();
+        break;
+      case Json::parse_event_t::array_start:
+        last_key.clear();
+        break;
+      default:
+        break;
+    }
+    return true;
+  };
   try {
-    return Json::parse(text);
+    return Json::parse(text, no_duplicates);
   } catch (const Json::parse_error& e) {
     throw Error(origin + ": malformed JSON at byte " + std::to_string(e.byte) + ": " + e.what());
   } catch (const Json::exception& e) {  // e.g. out_of_range.406: a number like 1e999
@@ -195,6 +228,28 @@ void write_folder_atomic(const std::string& path, const std::vector<std::pair<st
   if (ec || !fs::is_directory(parent)) throw Error(path + ": cannot create parent folder " + parent.string());
   if (fs::exists(target, ec) && !fs::is_directory(target, ec))
     throw Error(path + ": exists and is not a folder; refusing to replace it");
+  // Only an earlier output of the same kind is replaced (issue 20: `--out victim` deleted a
+  // user's folder): every entry a plain file with an extension the new folder has, and one
+  // name in common with it. Anything else is refused before any work is lost.
+  if (fs::is_directory(target, ec) && !fs::is_empty(target, ec)) {
+    std::set<std::string> names, extensions;
+    for (const auto& f : files) {
+      names.insert(f.first);
+      extensions.insert(fs::path(f.first).extension().string());
+    }
+    bool common = false;
+    for (const auto& entry : fs::directory_iterator(target, ec)) {
+      const std::string name = entry.path().filename().string();
+      if (!entry.is_regular_file(ec) || !extensions.count(entry.path().extension().string()))
+        throw Error(path + ": the folder exists and holds \"" + name +
+                    "\", which this command does not write: it is not an earlier output of this command, so "
+                    "it is not replaced (remove it or choose another folder)");
+      common = common || names.count(name) > 0;
+    }
+    if (!common)
+      throw Error(path + ": the folder exists and holds none of the files this command writes: it is not an earlier "
+                  "output of this command, so it is not replaced (remove it or choose another folder)");
+  }
   const std::string pid = std::to_string(::getpid());
   const fs::path partial = parent / ("." + target.filename().string() + ".partial." + pid);
   const fs::path old = parent / ("." + target.filename().string() + ".old." + pid);

@@ -73,7 +73,10 @@ void write_file_atomic(const std::string& path, const std::string& content);
 /// Writes `files` (name, content) into the folder `path` as a whole: they are written to
 /// a hidden sibling folder first, which then replaces `path` (the previous folder is moved
 /// aside and removed only once the new one is in place), so a good run folder is never
-/// half-overwritten. Creates missing parent folders.
+/// half-overwritten. Creates missing parent folders. An existing folder is replaced only when
+/// it looks like an earlier output of the same command: nothing but files, each with an
+/// extension among the new files', and one name in common; otherwise it throws naming the
+/// entry (a user's folder, the current folder, a folder holding the inputs are never replaced).
 void write_folder_atomic(const std::string& path, const std::vector<std::pair<std::string, std::string>>& files);
 
 /// JSON text as the project writes it: 2-space indent, trailing newline.

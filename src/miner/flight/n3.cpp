@@ -25,7 +25,11 @@ const char* to_string(Status s) {
 
 void validate(const Config& c) {
   auto fail = [](const std::string& what) { throw Error("n3: " + what); };
-  if (!(c.rate_hz >= 400.0) || !std::isfinite(c.rate_hz)) fail("rate_hz must be >= 400 (the N3's inner loop)");
+  // At most 10 kHz: the loop steps the simulation once per tick, so 4e9 Hz was 3e10 steps for
+  // a few seconds of flight (issue 20, unbounded work); 10 kHz x the 1000 s flight cap is 1e7.
+  constexpr double kMaxRateHz = 10000.0;
+  if (!(c.rate_hz >= 400.0 && c.rate_hz <= kMaxRateHz))
+    fail("rate_hz must be in [400, 10000] (the N3's inner loop), got " + std::to_string(c.rate_hz));
   if (!(c.latency_s >= 0.0) || !std::isfinite(c.latency_s)) fail("latency_s must be finite and >= 0");
   if (!(c.timeout_s > 0.0) || !std::isfinite(c.timeout_s)) fail("timeout_s must be positive");
   if (!(c.max_tilt_deg > 0.0 && c.max_tilt_deg < 90.0)) fail("max_tilt_deg must be in (0, 90)");

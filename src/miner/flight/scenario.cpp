@@ -49,7 +49,16 @@ Scenario scenario_from_json(const Json& doc, const std::string& origin, const st
                   "command_dropout_s"});
   Scenario s;
   s.origin = origin;
-  if (root.has("name")) s.name = root.at("name").string();
+  if (root.has("name")) {
+    // The name becomes the default run folder runs/<name>-seed<seed>: one plain, visible name
+    // (issue 20: "../../x" wrote outside runs/, "" made runs/-seed1).
+    s.name = root.at("name").string();
+    if (s.name.empty() || s.name.size() > 128 || s.name[0] == '.' ||
+        s.name.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789._+-") !=
+            std::string::npos)
+      root.at("name").fail("must be 1 to 128 letters, digits or . _ + - not starting with '.', got \"" + s.name +
+                           "\"");
+  }
 
   const JsonField map_field = root.at("map");
   if (map_field.value().is_string()) {

@@ -311,6 +311,16 @@ Json write_dataset(const DatasetOptions& o, const std::string& dir, std::ostream
 
 Json merge_dataset_parts(const std::vector<std::string>& parts, const std::string& dir) {
   if (parts.empty()) throw Error("dataset merge: no part folders");
+  // The output replaces its folder whole: it must not be, or hold, a part (issue 20: `--out`
+  // the parts' parent deleted them).
+  namespace fs = std::filesystem;
+  const fs::path out_path = fs::weakly_canonical(fs::absolute(dir));
+  for (const auto& p : parts) {
+    const fs::path part = fs::weakly_canonical(fs::absolute(p));
+    const auto [o, q] = std::mismatch(out_path.begin(), out_path.end(), part.begin(), part.end());
+    if (o == out_path.end())
+      throw Error("dataset merge: --out " + dir + " is or holds the part " + p + ", which the merged folder would replace");
+  }
   std::vector<Json> docs;
   std::vector<DatasetLayout> layouts;
   for (const auto& p : parts) {

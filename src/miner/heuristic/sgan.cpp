@@ -494,8 +494,15 @@ std::vector<double> reference_errors(const Sgan& sgan, const std::string& refere
                                   ref.at(p + "noise", shape).values);
     const auto& want = ref.at(p + "output", shape).values;
     double worst = 0.0;
-    for (std::size_t i = 0; i < out.size(); ++i)
-      worst = std::max(worst, std::abs(static_cast<double>(out[i]) - static_cast<double>(want[i])));
+    for (std::size_t i = 0; i < out.size(); ++i) {
+      const double diff = std::abs(static_cast<double>(out[i]) - static_cast<double>(want[i]));
+      // std::max would skip a NaN and report agreement (issue 20: an all-NaN reference "agreed").
+      if (!std::isfinite(diff))
+        throw Error(reference_path + ": " + p + "output[" + std::to_string(i) + "]: C++ gives " +
+                    std::to_string(out[i]) + ", the reference " + std::to_string(want[i]) +
+                    ": not a finite comparison (a reference holds finite network outputs)");
+      worst = std::max(worst, diff);
+    }
     errors.push_back(worst);
   }
   return errors;

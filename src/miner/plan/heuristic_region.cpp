@@ -78,7 +78,9 @@ HeuristicRegion HeuristicRegion::from_json(const Json& doc, const std::string& o
   if (format != kRegionFormat) {
     root.at("format").fail("unknown format tag \"" + format + "\", expected \"" + kRegionFormat + "\"");
   }
+  root.only_keys({"format", "bounds", "dims", "threshold", "source", "probabilities"});  // issue 20: no ignored key
   const JsonField jb = root.at("bounds");
+  jb.only_keys({"min", "max"});
   world::Box bounds{jb.at("min").vec3(), jb.at("max").vec3()};
   const JsonField jd = root.at("dims");
   if (jd.array_size() != 3) jd.fail("expected an array of 3 integers");

@@ -386,9 +386,14 @@ AnswerCheck measure_answer(const MincoProblem& p, const PolynomialTrajectory& tr
     return out;
   }
   // Per segment and derivative k, the size of the terms it is computed from,
-  // S_ik = sum_j |c_ij| j!/(j-k)! T_i^(j-k) (largest axis): its rounding error is relative to
-  // that (per-segment scaling: a residual at a junction of a 1e-6 s and a 1 s segment is
-  // measured against each side's own scale, not against the other's).
+  // S_ik = max(sum_j |c_ij| j!/(j-k)! T_i^(j-k), S_i0 / T_i^k) (largest axis): its rounding
+  // error is relative to that (per-segment scaling: a residual at a junction of a 1e-6 s and a
+  // 1 s segment is measured against each side's own scale, not against the other's). The
+  // second term is the scale the solve's rounding gives every coefficient (c_j carries
+  // ~eps S_i0 / T_i^j): a derivative that vanishes, such as the acceleration of a
+  // constant-velocity segment between collinear waypoints, is rounding noise whose size is
+  // set by the positions, not by its own (zero) terms (issue 20: such straight lines were
+  // refused with residuals of ~1 "relative").
   const int N = 2 * s;
   std::vector<double> S(static_cast<std::size_t>(M * N), 0.0);
   for (int i = 0; i < M; ++i) {
@@ -398,7 +403,8 @@ AnswerCheck measure_answer(const MincoProblem& p, const PolynomialTrajectory& tr
       Eigen::Array3d sum = Eigen::Array3d::Zero();
       double tp = 1.0;
       for (int j = k; j < N; ++j, tp *= T) sum += c.row(j).transpose().array().abs() * (falling_factorial(j, k) * tp);
-      S[static_cast<std::size_t>(i * N + k)] = sum.maxCoeff();
+      S[static_cast<std::size_t>(i * N + k)] =
+          std::max(sum.maxCoeff(), S[static_cast<std::size_t>(i * N)] / std::pow(T, k));
     }
     out.term_scale = std::max(out.term_scale, S[static_cast<std::size_t>(i * N)]);
   }

@@ -1,6 +1,7 @@
 #include <catch2/catch.hpp>
 
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <fstream>
 #include <sstream>
@@ -36,6 +37,15 @@ TEST_CASE("Malformed JSON names the file and the byte offset", "[REQ-CORE-003]")
                     Contains("z.json: invalid JSON: [json.exception.out_of_range.406] number overflow"));
   CHECK_THROWS_WITH(miner::read_json_file("/nonexistent/file.json"),
                     Contains("/nonexistent/file.json: cannot open file"));
+}
+
+TEST_CASE("A key named twice in one object is refused, naming it", "[REQ-CORE-003]") {
+  CHECK_THROWS_WITH(miner::parse_json(R"({"resolution": 0.25, "bounds": {}, "resolution": 0.5})", "m.json"),
+                    Contains("m.json: resolution: the key appears twice"));
+  CHECK_THROWS_WITH(miner::parse_json(R"({"a": {"b": 1, "c": {"d": 1, "d": 2}}})", "x.json"),
+                    Contains("x.json: a.c.d: the key appears twice"));
+  // The same key in different objects, or in objects of an array, is fine.
+  CHECK_NOTHROW(miner::parse_json(R"({"a": {"k": 1}, "b": {"k": 2}, "l": [{"k": 1}, {"k": 2}], "k": 3})", "ok.json"));
 }
 
 TEST_CASE("Field access names the dotted path and the type found", "[REQ-CORE-003]") {
@@ -91,6 +101,38 @@ TEST_CASE("Atomic write into a missing folder fails and leaves the old file inta
   CHECK_THROWS_AS(miner::write_file_atomic(blocked, "new"), Error);
   CHECK(read_all(path) == "good\n");
   CHECK(std::filesystem::is_directory(blocked + "/child"));
+}
+
+TEST_CASE("A folder write replaces only an earlier output of the same kind", "[REQ-CORE-004]") {
+  namespace fs = std::filesystem;
+  const auto dir = temp_dir("folder_kind");
+  const std::string run = (dir / "run").string();
+  const std::vector<std::pair<std::string, std::string>> first{{"summary.json", "{}\n"}, {"log.csv", "t\n"}};
+  miner::write_folder_atomic(run, first);
+  // An earlier output (same kind of files, one name in common) is replaced whole.
+  miner::write_folder_atomic(run, {{"summary.json", "{\"again\": 1}\n"}, {"other.csv", "x\n"}});
+  CHECK(read_all(run + "/summary.json") == "{\"again\": 1}\n");
+  CHECK_FALSE(fs::exists(run + "/log.csv"));
+  // A user's folder is not: a file of another kind, a subfolder, or no name in common.
+  const auto refused = [&](const std::string& name, const std::function<void(const fs::path&)>& make,
+                           const std::string& why) {
+    const fs::path victim = dir / name;
+    fs::create_directories(victim);
+    make(victim);
+    CHECK_THROWS_WITH(miner::write_folder_atomic(victim.string(), first), Contains(why) && Contains("not replaced"));
+    CHECK(fs::exists(victim / "keep"));
+    CHECK_FALSE(fs::exists(victim / "summary.json"));
+  };
+  refused("txt", [](const fs::path& v) { std::ofstream(v / "keep") << "precious"; }, "holds \"keep\"");
+  refused("sub", [](const fs::path& v) {
+    std::ofstream(v / "summary.json.bak") << "x";
+    fs::create_directories(v / "keep");
+  }, "which this command does not write");
+  const fs::path other = dir / "other";
+  fs::create_directories(other);
+  std::ofstream(other / "notes.json") << "{}";
+  CHECK_THROWS_WITH(miner::write_folder_atomic(other.string(), first), Contains("holds none of the files"));
+  CHECK(fs::exists(other / "notes.json"));
 }
 
 TEST_CASE("only_keys refuses an unknown key, naming it and the known ones", "[REQ-CORE-003]") {

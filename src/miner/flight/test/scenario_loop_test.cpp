@@ -75,7 +75,15 @@ TEST_CASE("Bad scenarios are refused before flight with the fault named", "[REQ-
   expect_scenario_error(doc, "must divide the N3 loop rate");
   doc = default_doc();
   doc["n3"]["rate_hz"] = 200;
-  expect_scenario_error(doc, "rate_hz must be >= 400");
+  expect_scenario_error(doc, "rate_hz must be in [400, 10000]");
+  doc = default_doc();
+  doc["n3"]["rate_hz"] = 4e9;  // bounded work: refused, not flown for 3e10 ticks
+  expect_scenario_error(doc, "rate_hz must be in [400, 10000]");
+  for (const char* name : {"../../evil", "", ".hidden", "a/b", "sp ace"}) {
+    doc = default_doc();
+    doc["name"] = name;  // the default run folder is runs/<name>-seed<seed>
+    expect_scenario_error(doc, "name: must be 1 to 128 letters");
+  }
   doc = default_doc();
   doc["format"] = "miner-scenario-v0";
   expect_scenario_error(doc, "unknown format tag");

@@ -252,6 +252,11 @@ TEST_CASE("A dataset folder that contradicts itself is refused naming the file a
         edit_json(q0 + "/train-index.json", [](miner::Json& d) { d.erase(d.size() - 1); });
       },
       "train-index.json: (top level): has 1 entries, the shards 2 samples");
+  // An output folder that is or holds a part: refused, the parts kept.
+  CHECK_THROWS_WITH(heuristic::merge_dataset_parts({p0, p1}, root), Contains("is or holds the part"));
+  CHECK_THROWS_WITH(heuristic::merge_dataset_parts({p0, p1}, p0), Contains("is or holds the part"));
+  CHECK(fs::exists(p0 + "/dataset.json"));
+  CHECK(fs::exists(p1 + "/dataset.json"));
   // A negative map seed (nlohmann would wrap it on reading).
   refused(
       [&](const std::string& q0, const std::string&) {

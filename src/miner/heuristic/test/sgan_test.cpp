@@ -1,5 +1,9 @@
 #include <catch2/catch.hpp>
 
+#include <limits>
+
+#include <cstring>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -68,6 +72,34 @@ TEST_CASE("The shipped generator agrees with the PyTorch reference tensors to 1e
   CHECK(from_file.meta() == g.meta());
   // The reference file is checked as carefully as the weights.
   CHECK_THROWS_WITH(heuristic::reference_errors(g, kFixtures + "sgan.bin"), Contains("sgan-reference"));
+}
+
+TEST_CASE("A reference whose outputs are not finite is refused, never agreed with", "[REQ-HEUR-005]") {
+  // The shipped reference with one output cell set to NaN and its checksum redone: a NaN
+  // difference used to be skipped by std::max, and an all-NaN reference "agreed" with 0 error.
+  std::string blob = miner::read_file_bytes(kFixtures + "reference.bin");
+  std::uint32_t header_bytes = 0;
+  std::memcpy(&header_bytes, blob.data() + 8, 4);
+  miner::Json header = miner::parse_json(blob.substr(12, header_bytes), "reference header");
+  std::string data = blob.substr(12 + header_bytes);
+  bool found = false;
+  for (const auto& t : header["tensors"])
+    if (t["name"] == "0.output") {
+      const float nan = std::numeric_limits<float>::quiet_NaN();
+      std::memcpy(&data[t["offset"].get<std::size_t>() + 4 * 17], &nan, 4);  // cell 17
+      found = true;
+    }
+  REQUIRE(found);
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx",
+                static_cast<unsigned long long>(heuristic::fnv1a64(reinterpret_cast<const std::uint8_t*>(data.data()), data.size())));
+  header["data_fnv1a64"] = hex;
+  const std::string h = header.dump();
+  const auto n = static_cast<std::uint32_t>(h.size());
+  const std::string path = (std::filesystem::temp_directory_path() / "miner_sgan_test_nan_reference.bin").string();
+  miner::write_file_atomic(path, blob.substr(0, 8) + std::string(reinterpret_cast<const char*>(&n), 4) + h + data);
+  CHECK_THROWS_WITH(heuristic::reference_errors(heuristic::Sgan::builtin(), path),
+                    Contains("0.output[17]") && Contains("not a finite comparison"));
 }
 
 TEST_CASE("The first layer's planar and channels-last kernels agree with each other and with PyTorch",

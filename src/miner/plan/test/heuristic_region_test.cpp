@@ -86,6 +86,14 @@ TEST_CASE("A region round-trips through miner-region-v1 and bad files name the f
   CHECK_THROWS_WITH(HeuristicRegion::from_path(Box{{0, 0, 0}, {1, 1, 1}}, I(big, big, 4), {{0.5, 0.5, 0.5}}, 1, "t"),
                     Contains("more than the limit"));
   CHECK_THROWS_WITH(HeuristicRegion(Box{{0, 0, 0}, {0, 1, 1}}, I(1, 1, 1), {1.0}, 0.5), Contains("must exceed"));
+  // A misspelt or unknown key is refused, not ignored (a "treshold" ran with the default).
+  doc = r.to_json();
+  doc["treshold"] = doc["threshold"];
+  doc.erase("threshold");
+  CHECK_THROWS_WITH(HeuristicRegion::from_json(doc, "r.json"), Contains("did you mean \"threshold\""));
+  doc = r.to_json();
+  doc["bounds"]["mid"] = 1;
+  CHECK_THROWS_WITH(HeuristicRegion::from_json(doc, "r.json"), Contains("bounds") && Contains("mid"));
 }
 
 TEST_CASE("The A*-dilated region covers the path and its 3x3x3 neighbourhood", "[REQ-PLAN-005]") {

@@ -689,7 +689,7 @@ TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[RE
     };
     doctor([](miner::Json& d) { d["run_records"].erase(0); }, "has no record in any part");
     doctor([](miner::Json& d) { d["run_records"][0]["planner"] = "bogus"; }, "\"bogus\" is not a planner of this campaign");
-    doctor([](miner::Json& d) { d["run_records"][0]["run"] = 7; }, "is not a run of part 2/3");
+    doctor([](miner::Json& d) { d["run_records"][0]["run"] = 7; }, "is not a run of part 1/3");
     doctor([](miner::Json& d) { d["run_records"][0]["cost"] = -5.0; }, "a path cost must be >= 0");
     doctor([](miner::Json& d) { d["run_records"][0]["costs"] = 1.0; }, "did you mean \"cost\"");
   }

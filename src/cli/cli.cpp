@@ -207,7 +207,7 @@ void decimal_integers(CLI::App* app) {
 /// inputs are the values of every other option that name an existing file or folder.
 void check_outputs_against_inputs(CLI::App* app) {
   namespace fs = std::filesystem;
-  std::vector<std::pair<std::string, fs::path>> outputs, inputs;  // (option, path)
+  std::vector<std::pair<std::string, std::string>> outputs, inputs;  // (option, path)
   std::vector<CLI::App*> chain{app};
   for (std::size_t i = 0; i < chain.size(); ++i)
     for (CLI::App* sub : chain[i]->get_subcommands()) chain.push_back(sub);
@@ -218,17 +218,14 @@ void check_outputs_against_inputs(CLI::App* app) {
       const bool output = o->get_type_name().find("OUTPUT") != std::string::npos;
       for (const std::string& value : o->results()) {
         if (value.empty()) continue;
-        const fs::path path = fs::weakly_canonical(fs::absolute(fs::path(value), ec), ec);
-        if (ec) continue;
-        if (output) outputs.emplace_back(o->get_name(), path);
-        else if (fs::exists(path, ec)) inputs.emplace_back(o->get_name(), path);
+        if (output) outputs.emplace_back(o->get_name(), value);
+        else if (fs::exists(fs::path(value), ec)) inputs.emplace_back(o->get_name(), value);
       }
     }
   for (const auto& [out_name, out] : outputs)
     for (const auto& [in_name, in] : inputs) {
-      const auto [o, i] = std::mismatch(out.begin(), out.end(), in.begin(), in.end());
-      if (o == out.end())
-        throw CLI::ValidationError(out_name, out.string() + " is, or holds, the input " + in.string() + " (" + in_name +
+      if (is_same_or_inside(out, in))
+        throw CLI::ValidationError(out_name, out + " is, or holds, the input " + in + " (" + in_name +
                                                  "): the command would replace its own input");
     }
 }

@@ -285,6 +285,16 @@ void write_folder_atomic(const std::string& path, const std::vector<std::pair<st
   if (had_old) fs::remove_all(old, ec);
 }
 
+bool is_same_or_inside(const std::string& folder, const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path outer = fs::weakly_canonical(fs::absolute(fs::path(folder), ec), ec);
+  if (ec) return false;
+  const fs::path inner = fs::weakly_canonical(fs::absolute(fs::path(path), ec), ec);
+  if (ec) return false;
+  return std::mismatch(outer.begin(), outer.end(), inner.begin(), inner.end()).first == outer.end();
+}
+
 std::string dump_json(const Json& j) { return j.dump(2) + "\n"; }
 
 }  // namespace miner

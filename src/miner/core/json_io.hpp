@@ -79,6 +79,11 @@ void write_file_atomic(const std::string& path, const std::string& content);
 /// entry (a user's folder, the current folder, a folder holding the inputs are never replaced).
 void write_folder_atomic(const std::string& path, const std::vector<std::pair<std::string, std::string>>& files);
 
+/// Whether `path` is `folder` or lies inside it, both made absolute and canonical as far as
+/// they exist (links and ".." resolved); false when either cannot be resolved. An output
+/// folder that is replaced whole must not hold an input (issue 20).
+bool is_same_or_inside(const std::string& folder, const std::string& path);
+
 /// JSON text as the project writes it: 2-space indent, trailing newline.
 std::string dump_json(const Json& j);
 

@@ -313,12 +313,8 @@ Json merge_dataset_parts(const std::vector<std::string>& parts, const std::strin
   if (parts.empty()) throw Error("dataset merge: no part folders");
   // The output replaces its folder whole: it must not be, or hold, a part (issue 20: `--out`
   // the parts' parent deleted them).
-  namespace fs = std::filesystem;
-  const fs::path out_path = fs::weakly_canonical(fs::absolute(dir));
   for (const auto& p : parts) {
-    const fs::path part = fs::weakly_canonical(fs::absolute(p));
-    const auto [o, q] = std::mismatch(out_path.begin(), out_path.end(), part.begin(), part.end());
-    if (o == out_path.end())
+    if (is_same_or_inside(dir, p))
       throw Error("dataset merge: --out " + dir + " is or holds the part " + p + ", which the merged folder would replace");
   }
   std::vector<Json> docs;

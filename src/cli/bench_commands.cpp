@@ -66,15 +66,22 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   CLI::App* b = bench_cmd->add_subcommand("backend", "MINCO vs dense LU, closed form and KKT QP (paper Table II)");
   b->add_option("--segments", o->bench.segments, "segment counts M")->capture_default_str()->delimiter(',')
       ->check(CLI::Range(1, 1000000));
-  b->add_option("--orders", o->bench.orders, "orders s (3 jerk, 4 snap)")->capture_default_str()->delimiter(',');
-  b->add_option("--methods", o->bench.methods, "minco, dense-lu, closed-form, kkt-qp")->capture_default_str()->delimiter(',');
+  b->add_option("--orders", o->bench.orders, "orders s (3 jerk, 4 snap)")->capture_default_str()->delimiter(',')
+      ->check(integer_in(3, 4));
+  b->add_option("--methods", o->bench.methods, "minco, dense-lu, closed-form, kkt-qp")->capture_default_str()->delimiter(',')
+      ->check(CLI::IsMember({"minco", "dense-lu", "closed-form", "kkt-qp"}));
   b->add_option("--max-dense-segments", o->bench.max_dense_segments, "skip the O(M^3) baselines above this M")
-      ->capture_default_str();
-  b->add_option("--budget", o->bench.budget_s, "seconds per (method, order, M)")->capture_default_str();
-  b->add_option("--samples", o->bench.samples, "timed batches (median reported)")->capture_default_str();
+      ->capture_default_str()->check(integer_in(0, 1000000));
+  b->add_option("--budget", o->bench.budget_s, "seconds per (method, order, M)")->capture_default_str()
+      ->check(finite_in(1e-4, 3600.0));
+  b->add_option("--samples", o->bench.samples, "timed batches (median reported; fewer when one solve outlasts a batch)")
+      ->capture_default_str()->check(integer_in(3, 10000));
   b->add_option("--seed", o->bench.seed, "seed of the waypoints")->capture_default_str()->check(kUnsigned64);
   add_output_options(b, o->output);
   b->callback([o, &out] {
+    require_distinct("--segments", o->bench.segments);
+    require_distinct("--orders", o->bench.orders);
+    require_distinct("--methods", o->bench.methods);
     const auto records = bench::run_backend_bench(o->bench);
     std::ostringstream table;
     bench::print_table(records, table);
@@ -91,13 +98,13 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   fc->add_option("--runs", f->bench.runs, "runs per planner")->check(kRunsRange)->capture_default_str();
   fc->add_option("--seed", f->bench.seed, "master seed (run k uses stream k)")->capture_default_str()->check(kUnsigned64);
   fc->add_option("--target-factor", f->bench.target_factor, "target cost = this x the A* reference cost")
-      ->check(kPositive)
+      ->check(finite_in(0.01, 100.0))
       ->capture_default_str();
   fc->add_option("--max-iterations", f->bench.max_iterations, "iteration budget per run")
       ->check(kIterationsRange)
       ->capture_default_str();
   fc->add_option("--time-limit", f->bench.time_limit_s, "wall-clock cap per run in s")
-      ->check(kPositive)
+      ->check(finite_in(1e-3, 86400.0))
       ->capture_default_str();
   fc->add_option("--step", f->bench.planner_options.steer_step, "steering step eta in m (default 0.1 x diagonal)")
       ->check(kPositive);
@@ -107,7 +114,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
                "miner, miner-sgan: the paper's fixed mu, without the safeguard (REQ-PLAN-020)");
   fc->add_option("--region", f->bench.region_file, "miner's region file (default: the A*-dilated region)");
   fc->add_option("--weights", f->bench.weights_file, "miner-sgan's weights (default: the shipped fixtures/sgan/sgan.bin)");
-  fc->add_option("--region-dims", f->region_dims, "A*-dilated region grid")->expected(3)->check(kPositive);
+  fc->add_option("--region-dims", f->region_dims, "A*-dilated region grid")->expected(3)->check(integer_in(1, 4096));
   fc->add_option("--throughput-iterations", f->bench.throughput_iterations,
                  "iterations of the rrtstar vs ompl:RRTstar throughput check (0: skip)")
       ->capture_default_str()
@@ -127,15 +134,17 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
       "heuristic", "sGAN quality like the paper's heuristic table, and what its region buys MINER over RRT*");
   hc->add_option("--data", h->bench.data, "`miner dataset` folders, one map family each (a summary per family)")
       ->required();
-  hc->add_option("--split", h->bench.split, "split to measure (test: map seeds never trained on)")->capture_default_str();
-  hc->add_option("--samples", h->bench.samples, "first N samples of the split (0: all)")->capture_default_str();
+  hc->add_option("--split", h->bench.split, "split to measure (test: map seeds never trained on)")->capture_default_str()
+      ->check(CLI::IsMember({"train", "val", "test"}));
+  hc->add_option("--samples", h->bench.samples, "first N samples of the split (0: all)")->capture_default_str()
+      ->check(integer_in(0, 10000000));
   hc->add_option("--weights", h->bench.weights, "sGAN weights (default: the shipped fixtures/sgan/sgan.bin)");
   hc->add_option("--seed", h->bench.seed, "noise seed (sample k: seed + k) and planner seed")->capture_default_str()->check(kUnsigned64);
   hc->add_option("--iterations", h->bench.max_iterations, "planner iteration budget per query")
       ->check(kIterationsRange)
       ->capture_default_str();
   hc->add_option("--target-factor", h->bench.target_factor, "target cost = this x the sample's A* cost")
-      ->capture_default_str();
+      ->capture_default_str()->check(finite_in(0.01, 100.0));
   hc->add_flag("!--no-planners", h->bench.planners, "quality only: do not run MINER and RRT*");
   add_output_options(hc, h->output);
   hc->callback([h, &out] {
@@ -181,22 +190,22 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
       ->check(kRunsRange);
   pc->add_option("--seed", p->bench.seed, "seed of every campaign")->capture_default_str()->check(kUnsigned64);
   pc->add_option("--time-limit", p->bench.time_limit_s, "seconds per front-end run")->capture_default_str()
-      ->check(kPositive);
+      ->check(finite_in(1e-3, 86400.0));
   pc->add_option("--iterations", p->bench.max_iterations, "front-end iteration budget")->capture_default_str()
       ->check(kIterationsRange);
   pc->add_option("--weights", p->bench.weights, "sGAN weights (default: the shipped ones)");
   pc->add_option("--heuristic-data", p->bench.heuristic_data, "a `miner dataset` folder (default: generate unseen maps)");
   pc->add_option("--heuristic-samples", p->bench.heuristic_samples, "unseen maps for the heuristic table")
-      ->capture_default_str()->check(kPositive);
+      ->capture_default_str()->check(integer_in(1, 100000));
   pc->add_option("--heuristic-iterations", p->bench.heuristic_iterations, "MINER vs RRT* budget per heuristic query")
-      ->capture_default_str()->check(kPositive);
+      ->capture_default_str()->check(kIterationsRange);
   pc->add_option("--scenarios", p->bench.scenarios, "tracking scenarios (default: indoor-1 and indoor-2)")->delimiter(',');
   pc->add_option("--tracking-maps", p->bench.tracking_maps, "maps flown with the default scenario besides indoor-1")
       ->delimiter(',')->capture_default_str();
   pc->add_option("--backend-budget", p->bench.backend_budget_s, "seconds per back-end method and order")
-      ->capture_default_str()->check(kPositive);
+      ->capture_default_str()->check(finite_in(1e-4, 3600.0));
   pc->add_option("--jobs", p->bench.jobs, "threads for generating the heuristic test set")->capture_default_str()
-      ->check(kPositive);
+      ->check(integer_in(1, 256));
   pc->add_option("--results", p->results, "the Markdown file to write")->capture_default_str()->check(kOutputFileNewFolder);
   pc->add_option("--figures", p->figures, "folder for the box plots (default: <results folder>/results)")
       ->check(kOutputFolder);
@@ -247,7 +256,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
       ->check(kRunsRange);
   sc->add_option("--seed", su->bench.seed, "seed of every campaign")->capture_default_str()->check(kUnsigned64);
   sc->add_option("--time-limit", su->bench.time_limit_s, "seconds per run")->capture_default_str()
-      ->check(kPositive);
+      ->check(finite_in(1e-3, 86400.0));
   sc->add_option("--iterations", su->bench.max_iterations, "iteration budget per run")->capture_default_str()
       ->check(kIterationsRange);
   sc->add_option("--weights", su->bench.weights, "sGAN weights (default: the shipped ones)");
@@ -291,11 +300,11 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   CLI::App* vc = bench_cmd->add_subcommand(
       "voxels", "voxel map costs: load time, memory, point/segment/ray queries per second, A* grid and sGAN encoding");
   vc->add_option("--map", vo->map, "map file (.bt, .ot or .json)")->required();
-  vc->add_option("--radius", vo->bench.robot_radius, "robot radius in m")->capture_default_str()->check(kFiniteNonNegative);
+  vc->add_option("--radius", vo->bench.robot_radius, "robot radius in m")->capture_default_str()->check(finite_in(0.0, world::kMaxRobotRadius));
   vc->add_option("--queries", vo->bench.queries, "random queries of each kind")->capture_default_str()
       ->check(CLI::Range(1, 10000000));
   vc->add_option("--segment-length", vo->bench.segment_length, "segment query length in m")->capture_default_str()
-      ->check(kPositive);
+      ->check(finite_in(1e-3, 1e4));
   vc->add_option("--repeats", vo->bench.repeats, "timed loads, grid builds and encodings (median)")->capture_default_str()
       ->check(CLI::Range(1, 1000));
   vc->add_option("--seed", vo->bench.seed, "seed of the random queries")->capture_default_str()->check(kUnsigned64);

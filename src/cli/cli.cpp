@@ -1,10 +1,13 @@
 #include "cli/cli.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <new>
+#include <sstream>
 
 #include <CLI/CLI.hpp>
 
@@ -127,6 +130,45 @@ const CLI::Validator kPositive(
     },
     "POSITIVE");
 
+CLI::Validator finite_in(double lo, double hi) {
+  char range[96];
+  std::snprintf(range, sizeof range, "[%g, %g]", lo, hi);
+  const std::string text_range(range);
+  return CLI::Validator(
+      [lo, hi, text_range](std::string& text) -> std::string {
+        double v = 0.0;
+        if (!CLI::detail::lexical_cast(text, v) || !std::isfinite(v) || v < lo || v > hi)
+          return "must be a finite number in " + text_range + ", got " + text;
+        return {};
+      },
+      "in " + text_range);
+}
+
+CLI::Validator integer_in(long long lo, long long hi) {
+  const std::string text_range = "[" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+  return CLI::Validator(
+      [lo, hi, text_range](std::string& text) -> std::string {
+        long long v = 0;
+        if (!CLI::detail::lexical_cast(text, v) || v < lo || v > hi)
+          return "must be an integer in " + text_range + ", got " + text;
+        return {};
+      },
+      "in " + text_range);
+}
+
+void require_distinct(const std::string& option, const std::vector<std::string>& values) {
+  for (std::size_t i = 0; i < values.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (values[i] == values[j])
+        throw CLI::ValidationError(option, "lists " + values[i] + " twice (each value once)");
+}
+
+void require_distinct(const std::string& option, const std::vector<int>& values) {
+  std::vector<std::string> text;
+  for (int v : values) text.push_back(std::to_string(v));
+  require_distinct(option, text);
+}
+
 const CLI::Validator kFinite(
     [](std::string& text) -> std::string {
       double v = 0.0;
@@ -145,7 +187,7 @@ void add_query_options(CLI::App* cmd, QueryOptions& q) {
   cmd->add_option("--start", q.start, "start x y z in m (default: the map's query)")->expected(3)->check(kFinite);
   cmd->add_option("--goal", q.goal, "goal x y z in m (default: the map's query)")->expected(3)->check(kFinite);
   cmd->add_option("--radius", q.radius, "robot radius in m (default: the map's query radius or 0)")
-      ->check(kFiniteNonNegative);
+      ->check(finite_in(0.0, world::kMaxRobotRadius));
 }
 
 world::Map load_map(const std::string& path, const std::string& unknown) {
@@ -232,8 +274,8 @@ void check_outputs_against_inputs(CLI::App* app) {
 
 enum class Mode { kRun, kParseOnly };
 
-int cli_main(const std::vector<std::string>& args, std::ostream& out, std::ostream& err, Mode mode) {
-  CLI::App app{"miner — MINER-RRT* quadrotor planning and flight stack", "miner"};
+/// Every command of `miner` registered on `app` (their callbacks write to `out`).
+void add_commands(CLI::App& app, std::ostream& out) {
   app.require_subcommand(1);
   app.set_version_flag("--version", "miner 0.1.0");
   add_map_commands(app, out);
@@ -243,6 +285,101 @@ int cli_main(const std::vector<std::string>& args, std::ostream& out, std::ostre
   add_fly_commands(app, out);
   add_heuristic_commands(app, out);
   decimal_integers(&app);
+}
+
+/// `app` and every command below it, parents first.
+std::vector<CLI::App*> command_tree(CLI::App* app) {
+  std::vector<CLI::App*> chain{app};
+  for (std::size_t i = 0; i < chain.size(); ++i)
+    for (CLI::App* sub : chain[i]->get_subcommands([](CLI::App*) { return true; })) chain.push_back(sub);
+  return chain;
+}
+
+/// The command a line addresses: its path of command names from `app` ("miner plan").
+CLI::App* addressed_command(CLI::App* app, const std::vector<std::string>& args, std::string& path) {
+  CLI::App* current = app;
+  path = "miner";
+  for (const std::string& a : args) {
+    if (a.empty() || a[0] == '-') break;
+    CLI::App* next = nullptr;
+    for (CLI::App* sub : current->get_subcommands([](CLI::App*) { return true; }))
+      if (sub->get_name() == a) next = sub;
+    if (!next) break;
+    current = next;
+    path += " " + a;
+  }
+  return current;
+}
+
+/// An option-like argument of `cmd` that names no option of it (issue 20: `--mapp x` was
+/// answered "--map is required" and `--planer` with no suggestion). Negative numbers are
+/// values, not options; everything after "--" is positional. Empty when every option is
+/// known, else the message naming it and the nearest option of the command.
+std::string unknown_option(CLI::App* cmd, const std::string& path, const std::vector<std::string>& args) {
+  std::vector<std::string> names{"--help", "-h"};
+  if (cmd->get_parent() == nullptr) names.push_back("--version");
+  for (const CLI::Option* o : cmd->get_options()) {
+    for (const std::string& n : o->get_lnames()) names.push_back("--" + n);
+    for (const std::string& n : o->get_snames()) names.push_back("-" + n);
+  }
+  for (const std::string& a : args) {
+    if (a == "--") break;
+    // Option names start with a letter after their dashes; "-1" and "-1/2" are values.
+    const std::size_t dashes = a.rfind("--", 0) == 0 ? 2 : 1;
+    if (a.size() <= dashes || a[0] != '-' || !std::isalpha(static_cast<unsigned char>(a[dashes]))) continue;
+    const std::string name = a.substr(0, a.find('='));
+    if (std::find(names.begin(), names.end(), name) != names.end()) continue;
+    std::string nearest;
+    std::size_t best = std::max<std::size_t>(2, name.size() / 3) + 1;
+    for (const std::string& n : names) {
+      const std::size_t d = edit_distance(name, n);
+      if (d < best) best = d, nearest = n;
+    }
+    return "unknown option " + name + " for `" + path + "`" +
+           (nearest.empty() ? "" : ", did you mean " + nearest + "?");
+  }
+  return {};
+}
+
+}  // namespace
+
+std::vector<std::string> numeric_options_without_checks() {
+  std::ostringstream sink;
+  CLI::App app{"miner", "miner"};
+  add_commands(app, sink);
+  std::vector<std::string> unchecked;
+  for (CLI::App* cmd : command_tree(&app)) {
+    for (const CLI::Option* o : cmd->get_options()) {
+      const std::string type = o->get_type_name();
+      const bool integer = type.rfind("INT", 0) == 0 || type.rfind("UINT", 0) == 0;
+      const bool real = type.rfind("FLOAT", 0) == 0;
+      if (!integer && !real) continue;
+      // Integer options carry kDecimalInteger (added by decimal_integers): a range is a second check.
+      int checks = 0;
+      for (int k = 0;; ++k) {
+        try {
+          (void)const_cast<CLI::Option*>(o)->get_validator(k);
+          ++checks;
+        } catch (const CLI::OptionNotFound&) {
+          break;
+        }
+      }
+      if (checks < (integer ? 2 : 1)) {
+        std::string path = cmd->get_name();
+        for (const CLI::App* p = cmd->get_parent(); p != nullptr && p->get_parent() != nullptr; p = p->get_parent())
+          path = p->get_name() + " " + path;
+        unchecked.push_back(path + " " + o->get_name());
+      }
+    }
+  }
+  return unchecked;
+}
+
+namespace {
+
+int cli_main(const std::vector<std::string>& args, std::ostream& out, std::ostream& err, Mode mode) {
+  CLI::App app{"miner — MINER-RRT* quadrotor planning and flight stack", "miner"};
+  add_commands(app, out);
   app.parse_complete_callback([&app, mode] {
     check_outputs_against_inputs(&app);
     if (mode == Mode::kParseOnly) throw ParsedOnly{};
@@ -275,6 +412,15 @@ int cli_main(const std::vector<std::string>& args, std::ostream& out, std::ostre
       }
       current = next;
       path += " " + a;
+    }
+  }
+  {
+    std::string path;
+    CLI::App* cmd = addressed_command(&app, args, path);
+    const std::string unknown = unknown_option(cmd, path, args);
+    if (!unknown.empty()) {
+      err << "miner: usage error: " << unknown << "\nrun '" << path << " --help' for usage\n";
+      return static_cast<int>(ExitCode::kUsage);
     }
   }
   // CLI11 parses in reverse order of the vector it is given.

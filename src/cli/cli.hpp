@@ -29,6 +29,11 @@ int run_cli(const std::vector<std::string>& args, std::ostream& out, std::ostrea
 /// fuzz target src/fuzz/fuzz_cli.cpp drives it (REQ-HARNESS-006); never throws, never writes.
 int check_cli_arguments(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 
+/// Every numeric option of every command that has no check of its value besides the decimal
+/// form ("plan --goal-bias"): each must declare its range (issue 20: unbounded or silently
+/// altered values). The CLI test asserts the list is empty (REQ-CLI-002).
+std::vector<std::string> numeric_options_without_checks();
+
 /// Options shared by commands that produce a result: --json prints it as JSON instead
 /// of the human text, --out also writes the JSON to a file (atomically).
 struct OutputOptions {
@@ -52,6 +57,15 @@ extern const CLI::Validator kDecimalInteger;
 /// A finite number > 0, with a short message ("must be a finite number > 0, got -3"):
 /// CLI11's PositiveNumber prints the largest double with all its 309 digits. REQ-CLI-002.
 extern const CLI::Validator kPositive;
+/// A finite number in [lo, hi] ("must be a finite number in [1e-06, 3600], got nan"); CLI11's
+/// Range lets NaN through and prints its bounds with six decimals. REQ-CLI-002.
+CLI::Validator finite_in(double lo, double hi);
+/// An integer in [lo, hi], read after kDecimalInteger. REQ-CLI-002.
+CLI::Validator integer_in(long long lo, long long hi);
+/// Refuses a list option that names a value twice (issue 20: `--segments 5,5` timed the same
+/// case twice), as a usage error naming the option.
+void require_distinct(const std::string& option, const std::vector<std::string>& values);
+void require_distinct(const std::string& option, const std::vector<int>& values);
 /// Resource bounds of the command line (issue 20: bounded work, named in --help). An iteration
 /// budget above 1e7 holds a tree of ~1 GB; more than 1e5 runs of a campaign, or 1e4 boxes
 /// placed by a generator whose placement is quadratic, run for hours.

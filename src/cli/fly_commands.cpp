@@ -136,7 +136,7 @@ void add_fly_commands(CLI::App& app, std::ostream& out) {
   sim->add_option("--runs", b->bench.runs, "flights to time")->capture_default_str()->check(kRunsRange);
   // CVODE refuses (and leaks) below ~1e-15; above 1e-2 the flight is not integrated at all.
   sim->add_option("--rtol", b->bench.relative_tolerance, "CVODE relative tolerance")->capture_default_str()
-      ->check(CLI::Range(1e-12, 1e-2));
+      ->check(finite_in(1e-12, 1e-2));
   add_output_options(sim, b->output);
   sim->callback([b, &out] {
     const auto r = bench::run_sim_bench(resolve_scenario(b->scenario), b->bench);

@@ -78,20 +78,31 @@ void run_heuristic(const HeuristicCliOptions& o, std::ostream& out) {
 void add_heuristic_commands(CLI::App& app, std::ostream& out) {
   auto o = std::make_shared<DatasetCliOptions>();
   CLI::App* d = app.add_subcommand("dataset", "sGAN training data: random maps and queries, A* ground truth, E/S/T grids");
-  d->add_option("--count", o->dataset.count, "train + validation samples")->capture_default_str();
-  d->add_option("--test-count", o->dataset.test_count, "test samples from unseen map seeds")->capture_default_str();
-  d->add_option("--val-fraction", o->dataset.val_fraction, "share of --count kept for validation")->capture_default_str();
+  d->add_option("--count", o->dataset.count, "train + validation samples")->capture_default_str()
+      ->check(integer_in(1, 10000000));
+  d->add_option("--test-count", o->dataset.test_count, "test samples from unseen map seeds")->capture_default_str()
+      ->check(integer_in(0, 10000000));
+  d->add_option("--val-fraction", o->dataset.val_fraction, "share of --count kept for validation")->capture_default_str()
+      ->check(finite_in(0.0, 0.99));
   d->add_option("--seed", o->dataset.seed, "master seed")->capture_default_str()->check(kUnsigned64);
   d->add_option("--preset", o->dataset.preset, "map preset (sim, indoor, cluttered, rooms, forest, multilevel, scan)")->capture_default_str();
-  d->add_option("--dims", o->dims, "heuristic grid nx ny nz")->expected(3)->capture_default_str();
-  d->add_option("--dilation", o->dataset.dilation, "cells around start, goal and path cells (1: 3x3x3)")->capture_default_str();
-  d->add_option("--shard-size", o->dataset.shard_size, "samples per shard file")->capture_default_str();
-  d->add_option("--jobs", o->dataset.jobs, "worker threads (the output does not depend on it)")->capture_default_str();
+  d->add_option("--dims", o->dims, "heuristic grid nx ny nz")->expected(3)->capture_default_str()->check(integer_in(4, 256));
+  d->add_option("--dilation", o->dataset.dilation, "cells around start, goal and path cells (1: 3x3x3)")->capture_default_str()
+      ->check(integer_in(0, plan::HeuristicRegion::kMaxDilation));
+  d->add_option("--shard-size", o->dataset.shard_size, "samples per shard file")->capture_default_str()
+      ->check(integer_in(1, 1000000));
+  d->add_option("--jobs", o->dataset.jobs, "worker threads (the output does not depend on it)")->capture_default_str()
+      ->check(integer_in(1, 256));
   d->add_option("--shard", o->shard, "i/N: write only part i of N (shard files j with j % N == i); join with --merge");
   d->add_option("--merge", o->merge, "join these part folders (made with --shard) into --out instead of generating");
   d->add_option("--out", o->out, "output folder (written as a whole)")->required()->check(kOutputFolder);
-  d->callback([o, &out] {
+  d->callback([o, d, &out] {
     if (!o->merge.empty()) {
+      // The parts carry their own options: generation options beside --merge would be ignored.
+      for (const char* name : {"--count", "--test-count", "--val-fraction", "--seed", "--preset", "--dims", "--dilation",
+                               "--shard-size", "--jobs", "--shard"})
+        if (d->get_option(name)->count() > 0)
+          throw CLI::ValidationError(name, "does not apply to --merge (the parts carry their own options)");
       const Json doc = heuristic::merge_dataset_parts(o->merge, o->out);
       out << "merged " << o->merge.size() << " parts into " << o->out << ": " << doc["splits"]["train"]["count"]
           << " train, " << doc["splits"]["val"]["count"] << " val, " << doc["splits"]["test"]["count"] << " test samples\n";

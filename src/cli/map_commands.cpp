@@ -13,6 +13,7 @@
 #include "cli/cli.hpp"
 #include "miner/core/error.hpp"
 #include "miner/core/json_io.hpp"
+#include "miner/core/sha256.hpp"
 #include "miner/world/astar.hpp"
 #include "miner/world/map.hpp"
 #include "miner/world/map_generator.hpp"
@@ -214,17 +215,21 @@ void run_scan(const ScanCliOptions& o, std::ostream& out) {
   const world::VoxelGrid grid(q.map, q.radius);
   const world::GridPath route = world::astar(q.map, grid, q.start, q.goal);
   const world::ScanResult scan = world::scan_map(q.map, route.points, options);
-  write_file_atomic(o.out, scan.bt);
-  const Map scanned = Map::load(o.out);
+  // Read back from the bytes and both files written as one: a failure leaves both as they were.
+  const Map scanned = Map::from_voxels({world::parse_octree(scan.bt, o.out), world::UnknownPolicy::kOccupied,
+                                        std::filesystem::absolute(o.out).lexically_normal().string(),
+                                        sha256_hex(scan.bt)});
   const world::VoxelLayer& layer = scanned.voxels()->layer();
+  std::vector<std::pair<std::string, std::string>> files{{o.out, scan.bt}};
   if (!o.map_out.empty()) {
     Json doc = scanned.to_json();
     doc["query"] = {{"start", vec3_json(q.start)}, {"goal", vec3_json(q.goal)}, {"robot_radius", q.radius}};
     // Relative to the JSON's folder when they share one, so the pair can be moved together.
     const auto bt = std::filesystem::absolute(o.out), json = std::filesystem::absolute(o.map_out);
     if (bt.parent_path() == json.parent_path()) doc["voxels"]["file"] = bt.filename().string();
-    write_file_atomic(o.map_out, dump_json(doc));
+    files.emplace_back(o.map_out, dump_json(doc));
   }
+  write_files_atomic(files);
   out << "scanned " << o.query.map << " along " << scan.poses << " poses (" << route.cost << " m): " << scan.rays
       << " rays, " << scan.returns << " returns\n"
       << "wrote " << o.out << ": " << layer.dims().x() << " x " << layer.dims().y() << " x " << layer.dims().z()
@@ -252,7 +257,9 @@ void run_import(const ImportOptions& o, std::ostream& out) {
     Eigen::Vector3d origin;
     if (!o.origin.empty()) origin = Eigen::Vector3d(o.origin[0], o.origin[1], o.origin[2]);
     else if (cloud.viewpoint) origin = *cloud.viewpoint;
-    else throw Error(path + ": no sensor origin (a PLY file has none): give --origin x y z, the sensor position the rays start from");
+    const bool ply = path.size() >= 4 && path.compare(path.size() - 4, 4, ".ply") == 0;
+    if (!o.origin.empty() || cloud.viewpoint) {
+    } else throw Error(path + ": no sensor origin (" + (ply ? std::string("a PLY file has none") : std::string("the PCD file has no VIEWPOINT line")) + "): give --origin x y z, the sensor position the rays start from");
     points += cloud.points.size();
     skipped += cloud.skipped;
     scans.push_back({std::move(cloud), origin});
@@ -284,9 +291,10 @@ void add_map_commands(CLI::App& app, std::ostream& out) {
   g->add_option("--seed", gen->seed, "random seed")->capture_default_str()->check(kUnsigned64);
   g->add_option("--obstacles", gen->obstacles, "number of obstacles (default: the preset's range)")
       ->check(CLI::Range(0, kMaxObstacles));
-  g->add_option("--size", gen->size, "families: extents X Y Z in m instead of drawn ones")->expected(3);
+  g->add_option("--size", gen->size, "families: extents X Y Z in m instead of drawn ones")->expected(3)
+      ->check(finite_in(0.0, 2.0 * world::kMaxCoordinate));
   g->add_option("--resolution", gen->resolution, "families: grid resolution in m instead of the drawn one")
-      ->check(kFinite);
+      ->check(finite_in(world::kMinResolution, world::kMaxResolution));
   g->add_option("--out", gen->out, "output file (.json, or .bt for OctoMap)")->required()->check(kOutputFile);
   g->callback([gen, &out] { run_gen(*gen, out); });
 
@@ -296,7 +304,7 @@ void add_map_commands(CLI::App& app, std::ostream& out) {
   i->add_option("--unknown", info->unknown, "voxel maps: count unknown space as 'occupied' or 'free' in the grid")
       ->check(CLI::IsMember({"occupied", "free"}));
   i->add_option("--radius", info->radius, "robot radius in m (default: the map's query radius or 0)")
-      ->check(kFiniteNonNegative);
+      ->check(finite_in(0.0, world::kMaxRobotRadius));
   add_output_options(i, info->output);
   i->callback([info, &out] { run_info(*info, out); });
 
@@ -310,20 +318,23 @@ void add_map_commands(CLI::App& app, std::ostream& out) {
   CLI::App* sc = map->add_subcommand(
       "scan", "simulate a mapping run: a range sensor flown along the query's A* path (the vehicle's own volume, --radius, known free) builds an OctoMap (free, occupied, unknown)");
   add_query_options(sc, scan->query);
-  sc->add_option("--range", scan->scan.range, "sensor range in m")->capture_default_str()->check(kPositive);
-  sc->add_option("--fov", scan->fov, "horizontal and vertical field of view in degrees")->expected(2)->capture_default_str();
-  sc->add_option("--rays", scan->rays, "rays across the horizontal and the vertical field")->expected(2)->capture_default_str();
-  sc->add_option("--noise", scan->scan.noise, "range noise standard deviation in m")->capture_default_str()
-      ->check(kFiniteNonNegative);
+  sc->add_option("--range", scan->scan.range, "sensor range in m")->capture_default_str()->check(finite_in(0.01, 1000.0));
+  sc->add_option("--fov", scan->fov, "horizontal and vertical field of view in degrees")->expected(2)->capture_default_str()
+      ->check(finite_in(0.0, 360.0));
+  sc->add_option("--rays", scan->rays, "rays across the horizontal and the vertical field")->expected(2)->capture_default_str()
+      ->check(integer_in(1, 100000));
+  sc->add_option("--noise", scan->scan.noise, "range noise standard deviation in m (at most half the range)")
+      ->capture_default_str()->check(finite_in(0.0, 500.0));
   sc->add_option("--dropout", scan->scan.dropout, "probability that a return is lost")->capture_default_str()
-      ->check(kFiniteNonNegative);
+      ->check(finite_in(0.0, 0.99));
   sc->add_option("--spacing", scan->scan.spacing, "distance between sensor poses along the path in m")
-      ->capture_default_str()->check(kPositive);
+      ->capture_default_str()->check(finite_in(0.01, 1000.0));
   sc->add_option("--body-radius", scan->scan.body_radius,
                  "radius in m of the volume the vehicle sweeps along the path, set free (default: --radius)")
-      ->check(kFiniteNonNegative);
+      ->check(finite_in(0.0, world::kMaxRobotRadius));
   sc->add_flag("!--no-spin", scan->scan.spin_at_ends, "no full turn at the first and the last pose");
-  sc->add_option("--resolution", scan->scan.resolution, "voxel size in m (default: the map's)")->check(kPositive);
+  sc->add_option("--resolution", scan->scan.resolution, "voxel size in m (default: the map's)")
+      ->check(finite_in(world::kMinResolution, world::kMaxResolution));
   sc->add_option("--seed", scan->scan.seed, "random seed (range noise, dropouts)")->capture_default_str()->check(kUnsigned64);
   sc->add_option("--out", scan->out, "the scan as an OctoMap binary tree (.bt)")->required()->check(kOutputFile);
   sc->add_option("--map-out", scan->map_out, "also a map file (.json) referencing the scan, with the query")
@@ -336,9 +347,10 @@ void add_map_commands(CLI::App& app, std::ostream& out) {
   im->add_option("--cloud", import->clouds, "point cloud file (.ply or .pcd); repeat for several scans")->required();
   im->add_option("--origin", import->origin, "sensor position x y z in m (default: each PCD file's VIEWPOINT)")
       ->expected(3)->check(kFinite);
-  im->add_option("--resolution", import->resolution, "voxel size in m")->capture_default_str()->check(kPositive);
+  im->add_option("--resolution", import->resolution, "voxel size in m")->capture_default_str()
+      ->check(finite_in(world::kMinResolution, world::kMaxResolution));
   im->add_option("--range", import->range, "longest ray in m; farther points only free the ray up to it (default: no limit)")
-      ->check(kPositive);
+      ->check(finite_in(0.01, 1e4));
   im->add_option("--out", import->out, "the map as an OctoMap binary tree (.bt)")->required()->check(kOutputFile);
   im->callback([import, &out] { run_import(*import, out); });
 

@@ -27,10 +27,10 @@ struct RegionGridOptions {
 void add_region_grid_options(CLI::App* cmd, RegionGridOptions& r) {
   cmd->add_option("--dims", r.dims, "heuristic grid size nx ny nz (the sGAN's grid)")
       ->expected(3)
-      ->check(kPositive)
+      ->check(integer_in(1, 4096))
       ->capture_default_str();
   cmd->add_option("--dilation", r.dilation, "cells added around each path cell (1: 3x3x3 cubes)")
-      ->check(kFiniteNonNegative)
+      ->check(integer_in(0, plan::HeuristicRegion::kMaxDilation))
       ->capture_default_str();
 }
 
@@ -193,37 +193,45 @@ void add_plan_commands(CLI::App& app, std::ostream& out) {
       ->check(kIterationsRange)
       ->capture_default_str();
   p->add_flag("--first", po->planner_options.stop_at_first, "stop at the first solution (Alg. 1 Line 24)");
-  p->add_option("--target-cost", po->target_cost, "stop once the path cost is <= this (m)")
-      ->check(kPositive);
+  CLI::Option* target_cost = p->add_option("--target-cost", po->target_cost, "stop once the path cost is <= this (m)")
+      ->check(finite_in(1e-9, 1e9));
   p->add_option("--target-factor", po->target_factor,
                 "stop once the cost is <= this x the A* reference cost (e.g. 1.05)")
-      ->check(kPositive);
+      ->check(finite_in(0.01, 100.0))
+      ->excludes(target_cost);
   p->add_option("--step", po->planner_options.steer_step, "steering step eta in m (default: 0.1 x map diagonal)")
-      ->check(kPositive);
+      ->check(finite_in(1e-6, 1e6));
   p->add_option("--goal-radius", po->planner_options.goal_radius, "goal region radius in m (default: 2 x resolution)")
-      ->check(kPositive);
+      ->check(finite_in(1e-6, 1e6));
   p->add_option("--goal-bias", po->planner_options.goal_bias, "probability of sampling the goal")
-      ->check(CLI::Range(0.0, 0.999999))
+      ->check(finite_in(0.0, 0.999999))
       ->capture_default_str();
   p->add_option("--mu1", po->planner_options.mu_1, "miner: P(sample region) after the first solution, < 1")
-      ->check(CLI::Range(0.0, 0.999999))
+      ->check(finite_in(0.0, 0.999999))
       ->capture_default_str();
   p->add_option("--mu2", po->planner_options.mu_2, "miner: P(sample region) before the first solution, < 1")
-      ->check(CLI::Range(0.0, 0.999999))
+      ->check(finite_in(0.0, 0.999999))
       ->capture_default_str();
   p->add_flag("!--no-safeguard", po->planner_options.safeguard,
               "miner: the paper's fixed mu_1/mu_2, without the online trust of REQ-PLAN-020");
   p->add_option("--safeguard-iterations", po->planner_options.safeguard_iterations,
                 "miner safeguard: k_0, iterations without a solution after which mu decays as k_0 / t")
-      ->check(kPositive)
+      ->check(integer_in(1, kMaxIterations))
       ->capture_default_str();
   p->add_option("--rewire-factor", po->planner_options.rewire_factor, "rewiring radius factor (>= 1)")
-      ->check(CLI::Range(1.0, 100.0))
+      ->check(finite_in(1.0, 100.0))
       ->capture_default_str();
   p->add_flag("--tree", po->tree, "include the final tree (vertices, parents) in the JSON");
   p->add_flag("--timing", po->timing, "include wall-clock times (makes the output non-deterministic)");
   add_output_options(p, po->output);
-  p->callback([po, &out] {
+  p->callback([po, p, &out] {
+    // The region, its grid and the safeguard belong to miner: given to another planner they
+    // would be ignored without a word (issue 20).
+    if (po->planner != "miner")
+      for (const char* name : {"--region", "--weights", "--dims", "--dilation", "--mu1", "--mu2", "--no-safeguard",
+                               "--safeguard-iterations"})
+        if (p->get_option(name)->count() > 0)
+          throw CLI::ValidationError(name, std::string("applies to --planner miner only, not ") + po->planner);
     po->planner_options.record_tree = po->tree;
     run_plan(*po, out);
   });

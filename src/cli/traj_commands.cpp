@@ -44,7 +44,8 @@ void add_traj_commands(CLI::App& app, std::ostream& out) {
   s->add_option("--allocate", solve->allocate,
                 "durations from the limits: trapezoid (default) or optimise (min J + rho sum T within the limits, Ceres)")
       ->check(CLI::IsMember({"trapezoid", "optimise"}));
-  s->add_option("--rho", solve->rho, "weight of the total time with --allocate optimise (default 1, or the file's)");
+  s->add_option("--rho", solve->rho, "weight of the total time with --allocate optimise (default 1, or the file's)")
+      ->check(finite_in(1e-9, 1e9));
   s->callback([solve, &out] { run_solve(*solve, out); });
 }
 

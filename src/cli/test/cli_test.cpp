@@ -185,12 +185,12 @@ TEST_CASE("Bad input: each case names what is wrong and exits non-zero", "[REQ-C
       {{"astar", "--map", write("neg-res.json",
                                 R"({"format": "miner-map-v1", "bounds": {"min": [0,0,0], "max": [1,1,1]},
                                     "resolution": -1, "obstacles": []})")},
-       1, "resolution: must be positive"},
+       1, "resolution: -1 m is outside the resolutions a map may have"},
       {{"astar", "--map", map, "--start", "5", "5", "5", "--goal", "1", "1", "1"}, 1, "start (5, 5, 5) lies inside obstacle 0"},
       {{"astar", "--map", map, "--start", "1", "1", "1", "--goal", "1", "1", "11"}, 1, "goal (1, 1, 11) lies outside the map bounds"},
       {{"astar", "--map", map, "--start", "nan", "1", "1", "--goal", "1", "1", "1"}, 2, "must be a finite number"},
       {{"astar", "--map", map, "--start", "1", "1", "--goal", "1", "1", "1"}, 2, "--start"},
-      {{"astar", "--map", map, "--start", "1", "1", "1", "--goal", "2", "2", "2", "--radius", "-1"}, 2, "must be a finite number >= 0"},
+      {{"astar", "--map", map, "--start", "1", "1", "1", "--goal", "2", "2", "2", "--radius", "-1"}, 2, "--radius: must be a finite number in [0, 10], got -1"},
       {{"astar", "--map", map, "--start", "3.2", "5", "5", "--goal", "9", "9", "9", "--radius", "0.5"}, 1, "lies in an occupied grid cell"},
       {{"map", "gen", "--preset", "swamp", "--out", dir() + "/x.json"}, 1, "unknown map preset \"swamp\""},
       {{"map", "info", "--map", write("garbage.bt", "not an octree")}, 1, "not an OctoMap file"},
@@ -291,6 +291,66 @@ TEST_CASE("Resource bounds: counts, budgets and tolerances outside their range a
   CHECK(zero.code != 0);
   CHECK_THAT(zero.err, Contains("resolution"));
   CHECK_FALSE(std::filesystem::exists(dir() + "/z.json"));
+}
+
+TEST_CASE("Every numeric option of every command declares its range", "[REQ-CLI-002]") {
+  // The structural half: no option is left to take any number (issue 20's class "silent
+  // acceptance"); planting an option without a check makes this list it.
+  const std::vector<std::string> unchecked = miner::cli::numeric_options_without_checks();
+  std::string list;
+  for (const auto& o : unchecked) list += o + "; ";
+  INFO("options without a range: " << list);
+  CHECK(unchecked.empty());
+  // The behavioural half, one option per kind of check.
+  const std::string map = write("pillar-ranges.json", kPillarMap);
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases{
+      {{"bench", "backend", "--budget", "inf"}, "--budget: must be a finite number in [0.0001, 3600], got inf"},
+      {{"bench", "backend", "--budget", "1e308"}, "--budget"},
+      {{"bench", "backend", "--samples", "1"}, "--samples: must be an integer in [3, 10000], got 1"},
+      {{"bench", "backend", "--max-dense-segments", "-1"}, "--max-dense-segments"},
+      {{"bench", "backend", "--orders", "5"}, "--orders"},
+      {{"plan", "--map", map, "--goal-bias", "nan"}, "--goal-bias: must be a finite number in [0, 0.999999]"},
+      {{"plan", "--map", map, "--rewire-factor", "nan"}, "--rewire-factor"},
+      {{"plan", "--map", map, "--target-factor", "1e308"}, "--target-factor"},
+      {{"region", "astar", "--map", map, "--dilation", "2000000000", "--out", dir() + "/r.json"}, "--dilation"},
+      {{"map", "scan", "--map", map, "--resolution", "1e300", "--out", dir() + "/s.bt"}, "--resolution"},
+      {{"map", "scan", "--map", map, "--resolution", "0.0001", "--out", dir() + "/s.bt"}, "--resolution"},
+      {{"map", "import", "--cloud", map, "--resolution", "1e300", "--out", dir() + "/i.bt"}, "--resolution"},
+      {{"astar", "--map", map, "--radius", "1e300"}, "--radius"},
+      {{"dataset", "--val-fraction", "nan", "--out", dir() + "/d"}, "--val-fraction"}};
+  for (const auto& [args, message] : cases) {
+    const Run r = miner_cli(args);
+    INFO(r.err);
+    CHECK(r.code == 2);
+    CHECK_THAT(r.err, Contains(message));
+  }
+}
+
+TEST_CASE("Unknown options are named with the nearest one; duplicates, exclusive and misplaced options are refused",
+          "[REQ-CLI-002]") {
+  const std::string map = write("pillar-unknown.json", kPillarMap);
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases{
+      {{"astar", "--mapp", map}, "unknown option --mapp for `miner astar`, did you mean --map?"},
+      {{"plan", "--planer", "rrtstar", "--map", map}, "unknown option --planer for `miner plan`, did you mean --planner?"},
+      {{"--verbose"}, "unknown option --verbose for `miner`"},
+      {{"bench", "sim", "--run", "1"}, "did you mean --runs?"},
+      {{"bench", "backend", "--segments", "5,5"}, "--segments: lists 5 twice"},
+      {{"bench", "backend", "--methods", "minco,minco"}, "--methods: lists minco twice"},
+      {{"plan", "--map", map, "--target-cost", "1", "--target-factor", "1"}, "excludes"},
+      {{"plan", "--map", map, "--planner", "informed", "--mu1", "0.5"}, "--mu1: applies to --planner miner only"},
+      {{"plan", "--map", map, "--planner", "rrtstar", "--no-safeguard"}, "--no-safeguard: applies to --planner miner only"},
+      {{"dataset", "--merge", dir() + "/p0", "--count", "5", "--out", dir() + "/m"}, "--count: does not apply to --merge"}};
+  for (const auto& [args, message] : cases) {
+    const Run r = miner_cli(args);
+    INFO(r.err);
+    CHECK(r.code == 2);
+    CHECK_THAT(r.err, Contains(message));
+  }
+  // Negative numbers are values, not options.
+  std::ostringstream out, err;
+  INFO(err.str());
+  CHECK(miner::cli::check_cli_arguments({"astar", "--map", map, "--start", "-1", "5", "5", "--goal", "9", "-5", "5"},
+                                        out, err) == 0);
 }
 
 TEST_CASE("No output replaces an input, and outputs are probed for writing before the work", "[REQ-CLI-003]") {
@@ -795,7 +855,7 @@ TEST_CASE("miner dataset writes the dataset folder and refuses a missing --out",
   CHECK(std::filesystem::exists(out + "/dataset.json"));
   CHECK(r.err.empty());  // not a terminal: no progress bar
   CHECK(miner_cli({"dataset", "--count", "2"}).code == 2);
-  CHECK(miner_cli({"dataset", "--count", "0", "--out", dir() + "/none"}).code == 1);
+  CHECK(miner_cli({"dataset", "--count", "0", "--out", dir() + "/none"}).code == 2);
 }
 
 TEST_CASE("miner heuristic writes the filtered region and reports raw and filtered quality", "[REQ-HEUR-008]") {
@@ -991,7 +1051,7 @@ TEST_CASE("miner map scan writes a deterministic OctoMap and a map that referenc
   // Bad settings name themselves.
   CHECK_THAT(miner_cli({"map", "scan", "--map", src, "--out", dir() + "/scan.json"}).err, Contains("must end in .bt"));
   CHECK_THAT(miner_cli({"map", "scan", "--map", src, "--fov", "400", "60", "--out", bt}).err,
-             Contains("horizontal field of view"));
+             Contains("--fov: must be a finite number in [0, 360], got 400"));
   CHECK_THAT(miner_cli({"map", "info", "--map", json, "--unknown", "maybe"}).err, Contains("--unknown"));
 }
 

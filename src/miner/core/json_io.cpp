@@ -171,6 +171,16 @@ double JsonField::positive_number() const {
   return v;
 }
 
+double JsonField::number_in(double lo, double hi, const std::string& unit) const {
+  const double v = number();
+  if (v < lo || v > hi) {
+    char range[128];
+    std::snprintf(range, sizeof range, "[%g, %g]", lo, hi);
+    fail("must be in " + std::string(range) + (unit.empty() ? "" : " " + unit) + ", got " + value_->dump());
+  }
+  return v;
+}
+
 int JsonField::integer() const {
   const double v = number();
   if (std::floor(v) != v || std::fabs(v) > 2147483647.0) fail("expected an integer, got " + value_->dump());
@@ -191,6 +201,49 @@ Eigen::Vector3d JsonField::vec3() const {
 }
 
 Json vec3_json(const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); }
+
+void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& files) {
+  namespace fs = std::filesystem;
+  std::vector<std::pair<fs::path, fs::path>> moves;  // (temporary, target)
+  std::error_code ec;
+  const auto discard = [&] {
+    for (const auto& [tmp, target] : moves) fs::remove(tmp, ec);
+  };
+  for (const auto& [path, content] : files) {
+    const fs::path target(path);
+    const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+    if (!fs::is_directory(dir, ec)) {
+      discard();
+      throw Error(path + ": folder " + dir.string() + " does not exist");
+    }
+    // What would make a rename fail is checked before any rename: a folder in the file's place.
+    if (fs::is_directory(target, ec)) {
+      discard();
+      throw Error(path + ": is a folder, not a file");
+    }
+    const fs::path tmp = dir / ("." + target.filename().string() + ".tmp." + std::to_string(::getpid()));
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) {
+      discard();
+      throw Error(path + ": cannot write (temporary file " + tmp.string() + ")");
+    }
+    moves.emplace_back(tmp, target);
+    out << content;
+    out.flush();
+    if (!out) {
+      out.close();
+      discard();
+      throw Error(path + ": write failed");
+    }
+  }
+  for (const auto& [tmp, target] : moves) {
+    fs::rename(tmp, target, ec);
+    if (ec) {
+      discard();
+      throw Error(target.string() + ": cannot replace file: " + ec.message());
+    }
+  }
+}
 
 void write_file_atomic(const std::string& path, const std::string& content) {
   namespace fs = std::filesystem;

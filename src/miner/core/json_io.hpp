@@ -42,6 +42,10 @@ class JsonField {
 
   double number() const;                ///< finite number
   double positive_number() const;       ///< finite and > 0
+  /// A finite number in [lo, hi]; the message names the range and `unit` ("must be in [0, 5]
+  /// m, got 1e9"). Every physical value a file gives has a range (issue 20: a goal tolerance
+  /// of 1e9 m made every flight "reach" its goal).
+  double number_in(double lo, double hi, const std::string& unit = "") const;
   int integer() const;                  ///< an integral number
   std::string string() const;
   Eigen::Vector3d vec3() const;         ///< array of 3 finite numbers
@@ -69,6 +73,10 @@ Json vec3_json(const Eigen::Vector3d& v);
 /// Writes `content` to `path` via a temporary file in the same folder and a rename,
 /// so readers see either the old file or the complete new one, never a mix.
 void write_file_atomic(const std::string& path, const std::string& content);
+/// Several files written as one: every content goes to a temporary file beside its target
+/// first, and only when all are written are they renamed into place, so a failure leaves every
+/// existing file as it was (issue 20: `map scan` replaced --out, then failed on --map-out).
+void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& files);
 
 /// Writes `files` (name, content) into the folder `path` as a whole: they are written to
 /// a hidden sibling folder first, which then replaces `path` (the previous folder is moved

@@ -11,18 +11,25 @@ namespace miner::flight {
 ControllerParams controller_params_from_json(const JsonField& f) {
   f.only_keys({"rate_hz", "kp", "kv", "ki", "integral_limit", "max_tilt_deg"});
   ControllerParams c;
-  if (f.has("rate_hz")) c.rate_hz = f.at("rate_hz").positive_number();
+  if (f.has("rate_hz")) c.rate_hz = f.at("rate_hz").number_in(1.0, 10000.0, "Hz");
+  // Gains above kMaxGain (1/s^2, 1/s, 1/s^3) make the loop's own discretisation unstable at any
+  // rate the N3 allows (issue 20: kp 1e300 flew and diverged).
+  constexpr double kMaxGain = 1000.0;
   auto gains = [&](const char* key, Eigen::Vector3d& g, bool allow_zero) {
     if (!f.has(key)) return;
     const JsonField field = f.at(key);
     g = field.vec3();
     if (allow_zero ? g.minCoeff() < 0.0 : !(g.minCoeff() > 0.0))
       field.fail(allow_zero ? "gains must be >= 0" : "gains must be positive");
+    if (g.maxCoeff() > kMaxGain) field.fail("gains must be at most 1000, got " + field.value().dump());
   };
   gains("kp", c.kp, false);
   gains("kv", c.kv, false);
   gains("ki", c.ki, true);
-  if (f.has("integral_limit")) c.integral_limit = f.at("integral_limit").positive_number();
+  if (f.has("integral_limit")) {
+    c.integral_limit = f.at("integral_limit").number_in(0.0, 100.0, "m/s^2");
+    if (!(c.integral_limit > 0.0)) f.at("integral_limit").fail("must be positive");
+  }
   if (f.has("max_tilt_deg")) {
     c.max_tilt_deg = f.at("max_tilt_deg").positive_number();
     if (c.max_tilt_deg >= 90.0) f.at("max_tilt_deg").fail("must be below 90");

@@ -47,8 +47,8 @@ Config config_from_json(const JsonField& f) {
   f.only_keys({"rate_hz", "latency_s", "timeout_s", "failsafe", "max_tilt_deg", "max_yaw_rate_deg"});
   Config c;
   if (f.has("rate_hz")) c.rate_hz = f.at("rate_hz").number();
-  if (f.has("latency_s")) c.latency_s = f.at("latency_s").number();
-  if (f.has("timeout_s")) c.timeout_s = f.at("timeout_s").number();
+  if (f.has("latency_s")) c.latency_s = f.at("latency_s").number_in(0.0, 1.0, "s");
+  if (f.has("timeout_s")) c.timeout_s = f.at("timeout_s").number_in(0.0, 10.0, "s");
   if (f.has("failsafe")) {
     const std::string s = f.at("failsafe").string();
     if (s == "hover") c.failsafe = Failsafe::kHover;
@@ -56,7 +56,7 @@ Config config_from_json(const JsonField& f) {
     else f.at("failsafe").fail("expected \"hover\" or \"land\", got \"" + s + "\"");
   }
   if (f.has("max_tilt_deg")) c.max_tilt_deg = f.at("max_tilt_deg").number();
-  if (f.has("max_yaw_rate_deg")) c.max_yaw_rate_deg = f.at("max_yaw_rate_deg").number();
+  if (f.has("max_yaw_rate_deg")) c.max_yaw_rate_deg = f.at("max_yaw_rate_deg").number_in(0.0, 3600.0, "deg/s");
   try {
     validate(c);
   } catch (const Error& e) {

@@ -92,6 +92,21 @@ Scenario scenario_from_json(const Json& doc, const std::string& origin, const st
     }
     s.waypoints = m;
   }
+  // The route start, waypoints..., goal has no repeated point: a zero-length leg has no
+  // trajectory (issue 20: the refusal came later, naming the pipeline's "points[0]"). A given
+  // trajectory file replaces the route.
+  if (!(root.has("trajectory") && root.at("trajectory").has("file"))) {
+    std::vector<std::pair<Eigen::Vector3d, std::string>> route{{s.start, "start"}};
+    if (s.waypoints)
+      for (Eigen::Index i = 0; i < s.waypoints->rows(); ++i)
+        route.emplace_back(s.waypoints->row(i).transpose(), "waypoints[" + std::to_string(i) + "]");
+    route.emplace_back(s.goal, "goal");
+    constexpr double kCoincident = 1e-9;  // m: closer points are one point
+    for (std::size_t i = 1; i < route.size(); ++i)
+      if ((route[i].first - route[i - 1].first).norm() <= kCoincident)
+        root.fail(route[i].second + " " + format_point(route[i].first) + " coincides with " + route[i - 1].second +
+                  ": remove the repeated point");
+  }
   if (root.has("trajectory")) {
     const JsonField t = root.at("trajectory");
     if (t.has("file")) {
@@ -102,8 +117,8 @@ Scenario scenario_from_json(const Json& doc, const std::string& origin, const st
       s.order = t.at("order").integer();
       if (s.order != 3 && s.order != 4) t.at("order").fail("must be 3 (jerk) or 4 (snap)");
     }
-    if (t.has("v_max")) s.limits.v_max = t.at("v_max").positive_number();
-    if (t.has("a_max")) s.limits.a_max = t.at("a_max").positive_number();
+    if (t.has("v_max")) s.limits.v_max = t.at("v_max").number_in(kMinLimit, kMaxSpeed, "m/s");
+    if (t.has("a_max")) s.limits.a_max = t.at("a_max").number_in(kMinLimit, kMaxAcceleration, "m/s^2");
     if (t.has("allocation")) {
       s.allocation = t.at("allocation").string();
       if (s.allocation != "trapezoid" && s.allocation != "optimise")
@@ -111,7 +126,7 @@ Scenario scenario_from_json(const Json& doc, const std::string& origin, const st
     }
     if (t.has("rho")) {
       if (s.allocation != "optimise") t.at("rho").fail("only used with \"allocation\": \"optimise\"");
-      s.rho = t.at("rho").positive_number();
+      s.rho = t.at("rho").number_in(1e-9, 1e9);
     }
     t.only_keys({"file", "order", "v_max", "a_max", "allocation", "rho"});
   }
@@ -125,7 +140,8 @@ Scenario scenario_from_json(const Json& doc, const std::string& origin, const st
     if (p.has("weights")) s.weights = resolve(base_dir, p.at("weights").string());
     if (p.has("iterations")) {
       const long long n = p.at("iterations").integer();
-      if (n < 1) p.at("iterations").fail("must be >= 1");
+      if (n < 1 || n > kMaxPlannerIterations)
+        p.at("iterations").fail("must be in [1, " + std::to_string(kMaxPlannerIterations) + "], got " + std::to_string(n));
       s.planner_iterations = static_cast<std::size_t>(n);
     }
   }
@@ -140,10 +156,17 @@ Scenario scenario_from_json(const Json& doc, const std::string& origin, const st
       root.at("hover_after_s").fail("must be at most " + std::to_string(static_cast<int>(kMaxFlightSeconds)) +
                                     " s (the longest simulated flight), got " + std::to_string(s.hover_after_s));
   }
-  if (root.has("goal_tolerance_m")) s.goal_tolerance = root.at("goal_tolerance_m").positive_number();
+  if (root.has("goal_tolerance_m")) {
+    s.goal_tolerance = root.at("goal_tolerance_m").number_in(0.0, kMaxGoalTolerance, "m");
+    if (!(s.goal_tolerance > 0.0)) root.at("goal_tolerance_m").fail("must be positive");
+  }
   if (root.has("planning_margin_m")) {
-    s.planning_margin = root.at("planning_margin_m").number();
-    if (s.planning_margin < 0.0) root.at("planning_margin_m").fail("must be >= 0");
+    s.planning_margin = root.at("planning_margin_m").number_in(0.0, kMaxPlanningMargin, "m");
+    // The planner keeps the vehicle radius + margin clear: it must fit the map's radius bound.
+    if (s.vehicle.radius + s.planning_margin > world::kMaxRobotRadius)
+      root.at("planning_margin_m").fail("with the vehicle radius " + std::to_string(s.vehicle.radius) +
+                                        " m gives a clearance above the " +
+                                        std::to_string(static_cast<int>(world::kMaxRobotRadius)) + " m a plan may keep");
   }
   if (root.has("imu")) s.imu = imu_params_from_json(root.at("imu"));
   if (root.has("pose")) s.pose = pose_params_from_json(root.at("pose"));
@@ -156,9 +179,16 @@ Scenario scenario_from_json(const Json& doc, const std::string& origin, const st
       s.ekf.gate_probability = e.at("gate_probability").positive_number();
       if (s.ekf.gate_probability >= 1.0) e.at("gate_probability").fail("must be below 1");
     }
-    if (e.has("initial_position_sigma")) s.ekf.initial_position_sigma = e.at("initial_position_sigma").positive_number();
-    if (e.has("initial_velocity_sigma")) s.ekf.initial_velocity_sigma = e.at("initial_velocity_sigma").positive_number();
-    if (e.has("initial_attitude_sigma")) s.ekf.initial_attitude_sigma = e.at("initial_attitude_sigma").positive_number();
+    // Initial uncertainties: positive (the EKF inverts them) and no wider than the largest map
+    // (m, m/s) or a half turn (rad).
+    const auto sigma = [&](const char* key, double hi, const char* unit, double& to) {
+      if (!e.has(key)) return;
+      to = e.at(key).number_in(0.0, hi, unit);
+      if (!(to > 0.0)) e.at(key).fail("must be positive");
+    };
+    sigma("initial_position_sigma", 100.0, "m", s.ekf.initial_position_sigma);
+    sigma("initial_velocity_sigma", 100.0, "m/s", s.ekf.initial_velocity_sigma);
+    sigma("initial_attitude_sigma", kPi, "rad", s.ekf.initial_attitude_sigma);
   }
   s.ekf.imu = s.imu;
   s.ekf.pose = s.pose;
@@ -170,7 +200,8 @@ Scenario scenario_from_json(const Json& doc, const std::string& origin, const st
     const JsonField d = root.at("command_dropout_s");
     if (d.array_size() != 2) d.fail("expected [t0, t1]");
     const double t0 = d.at(0).number(), t1 = d.at(1).number();
-    if (!(t0 >= 0.0 && t1 > t0)) d.fail("needs 0 <= t0 < t1");
+    if (!(t0 >= 0.0 && t1 > t0 && t1 <= kMaxFlightSeconds))
+      d.fail("needs 0 <= t0 < t1 <= " + std::to_string(static_cast<int>(kMaxFlightSeconds)) + " s");
     s.command_dropout = std::make_pair(t0, t1);
   }
   // The limits themselves must be flyable: a horizontal a_max needs atan(a_max / g) of tilt.

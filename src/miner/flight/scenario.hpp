@@ -46,6 +46,19 @@ inline constexpr const char* kScenarioFormat = "miner-scenario-v1";
 /// long hover, or limits so low that the reference lasts hours) is refused before any
 /// sampling or simulation (REQ-FLIGHT-007).
 inline constexpr double kMaxFlightSeconds = 1000.0;
+/// Ranges of a scenario's values (REQ-FLIGHT-007; issue 20: a goal tolerance of 1e9 m made any
+/// flight "reach" its goal, v_max 1e308 was accepted). Speed and acceleration limits: from
+/// 1 cm/s (below it the reference outlasts kMaxFlightSeconds on any map) to what a racing
+/// quadrotor reaches; the tilt check below narrows a_max further.
+inline constexpr double kMinLimit = 0.01;
+inline constexpr double kMaxSpeed = 50.0;          ///< m/s
+inline constexpr double kMaxAcceleration = 50.0;   ///< m/s^2
+/// Arrival within 5 m: a wider tolerance no longer says the vehicle reached its goal.
+inline constexpr double kMaxGoalTolerance = 5.0;   ///< m
+/// The planning margin grows the robot radius; 10 m is the largest robot radius a map takes.
+inline constexpr double kMaxPlanningMargin = 10.0;  ///< m
+/// The planner's iteration budget (the CLI's --iterations bound: a tree of ~1 GB).
+inline constexpr long long kMaxPlannerIterations = 10000000;
 
 struct Scenario {
   std::string name = "scenario";

@@ -58,12 +58,11 @@ PoseMeasurement measure_pose(const PoseParams& params, double stamp, const Eigen
 }
 
 namespace {
-double optional_non_negative(const JsonField& f, const char* key, double fallback) {
+/// An optional value in [0, hi] `unit` (issue 20: an accelerometer noise of 1e300 and a pose
+/// delay of 1e6 s were accepted and flown).
+double optional_non_negative(const JsonField& f, const char* key, double fallback, double hi, const char* unit) {
   if (!f.has(key)) return fallback;
-  const JsonField v = f.at(key);
-  const double x = v.number();
-  if (x < 0.0) v.fail("must be >= 0, got " + v.value().dump());
-  return x;
+  return f.at(key).number_in(0.0, hi, unit);
 }
 }  // namespace
 
@@ -71,24 +70,27 @@ ImuParams imu_params_from_json(const JsonField& f) {
   f.only_keys({"accel_noise_density", "gyro_noise_density", "accel_bias_random_walk", "gyro_bias_random_walk",
                "accel_bias_initial", "gyro_bias_initial"});
   ImuParams p;
-  p.accel_noise_density = optional_non_negative(f, "accel_noise_density", p.accel_noise_density);
-  p.gyro_noise_density = optional_non_negative(f, "gyro_noise_density", p.gyro_noise_density);
-  p.accel_bias_random_walk = optional_non_negative(f, "accel_bias_random_walk", p.accel_bias_random_walk);
-  p.gyro_bias_random_walk = optional_non_negative(f, "gyro_bias_random_walk", p.gyro_bias_random_walk);
-  p.accel_bias_initial = optional_non_negative(f, "accel_bias_initial", p.accel_bias_initial);
-  p.gyro_bias_initial = optional_non_negative(f, "gyro_bias_initial", p.gyro_bias_initial);
+  p.accel_noise_density = optional_non_negative(f, "accel_noise_density", p.accel_noise_density, 1.0, "m/s^2/sqrt(Hz)");
+  p.gyro_noise_density = optional_non_negative(f, "gyro_noise_density", p.gyro_noise_density, 1.0, "rad/s/sqrt(Hz)");
+  p.accel_bias_random_walk = optional_non_negative(f, "accel_bias_random_walk", p.accel_bias_random_walk, 1.0, "m/s^3/sqrt(Hz)");
+  p.gyro_bias_random_walk = optional_non_negative(f, "gyro_bias_random_walk", p.gyro_bias_random_walk, 1.0, "rad/s^2/sqrt(Hz)");
+  p.accel_bias_initial = optional_non_negative(f, "accel_bias_initial", p.accel_bias_initial, 10.0, "m/s^2");
+  p.gyro_bias_initial = optional_non_negative(f, "gyro_bias_initial", p.gyro_bias_initial, 1.0, "rad/s");
   return p;
 }
 
 PoseParams pose_params_from_json(const JsonField& f) {
   f.only_keys({"rate_hz", "delay_s", "position_sigma", "attitude_sigma", "outlier_probability", "outlier_magnitude"});
   PoseParams p;
-  if (f.has("rate_hz")) p.rate_hz = f.at("rate_hz").positive_number();
-  p.delay_s = optional_non_negative(f, "delay_s", p.delay_s);
-  p.position_sigma = optional_non_negative(f, "position_sigma", p.position_sigma);
-  p.attitude_sigma = optional_non_negative(f, "attitude_sigma", p.attitude_sigma);
-  p.outlier_probability = optional_non_negative(f, "outlier_probability", p.outlier_probability);
-  p.outlier_magnitude = optional_non_negative(f, "outlier_magnitude", p.outlier_magnitude);
+  if (f.has("rate_hz")) {
+    p.rate_hz = f.at("rate_hz").number_in(0.0, 10000.0, "Hz");
+    if (!(p.rate_hz > 0.0)) f.at("rate_hz").fail("must be positive");
+  }
+  p.delay_s = optional_non_negative(f, "delay_s", p.delay_s, 1.0, "s");
+  p.position_sigma = optional_non_negative(f, "position_sigma", p.position_sigma, 10.0, "m");
+  p.attitude_sigma = optional_non_negative(f, "attitude_sigma", p.attitude_sigma, 1.0, "rad");
+  p.outlier_probability = optional_non_negative(f, "outlier_probability", p.outlier_probability, 1.0, "");
+  p.outlier_magnitude = optional_non_negative(f, "outlier_magnitude", p.outlier_magnitude, 100.0, "m");
   if (p.outlier_probability > 1.0) f.at("outlier_probability").fail("must be in [0, 1]");
   if (!(p.position_sigma > 0.0) || !(p.attitude_sigma > 0.0))
     f.fail("position_sigma and attitude_sigma must be positive (the EKF divides by them)");

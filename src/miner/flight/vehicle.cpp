@@ -1,10 +1,12 @@
 #include "miner/flight/vehicle.hpp"
 
 #include <cmath>
+#include <cstdio>
 
 #include <Eigen/LU>
 
 #include "miner/core/error.hpp"
+#include "miner/world/map.hpp"
 
 namespace miner::flight {
 
@@ -28,21 +30,27 @@ double VehicleParams::hover_rotor_speed() const {
 }
 
 void validate(const VehicleParams& v, const std::string& origin) {
-  auto positive = [&](double x, const char* field) {
-    if (!std::isfinite(x) || !(x > 0.0)) bad(origin, field, "must be a positive finite number, got " + std::to_string(x));
+  // Each value positive and at most `hi`: bounds far above any multirotor (a 1 t, 20 m vehicle)
+  // that still refuse the absurd (issue 20: values near 1e308 flew).
+  auto positive = [&](double x, const char* field, double hi) {
+    if (!std::isfinite(x) || !(x > 0.0) || x > hi) {
+      char text[160];
+      std::snprintf(text, sizeof text, "must be a finite number in (0, %g], got %g", hi, x);
+      bad(origin, field, text);
+    }
   };
-  positive(v.mass, "mass_kg");
-  for (int i = 0; i < 3; ++i) positive(v.inertia[i], "inertia_kg_m2");
-  positive(v.arm_length, "arm_length_m");
-  positive(v.thrust_coefficient, "thrust_coefficient_N_per_rad_s2");
-  positive(v.torque_to_thrust_ratio, "torque_to_thrust_ratio_m");
-  positive(v.rotor_speed_max, "rotor_speed_max_rad_s");
-  positive(v.motor_time_constant_up, "motor_time_constant_up_s");
-  positive(v.motor_time_constant_down, "motor_time_constant_down_s");
-  positive(v.radius, "radius_m");
+  positive(v.mass, "mass_kg", 1000.0);
+  for (int i = 0; i < 3; ++i) positive(v.inertia[i], "inertia_kg_m2", 1000.0);
+  positive(v.arm_length, "arm_length_m", 10.0);
+  positive(v.thrust_coefficient, "thrust_coefficient_N_per_rad_s2", 1.0);
+  positive(v.torque_to_thrust_ratio, "torque_to_thrust_ratio_m", 1.0);
+  positive(v.rotor_speed_max, "rotor_speed_max_rad_s", 1e5);
+  positive(v.motor_time_constant_up, "motor_time_constant_up_s", 1.0);
+  positive(v.motor_time_constant_down, "motor_time_constant_down_s", 1.0);
+  positive(v.radius, "radius_m", world::kMaxRobotRadius);
   for (int i = 0; i < 3; ++i) {
-    if (!std::isfinite(v.linear_drag[i]) || v.linear_drag[i] < 0.0)
-      bad(origin, "linear_drag_N_s_per_m", "must be finite and >= 0");
+    if (!std::isfinite(v.linear_drag[i]) || v.linear_drag[i] < 0.0 || v.linear_drag[i] > 100.0)
+      bad(origin, "linear_drag_N_s_per_m", "must be finite and in [0, 100]");
     const double j = v.inertia[i], a = v.inertia[(i + 1) % 3], b = v.inertia[(i + 2) % 3];
     if (j > a + b)
       bad(origin, "inertia_kg_m2", "principal moments violate the triangle inequality (" +

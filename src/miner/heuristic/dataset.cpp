@@ -155,9 +155,13 @@ std::vector<Json> read_index(const std::string& dir, const SplitLayout& S) {
     e.only_keys({"k", "map_seed", "start", "goal", "astar_cost"});
     for (const char* key : {"k", "map_seed"})
       if (!e.at(key).value().is_number_unsigned()) e.at(key).fail("expected an integer in [0, 2^64 - 1]");
-    e.at("start").vec3();
-    e.at("goal").vec3();
-    e.at("astar_cost").number();
+    const Eigen::Vector3d start = e.at("start").vec3(), goal = e.at("goal").vec3();
+    // A path is never shorter than the straight line (issue 20: a cost of -5 merged); the
+    // tolerance allows the cost's own rounding.
+    constexpr double kCostRounding = 1e-9;
+    const double cost = e.at("astar_cost").number();
+    if (cost < (goal - start).norm() * (1.0 - kCostRounding))
+      e.at("astar_cost").fail("is " + e.at("astar_cost").value().dump() + ", shorter than the straight line from start to goal");
     out.push_back(e.value());
   }
   return out;
@@ -172,7 +176,8 @@ void validate(const DatasetOptions& o) {
   if (!(o.val_fraction >= 0.0 && o.val_fraction < 1.0)) throw Error("dataset: --val-fraction must be in [0, 1)");
   if ((o.dims.array() < 4).any() || (o.dims.array() > 256).any())
     throw Error("dataset: --dims must be between 4 and 256 cells per axis");
-  if (o.dilation < 0 || o.dilation > 4) throw Error("dataset: --dilation must be in [0, 4]");
+  if (o.dilation < 0 || o.dilation > plan::HeuristicRegion::kMaxDilation)
+    throw Error("dataset: --dilation must be in [0, " + std::to_string(plan::HeuristicRegion::kMaxDilation) + "]");
   if (o.shard_size < 1) throw Error("dataset: --shard-size must be >= 1");
   if (o.jobs < 1 || o.jobs > 256) throw Error("dataset: --jobs must be in [1, 256]");
   require_shard(o.shard_index, o.shard_count);

@@ -214,8 +214,17 @@ struct Sgan::Impl {
 
 void Sgan::Impl::build(const TensorFile& f, Sgan::FirstLayer first_layer) {
   const JsonField a(f.meta, "meta", f.path);
+  a.only_keys({"architecture", "final", "training"});
   const JsonField ar = a.at("architecture");
+  ar.only_keys({"name", "width", "dims", "environment_scale", "threshold", "layers"});
   if (ar.at("name").string() != "sgan-unet4") ar.at("name").fail("unknown architecture (expected sgan-unet4)");
+  if (ar.has("layers")) {  // optional (the tensors name the layers); when given it must be right
+    const std::vector<std::string> expected{"enc1", "enc2", "enc3", "enc4", "mid1", "mid2", "dec3", "dec2", "dec1"};
+    const JsonField layers = ar.at("layers");
+    std::vector<std::string> given;
+    for (std::size_t i = 0; i < layers.array_size(); ++i) given.push_back(layers.at(i).string());
+    if (given != expected) layers.fail("must list sgan-unet4's nine layers enc1 ... dec1 in order");
+  }
   arch.width = ar.at("width").integer();
   if (arch.width < 1 || arch.width > 256) ar.at("width").fail("must be in [1, 256]");
   const JsonField dims = ar.at("dims");
@@ -223,7 +232,10 @@ void Sgan::Impl::build(const TensorFile& f, Sgan::FirstLayer first_layer) {
   if ((arch.dims.array() < 8).any() || (arch.dims.array() > 256).any() || arch.dims.x() % 8 != 0 ||
       arch.dims.y() % 8 != 0 || arch.dims.z() % 8 != 0)
     dims.fail("each must be a multiple of 8 in [8, 256]");
-  arch.environment_scale = ar.at("environment_scale").number();
+  // E in {0, 1, 2} enters the network as E x scale: a scale outside (0, 1] is no encoding the
+  // network was trained on (issue 20: -1e300 was accepted).
+  arch.environment_scale = ar.at("environment_scale").number_in(0.0, 1.0);
+  if (!(arch.environment_scale > 0.0)) ar.at("environment_scale").fail("must be positive");
   arch.threshold = ar.at("threshold").number();
   if (!(arch.threshold > 0.0 && arch.threshold < 1.0)) ar.at("threshold").fail("must be in (0, 1)");
 

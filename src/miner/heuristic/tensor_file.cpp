@@ -1,5 +1,7 @@
 #include "miner/heuristic/tensor_file.hpp"
 
+#include <algorithm>
+
 #include <cstdio>
 #include <cstring>
 #include <sstream>
@@ -60,6 +62,8 @@ TensorFile parse_tensor_file(const std::string& blob, const std::string& path, c
     throw Error(path + ": the header is not valid JSON (" + e.what() + ")");
   }
   const JsonField root(header, "", path);
+  if (!header.is_object()) root.fail("the header is not a JSON object");
+  root.only_keys({"format", "kind", "meta", "data_bytes", "data_fnv1a64", "tensors"});
   if (root.at("format").string() != "miner-tensors-v1") root.at("format").fail("expected miner-tensors-v1");
   f.kind = root.at("kind").string();
   if (f.kind != kind) root.at("kind").fail("expected '" + kind + "'");
@@ -76,8 +80,10 @@ TensorFile parse_tensor_file(const std::string& blob, const std::string& path, c
   if (root.at("data_fnv1a64").string() != hex)
     throw Error(path + ": checksum mismatch (the data was altered or the file is damaged)");
   const JsonField list = root.at("tensors");
+  std::vector<std::pair<std::size_t, std::size_t>> spans;  // (first byte, end) of each tensor
   for (std::size_t t = 0; t < list.array_size(); ++t) {
     const JsonField e = list.at(t);
+    e.only_keys({"name", "shape", "count", "offset"});
     const std::string name = e.at("name").string();
     Tensor tensor;
     std::size_t product = 1;
@@ -91,12 +97,24 @@ TensorFile parse_tensor_file(const std::string& blob, const std::string& path, c
     const auto count = static_cast<std::size_t>(e.at("count").integer());
     const auto offset = static_cast<std::size_t>(e.at("offset").integer());
     if (count != product) e.at("count").fail("does not match the shape " + shape_text(tensor.shape));
-    if (offset % 4 != 0 || offset > data_bytes || count > (data_bytes - offset) / 4)
-      e.at("offset").fail("the tensor runs past the data");
+    if (offset % 4 != 0) e.at("offset").fail("must be a multiple of 4 (float32 data), got " + std::to_string(offset));
+    if (offset > data_bytes || count > (data_bytes - offset) / 4) e.at("offset").fail("the tensor runs past the data");
+    spans.emplace_back(offset, offset + count * 4);
     tensor.values.resize(count);
     std::memcpy(tensor.values.data(), data + offset, count * 4);  // little-endian host (x86-64, arm64)
     if (!f.tensors.emplace(name, std::move(tensor)).second) e.at("name").fail("appears twice");
   }
+  // The tensors tile the data: no two share a byte (issue 20: a bias aliased its weights) and
+  // none is left over.
+  std::sort(spans.begin(), spans.end());
+  std::size_t end = 0;
+  for (const auto& [first, last] : spans) {
+    if (first < end) list.fail("two tensors overlap in the data (bytes " + std::to_string(first) + " to " +
+                               std::to_string(end) + ")");
+    if (first > end) list.fail("data bytes " + std::to_string(end) + " to " + std::to_string(first) + " belong to no tensor");
+    end = last;
+  }
+  if (end != data_bytes) list.fail("data bytes " + std::to_string(end) + " to " + std::to_string(data_bytes) + " belong to no tensor");
   return f;
 }
 

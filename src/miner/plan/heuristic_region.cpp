@@ -124,7 +124,8 @@ void HeuristicRegion::save(const std::string& path) const {
 HeuristicRegion HeuristicRegion::from_path(const world::Box& bounds, const Eigen::Vector3i& dims,
                                            const std::vector<Eigen::Vector3d>& path, int dilation,
                                            std::string source) {
-  if (dilation < 0) throw Error("region dilation: must be >= 0, got " + std::to_string(dilation));
+  if (dilation < 0 || dilation > kMaxDilation)
+    throw Error("region dilation: must be in [0, " + std::to_string(kMaxDilation) + "], got " + std::to_string(dilation));
   if (path.empty()) throw Error("region from path: the path has no points");
   HeuristicRegion region(bounds, dims,
                          std::vector<double>(cell_count(dims), 0.0),

@@ -46,6 +46,9 @@ class HeuristicRegion {
   /// and output and the A*-dilated region's default; one constant for every default.
   static constexpr int kGridSide = 32;
   static Eigen::Vector3i default_dims() { return Eigen::Vector3i::Constant(kGridSide); }
+  /// Largest dilation of a path region, in cells (from_path, miner dataset, miner region):
+  /// 4 cells on each side already make a 9-cell-wide tube, over a quarter of a 32-cell axis.
+  static constexpr int kMaxDilation = 4;
   /// nx ny nz, checked without integer wrap: throws miner::Error naming the dims when an
   /// entry is < 1 or the product exceeds kMaxCells (REQ-PLAN-005).
   static std::size_t cell_count(const Eigen::Vector3i& dims);

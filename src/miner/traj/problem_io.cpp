@@ -7,6 +7,13 @@
 namespace miner::traj {
 
 namespace {
+/// Limits a problem file may give (m/s, m/s^2): wide enough for any unit a user picks at
+/// these scales, narrow enough that the trapezoid's v^2 / a stays finite.
+constexpr double kMinLimitValue = 1e-6;
+constexpr double kMaxLimitValue = 1e6;
+}  // namespace
+
+namespace {
 Eigen::MatrixX3d rows_of(const JsonField& f) {
   const std::size_t n = f.array_size();
   Eigen::MatrixX3d m(static_cast<Eigen::Index>(n), 3);
@@ -31,7 +38,10 @@ MincoProblem problem_from_json(const Json& doc, const std::string& origin) {
     if (!root.has("limits")) root.fail("needs \"durations\" or \"limits\" (for trapezoidal allocation)");
     const JsonField l = root.at("limits");
     l.only_keys({"v_max", "a_max"});
-    const Limits limits{l.at("v_max").number(), l.at("a_max").number()};
+    // Physical speeds and accelerations: 1e308 overflowed the trapezoid's v^2 / a into NaN
+    // durations, reported as a field the file does not have (issue 20).
+    const Limits limits{l.at("v_max").number_in(kMinLimitValue, kMaxLimitValue, "m/s"),
+                        l.at("a_max").number_in(kMinLimitValue, kMaxLimitValue, "m/s^2")};
     try {
       validate(limits);
     } catch (const Error& e) {
@@ -65,8 +75,9 @@ TrajectoryRequest request_from_json(const Json& doc, const std::string& origin, 
     root.at("durations").fail("durations are given, so there is nothing to optimise: drop them (or the optimise request)");
   AllocationOptions o;
   const JsonField l = root.at("limits");
-  o.limits = Limits{l.at("v_max").number(), l.at("a_max").number()};
-  if (root.has("rho")) o.rho = root.at("rho").positive_number();
+  o.limits = Limits{l.at("v_max").number_in(kMinLimitValue, kMaxLimitValue, "m/s"),
+                    l.at("a_max").number_in(kMinLimitValue, kMaxLimitValue, "m/s^2")};
+  if (root.has("rho")) o.rho = root.at("rho").number_in(1e-9, 1e9);
   if (rho_override) {
     if (!std::isfinite(*rho_override) || !(*rho_override > 0.0))
       throw Error("--rho: must be positive and finite, got " + std::to_string(*rho_override));

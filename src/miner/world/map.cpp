@@ -39,6 +39,15 @@ std::string box_name(std::size_t i, const Box& b) {
 
 }  // namespace
 
+void check_resolution(double resolution, const std::string& field) {
+  if (!std::isfinite(resolution) || resolution < kMinResolution || resolution > kMaxResolution) {
+    std::ostringstream os;
+    os << field << ": " << resolution << " m is outside the resolutions a map may have [" << kMinResolution << ", "
+       << kMaxResolution << "] m";
+    throw Error(os.str());
+  }
+}
+
 Eigen::Vector3i grid_dims(const Box& bounds, double resolution) {
   // Snaps in the cell count: a face within this many cells of a whole number is on it.
   constexpr double kGridSnapTolerance = 1e-9;
@@ -69,12 +78,14 @@ Map::Map(Box bounds, double resolution, std::vector<Box> obstacles, std::optiona
       query_(std::move(query)),
       source_(std::move(voxels)) {
   validate_box(bounds_, "bounds");
-  require_finite(resolution_, "resolution");
-  if (!(resolution_ > 0.0)) {
-    std::ostringstream os;
-    os << "resolution: must be positive, got " << resolution_;
-    throw Error(os.str());
-  }
+  for (const auto& [corner, name] : {std::pair{&bounds_.min, "bounds.min"}, std::pair{&bounds_.max, "bounds.max"}})
+    if (corner->cwiseAbs().maxCoeff() > kMaxCoordinate) {
+      std::ostringstream os;
+      os << name << ": " << format_point(*corner) << " lies farther than " << kMaxCoordinate
+         << " m from the origin (use a local frame)";
+      throw Error(os.str());
+    }
+  check_resolution(resolution_, "resolution");
   (void)grid_dims(bounds_, resolution_);  // a grid A* and the voxel grid can hold
   for (std::size_t i = 0; i < obstacles_.size(); ++i) {
     validate_box(obstacles_[i], "obstacles[" + std::to_string(i) + "]");
@@ -83,7 +94,13 @@ Map::Map(Box bounds, double resolution, std::vector<Box> obstacles, std::optiona
     require_finite(query_->start, "query.start");
     require_finite(query_->goal, "query.goal");
     require_finite(query_->robot_radius, "query.robot_radius");
-    if (query_->robot_radius < 0.0) throw Error("query.robot_radius: must not be negative");
+    if (query_->robot_radius < 0.0 || query_->robot_radius > kMaxRobotRadius) {
+      std::ostringstream os;
+      os << "query.robot_radius: " << query_->robot_radius << " m is outside [0, " << kMaxRobotRadius << "] m";
+      throw Error(os.str());
+    }
+    for (const auto& [p, name] : {std::pair{&query_->start, "query.start"}, std::pair{&query_->goal, "query.goal"}})
+      if (!in_bounds(*p)) throw Error(std::string(name) + ": " + format_point(*p) + " lies outside the map bounds");
   }
   if (source_) {
     if (!source_->layer) throw Error("voxels: no layer");
@@ -253,8 +270,9 @@ Map Map::from_json(const Json& doc, const std::string& origin) {
   if (root.has("query")) {
     const JsonField q = root.at("query");
     q.only_keys({"start", "goal", "robot_radius"});
-    query = Query{q.at("start").vec3(), q.at("goal").vec3(),
-                  q.has("robot_radius") ? q.at("robot_radius").number() : 0.0};
+    // The radius is required: a forgotten one planned for a point robot, touching obstacles
+    // (issue 20); 0 must be said.
+    query = Query{q.at("start").vec3(), q.at("goal").vec3(), q.at("robot_radius").number()};
   }
   try {
     return Map(bounds, resolution, std::move(obstacles), query, std::move(voxels));

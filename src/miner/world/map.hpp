@@ -36,6 +36,22 @@ inline constexpr const char* kMapFormat = "miner-map-v1";
 /// Largest grid a map may have (cells of `resolution` over its bounds): 2^28 cells keep A*'s
 /// ~9 bytes per cell near 2.4 GB. A map whose resolution gives more is refused (REQ-WORLD-002).
 inline constexpr double kMaxGridCells = 268435456.0;
+/// The metric range of a map (REQ-WORLD-002; issue 20: a resolution of 1e-300 overflowed the
+/// voxel grid's inflation, 1e300 made OctoMap's keys infinite and planning hang, and maps of
+/// 1e300 m gave infinite costs). Every reader (JSON, OctoMap, point-cloud import, scans)
+/// refuses values outside it, naming the file and field.
+/// 1 mm: finer than any mapping sensor's voxel (and 2^28 cells then span only 0.65 m^3).
+inline constexpr double kMinResolution = 1e-3;
+/// 100 m: coarser cells than any vehicle could plan in.
+inline constexpr double kMaxResolution = 100.0;
+/// 1000 km from the origin: double then keeps metres to ~1e-10 m, and a map of the Earth's
+/// scale still fits; beyond it a local frame is what the user needs.
+inline constexpr double kMaxCoordinate = 1e6;
+/// A vehicle 20 m across; the scan's swept body has the same bound.
+inline constexpr double kMaxRobotRadius = 10.0;
+/// Throws miner::Error "<field>: ..." unless `resolution` is finite and in [kMinResolution,
+/// kMaxResolution].
+void check_resolution(double resolution, const std::string& field);
 
 /// A start/goal pair stored with a map (optional extension of miner-map-v1), so a map
 /// generated for a benchmark carries the query it was checked against.

@@ -71,6 +71,8 @@ Header parse_header(const std::string& bytes, const std::string& origin) {
     }
     std::string value, extra;
     if (!(in >> value) || (in >> extra)) fail(origin, "header line \"" + line + "\" is not \"<key> <value>\"");
+    if ((key == "id" && have_id) || (key == "size" && have_size) || (key == "res" && have_res))
+      fail(origin, "header key \"" + key + "\" is given twice");
     if (key == "id") {
       h.id = value;
       have_id = true;
@@ -84,6 +86,12 @@ Header parse_header(const std::string& bytes, const std::string& origin) {
       h.res = std::strtod(value.c_str(), &end);
       if (end == value.c_str() || *end != '\0' || !std::isfinite(h.res) || !(h.res > 0.0))
         fail(origin, "header res \"" + value + "\" is not a positive resolution in m");
+      if (h.res < kMinResolution || h.res > kMaxResolution) {
+        std::ostringstream os;
+        os << "header res " << value << " m is outside the resolutions a map may have [" << kMinResolution << ", "
+           << kMaxResolution << "] m";
+        fail(origin, os.str());
+      }
       have_res = true;
     } else {
       fail(origin, "unknown header key \"" + key + "\" (an OctoMap header has id, size, res and data)");

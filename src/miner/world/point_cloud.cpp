@@ -10,6 +10,7 @@
 
 #include "miner/core/error.hpp"
 #include "miner/core/json_io.hpp"
+#include "miner/world/map.hpp"
 #include "miner/world/octree_leaves.hpp"
 
 namespace miner::world {
@@ -115,7 +116,7 @@ void add_point(PointCloud& cloud, const Eigen::Vector3d& p) {
 /// Reads `n` records of `fields` (x, y, z at xyz[0..2]) from ASCII lines or binary bytes.
 void read_records(PointCloud& cloud, const std::string& bytes, std::size_t pos, std::size_t n,
                   const std::vector<Field>& fields, const std::array<int, 3>& xyz, bool ascii, bool swap,
-                  std::size_t stride, const std::string& origin) {
+                  std::size_t stride, const std::string& origin, bool exact_end) {
   if (ascii) {
     std::size_t line_start = pos;
     for (std::size_t i = 0; i < n; ++i) {
@@ -132,7 +133,7 @@ void read_records(PointCloud& cloud, const std::string& bytes, std::size_t pos, 
         --i;
         continue;
       }
-      if (w.size() < fields.size()) {
+      if (w.size() != fields.size()) {
         std::ostringstream os;
         os << "point " << i << " has " << w.size() << " values, the header declares " << fields.size();
         fail(origin, os.str());
@@ -140,12 +141,25 @@ void read_records(PointCloud& cloud, const std::string& bytes, std::size_t pos, 
       add_point(cloud, {parse_number(w[xyz[0]], origin, i), parse_number(w[xyz[1]], origin, i),
                         parse_number(w[xyz[2]], origin, i)});
     }
+    // Nothing but blank space may follow the declared points (issue 20: extra lines were dropped).
+    if (exact_end && line_start < bytes.size() &&
+        bytes.find_first_not_of(" \t\r\n", line_start) != std::string::npos) {
+      std::ostringstream os;
+      os << "data continues after the " << n << " points the header declares";
+      fail(origin, os.str());
+    }
     return;
   }
   if ((bytes.size() - pos) / stride < n) {
     std::ostringstream os;
     os << "the header declares " << n << " points of " << stride << " bytes, but only " << bytes.size() - pos
        << " data bytes follow";
+    fail(origin, os.str());
+  }
+  if (exact_end && bytes.size() - pos != n * stride) {
+    std::ostringstream os;
+    os << bytes.size() - pos - n * stride << " bytes follow the " << n << " points of " << stride
+       << " bytes the header declares";
     fail(origin, os.str());
   }
   cloud.points.reserve(n);
@@ -175,7 +189,7 @@ PointCloud parse_ply(const std::string& bytes, const std::string& origin) {
   if (lines.next() != "ply") fail(origin, "not a PLY file (the first line is not \"ply\")");
   std::string format;
   std::size_t vertices = 0;
-  bool in_vertex = false, seen_element = false;
+  bool in_vertex = false, seen_element = false, other_elements = false;
   std::vector<Field> fields;
   std::size_t stride = 0;
   while (true) {
@@ -184,6 +198,8 @@ PointCloud parse_ply(const std::string& bytes, const std::string& origin) {
     if (w[0] == "end_header") break;
     if (w[0] == "format") {
       if (w.size() != 3) fail(origin, "malformed format line");
+      if (!format.empty()) fail(origin, "the header has two format lines");
+      if (w[2] != "1.0") fail(origin, "PLY version \"" + w[2] + "\" (MINER reads version 1.0)");
       format = w[1];
       if (format != "ascii" && format != "binary_little_endian" && format != "binary_big_endian")
         fail(origin, "unknown PLY format \"" + format + "\"");
@@ -192,6 +208,7 @@ PointCloud parse_ply(const std::string& bytes, const std::string& origin) {
       if (!seen_element && w[1] != "vertex") fail(origin, "the first element is \"" + w[1] + "\", not \"vertex\"");
       in_vertex = !seen_element;
       if (in_vertex) vertices = count_of(w[2], "element vertex", origin);
+      else other_elements = true;
       seen_element = true;
     } else if (w[0] == "property") {
       if (!in_vertex) continue;  // properties of later elements are never read
@@ -217,8 +234,9 @@ PointCloud parse_ply(const std::string& bytes, const std::string& origin) {
   if (!seen_element) fail(origin, "the header declares no vertex element");
   const std::array<int, 3> xyz = find_xyz(fields, origin);
   PointCloud cloud;
+  // Later elements (faces, edges) follow the vertices: only a vertex-only file must end with them.
   read_records(cloud, bytes, lines.pos, vertices, fields, xyz, format == "ascii", format == "binary_big_endian",
-               stride, origin);
+               stride, origin, !other_elements);
   return cloud;
 }
 
@@ -226,7 +244,8 @@ PointCloud parse_pcd(const std::string& bytes, const std::string& origin) {
   Lines lines{bytes, origin};
   std::vector<std::string> names, sizes, types, counts;
   std::size_t points = 0, width = 0, height = 1;
-  bool have_points = false;
+  bool have_points = false, have_width = false;
+  std::vector<std::string> seen;  // header keys, each at most once
   std::optional<Eigen::Vector3d> viewpoint;
   std::string data;
   while (true) {
@@ -234,12 +253,18 @@ PointCloud parse_pcd(const std::string& bytes, const std::string& origin) {
     const std::vector<std::string> w = words(line);
     if (w.empty() || w[0][0] == '#') continue;
     const std::vector<std::string> rest(w.begin() + 1, w.end());
+    if (std::find(seen.begin(), seen.end(), w[0]) != seen.end())
+      fail(origin, "header line " + w[0] + " is given twice");
+    seen.push_back(w[0]);
     if (w[0] == "VERSION") continue;
     if (w[0] == "FIELDS") names = rest;
     else if (w[0] == "SIZE") sizes = rest;
     else if (w[0] == "TYPE") types = rest;
     else if (w[0] == "COUNT") counts = rest;
-    else if (w[0] == "WIDTH" && rest.size() == 1) width = count_of(rest[0], "WIDTH", origin);
+    else if (w[0] == "WIDTH" && rest.size() == 1) {
+      width = count_of(rest[0], "WIDTH", origin);
+      have_width = true;
+    }
     else if (w[0] == "HEIGHT" && rest.size() == 1) height = count_of(rest[0], "HEIGHT", origin);
     else if (w[0] == "POINTS" && rest.size() == 1) {
       points = count_of(rest[0], "POINTS", origin);
@@ -248,6 +273,12 @@ PointCloud parse_pcd(const std::string& bytes, const std::string& origin) {
       Eigen::Vector3d t;
       for (int a = 0; a < 3; ++a) t[a] = parse_number(rest[a], origin + ": VIEWPOINT", 0);
       if (!t.allFinite()) fail(origin, "VIEWPOINT is not finite");
+      Eigen::Vector4d q;
+      for (int a = 0; a < 4; ++a) q[a] = parse_number(rest[3 + a], origin + ": VIEWPOINT", 0);
+      // The orientation is a unit quaternion (w x y z); 1e-3 allows the 4-6 digits files print.
+      constexpr double kUnitTolerance = 1e-3;
+      if (!q.allFinite() || std::abs(q.norm() - 1.0) > kUnitTolerance)
+        fail(origin, "VIEWPOINT orientation is not a unit quaternion");
       viewpoint = t;
     } else if (w[0] == "DATA" && rest.size() == 1) {
       data = rest[0];
@@ -259,7 +290,13 @@ PointCloud parse_pcd(const std::string& bytes, const std::string& origin) {
   if (names.empty()) fail(origin, "the header has no FIELDS line");
   if (sizes.size() != names.size() || types.size() != names.size() || (!counts.empty() && counts.size() != names.size()))
     fail(origin, "FIELDS, SIZE, TYPE and COUNT list different numbers of fields");
+  if (height == 0) fail(origin, "HEIGHT is 0 (an unorganised cloud has HEIGHT 1)");
   if (!have_points) points = width * height;
+  if (have_points && have_width && width * height != points) {
+    std::ostringstream os;
+    os << "WIDTH x HEIGHT = " << width << " x " << height << " does not match POINTS " << points;
+    fail(origin, os.str());
+  }
   if (data == "binary_compressed") fail(origin, "DATA binary_compressed is not supported (save the cloud as ascii or binary)");
   if (data != "ascii" && data != "binary") fail(origin, "unknown DATA \"" + data + "\"");
   std::vector<Field> fields;
@@ -288,7 +325,7 @@ PointCloud parse_pcd(const std::string& bytes, const std::string& origin) {
   const std::array<int, 3> xyz = find_xyz(fields, origin);
   PointCloud cloud;
   cloud.viewpoint = viewpoint;
-  read_records(cloud, bytes, lines.pos, points, fields, xyz, data == "ascii", false, stride, origin);
+  read_records(cloud, bytes, lines.pos, points, fields, xyz, data == "ascii", false, stride, origin, true);
   return cloud;
 }
 
@@ -309,7 +346,7 @@ PointCloud read_point_cloud(const std::string& path) {
 
 std::shared_ptr<const VoxelLayer> integrate_clouds(const std::vector<CloudScan>& scans, double resolution,
                                                    double max_range) {
-  if (!std::isfinite(resolution) || !(resolution > 0.0)) throw Error("resolution: must be positive and finite");
+  check_resolution(resolution, "resolution");
   octomap::OcTree tree(resolution);
   const double reach = 32767.0 * resolution;
   const auto point = [](const Eigen::Vector3d& p) {

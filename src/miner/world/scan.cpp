@@ -64,7 +64,8 @@ void validate_scan(const ScanOptions& o, const Map& map, const std::vector<Eigen
   check(o.h_rays >= 1 && o.h_rays <= 100000, "horizontal rays", "must lie in [1, 100000]");
   check(o.v_rays >= 1 && o.v_rays <= 100000, "vertical rays", "must lie in [1, 100000]");
   check(std::isfinite(o.noise) && o.noise >= 0.0 && o.noise <= 0.5 * o.range, "noise",
-        "must lie in [0, range / 2] m");
+        "must lie in [0, range / 2] m (noise " + std::to_string(o.noise) + " m, range " + std::to_string(o.range) +
+            " m): lower the noise or raise the range");
   check(std::isfinite(o.dropout) && o.dropout >= 0.0 && o.dropout < 1.0, "dropout", "must lie in [0, 1)");
   check(std::isfinite(o.spacing) && o.spacing > 0.0, "spacing", "must be positive");
   check(std::isfinite(o.resolution) && o.resolution >= 0.0, "resolution", "must be positive (or 0: the map's)");
@@ -86,6 +87,8 @@ void validate_scan(const ScanOptions& o, const Map& map, const std::vector<Eigen
     throw Error(os.str());
   }
   const double res = o.resolution > 0.0 ? o.resolution : map.resolution();
+  check_resolution(res, "scan resolution");
+  (void)grid_dims(map.bounds(), res);  // the scan's layer over the map must be a grid a map may have
   // Each ray walks up to min(range, the map's diagonal) / res voxels: bound the walk too.
   const double steps = rays * std::min(o.range, map.bounds().extent().norm()) / res;
   if (steps > kMaxRaySteps) {

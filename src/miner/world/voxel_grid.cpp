@@ -50,10 +50,12 @@ VoxelGrid::VoxelGrid(const Map& map, double robot_radius)
           for (int x = from.x(); x <= to.x(); ++x) occupancy_[index(x, y, z)] = 1;
     }
   }
+  // Each grown box covers a block of cells: cell i's interior (o + i res, o + (i+1) res) meets
+  // [lo, hi] iff o + (i+1) res > lo and o + i res < hi.
+  std::vector<std::pair<Eigen::Vector3i, Eigen::Vector3i>> blocks;
+  blocks.reserve(map.obstacles().size());
   for (const Box& obstacle : map.obstacles()) {
     const Box b = obstacle.inflated(robot_radius);
-    // Cell i's interior (o + i res, o + (i+1) res) meets [lo, hi] iff
-    // o + (i+1) res > lo and o + i res < hi.
     Eigen::Vector3i lo, hi;
     bool empty = false;
     for (int k = 0; k < 3; ++k) {
@@ -62,12 +64,46 @@ VoxelGrid::VoxelGrid(const Map& map, double robot_radius)
       lo[k] = first;
       hi[k] = last;
     }
-    if (empty) continue;
-    for (int z = lo.z(); z <= hi.z(); ++z)
-      for (int y = lo.y(); y <= hi.y(); ++y)
-        for (int x = lo.x(); x <= hi.x(); ++x) occupancy_[index(x, y, z)] = 1;
+    if (!empty) blocks.emplace_back(lo, hi);
   }
+  mark_blocks(blocks);
   if (map.voxels()) mark_voxels(*map.voxels(), map.bounds());
+}
+
+void VoxelGrid::mark_blocks(const std::vector<std::pair<Eigen::Vector3i, Eigen::Vector3i>>& blocks) {
+  // Plane by plane, a 2D difference array of the blocks that span the plane, summed: the work
+  // is O(sum of the blocks' heights + cells) however much the blocks overlap (issue 20: filling
+  // each block cell by cell took hours for 10^4 boxes each covering a percent of the map).
+  const int nx = dims_.x(), ny = dims_.y(), nz = dims_.z();
+  std::vector<std::vector<std::size_t>> starting(static_cast<std::size_t>(nz));
+  for (std::size_t i = 0; i < blocks.size(); ++i) starting[static_cast<std::size_t>(blocks[i].first.z())].push_back(i);
+  const std::size_t stride = static_cast<std::size_t>(nx) + 1;
+  std::vector<int> diff(stride * (static_cast<std::size_t>(ny) + 1));
+  std::vector<std::size_t> active;
+  for (int z = 0; z < nz; ++z) {
+    for (std::size_t i : starting[static_cast<std::size_t>(z)]) active.push_back(i);
+    active.erase(std::remove_if(active.begin(), active.end(), [&](std::size_t i) { return blocks[i].second.z() < z; }),
+                 active.end());
+    if (active.empty()) continue;
+    std::fill(diff.begin(), diff.end(), 0);
+    for (std::size_t i : active) {
+      const auto& [lo, hi] = blocks[i];
+      const std::size_t x0 = static_cast<std::size_t>(lo.x()), x1 = static_cast<std::size_t>(hi.x()) + 1;
+      const std::size_t y0 = static_cast<std::size_t>(lo.y()), y1 = static_cast<std::size_t>(hi.y()) + 1;
+      ++diff[y0 * stride + x0];
+      --diff[y0 * stride + x1];
+      --diff[y1 * stride + x0];
+      ++diff[y1 * stride + x1];
+    }
+    // Prefix sums along x, then along y: diff then holds how many blocks cover each cell.
+    for (int y = 0; y < ny; ++y)
+      for (int x = 1; x < nx; ++x) diff[y * stride + x] += diff[y * stride + x - 1];
+    for (int y = 1; y < ny; ++y)
+      for (int x = 0; x < nx; ++x) diff[y * stride + x] += diff[(y - 1) * stride + x];
+    for (int y = 0; y < ny; ++y)
+      for (int x = 0; x < nx; ++x)
+        if (diff[y * stride + x] > 0) occupancy_[index(x, y, z)] = 1;
+  }
 }
 
 void VoxelGrid::mark_voxels(const VoxelObstacles& voxels, const Box& bounds) {

@@ -13,6 +13,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -61,6 +62,8 @@ class VoxelGrid {
   std::vector<std::uint8_t> occupancy_;
   /// Blocked voxels of a voxel map, grown by the robot radius like the boxes.
   void mark_voxels(const VoxelObstacles& voxels, const Box& bounds);
+  /// Marks every cell of the blocks (first, last cell per axis, inclusive) occupied.
+  void mark_blocks(const std::vector<std::pair<Eigen::Vector3i, Eigen::Vector3i>>& blocks);
 };
 
 }  // namespace miner::world

@@ -103,6 +103,28 @@ TEST_CASE("Atomic write into a missing folder fails and leaves the old file inta
   CHECK(std::filesystem::is_directory(blocked + "/child"));
 }
 
+TEST_CASE("Files written as one: a failure on any leaves every existing file as it was", "[REQ-CORE-004][REQ-CLI-003]") {
+  const auto dir = temp_dir("atomic_many");
+  const std::string a = (dir / "a.bt").string(), b = (dir / "b.json").string();
+  miner::write_file_atomic(a, "old a\n");
+  // The second target's folder is missing: the first must not have been replaced (issue 20:
+  // `map scan` wrote --out, then failed on --map-out).
+  CHECK_THROWS_WITH(miner::write_files_atomic({{a, "new a\n"}, {(dir / "missing" / "b.json").string(), "b\n"}}),
+                    Contains("does not exist"));
+  CHECK(read_all(a) == "old a\n");
+  // A folder in the second target's place: found before any rename, the temporaries removed.
+  std::filesystem::create_directories(b + "/child");
+  CHECK_THROWS_WITH(miner::write_files_atomic({{a, "new a\n"}, {b, "b\n"}}), Contains("is a folder, not a file"));
+  CHECK(read_all(a) == "old a\n");
+  CHECK(std::filesystem::is_directory(b + "/child"));
+  std::size_t entries = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++entries;
+  CHECK(entries == 2);  // a.bt and the folder b.json: no temporary left
+  miner::write_files_atomic({{a, "new a\n"}, {(dir / "c.json").string(), "c\n"}});
+  CHECK(read_all(a) == "new a\n");
+  CHECK(read_all((dir / "c.json").string()) == "c\n");
+}
+
 TEST_CASE("A folder write replaces only an earlier output of the same kind", "[REQ-CORE-004]") {
   namespace fs = std::filesystem;
   const auto dir = temp_dir("folder_kind");

@@ -1,5 +1,7 @@
 #include <catch2/catch.hpp>
 
+#include <tuple>
+
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -107,9 +109,41 @@ TEST_CASE("Bad scenarios are refused before flight with the fault named", "[REQ-
   expect_scenario_error(doc, "hover_after_s: must be at most 1000 s");
   doc = default_doc();
   doc["planner"]["region"] = "astar";
-  doc["trajectory"]["v_max"] = 1e-4;
-  doc["trajectory"]["a_max"] = 1e-6;
+  doc["trajectory"]["v_max"] = 0.01;
+  doc["trajectory"]["a_max"] = 0.01;
   expect_scenario_error(doc, "more than the 1000 s a simulated flight may");
+  // Issue 20: every value has a range; outside it the field and the range are named (a goal
+  // tolerance of 1e9 m made any flight "reach" its goal).
+  const std::vector<std::tuple<const char*, const char*, miner::Json, std::string>> ranged{
+      {"goal_tolerance_m", nullptr, 1e9, "goal_tolerance_m: must be in [0, 5] m, got"},
+      {"trajectory", "v_max", 1e308, "trajectory.v_max: must be in [0.01, 50] m/s"},
+      {"trajectory", "a_max", 1e-6, "trajectory.a_max: must be in [0.01, 50] m/s^2"},
+      {"controller", "kp", miner::Json::array({1e300, 1e300, 1e300}), "controller.kp: gains must be at most 1000"},
+      {"imu", "accel_noise_density", 1e300, "imu.accel_noise_density: must be in [0, 1]"},
+      {"pose", "delay_s", 1e6, "pose.delay_s: must be in [0, 1] s"},
+      {"n3", "latency_s", 100.0, "n3.latency_s: must be in [0, 1] s"},
+      {"planning_margin_m", nullptr, 100.0, "planning_margin_m: must be in [0, 10] m"},
+      {"ekf", "initial_position_sigma", 1e9, "ekf.initial_position_sigma: must be in [0, 100] m"}};
+  for (const auto& [section, key, value, message] : ranged) {
+    doc = default_doc();
+    if (key) doc[section][key] = value;
+    else doc[section] = value;
+    expect_scenario_error(doc, message);
+  }
+  doc = default_doc();
+  doc["command_dropout_s"] = {1.0, 1e9};
+  expect_scenario_error(doc, "command_dropout_s: needs 0 <= t0 < t1 <= 1000 s");
+  // A repeated route point is named as the scenario writes it, not as the pipeline's points[i].
+  const miner::Json start = miner::read_json_file(kScenarios + "/../maps/indoor-1.json")["query"]["start"];
+  doc = default_doc();
+  doc["start"] = start;
+  doc["goal"] = start;
+  expect_scenario_error(doc, "coincides with start: remove the repeated point");
+  doc = default_doc();
+  doc["start"] = start;
+  doc["waypoints"] = {start};
+  expect_scenario_error(doc, "waypoints[0] (");
+  expect_scenario_error(doc, "coincides with start");
   doc = default_doc();
   doc["vehicle"] = flight::to_json(flight::VehicleParams{});
   doc["vehicle"]["mass_kgg"] = 2;

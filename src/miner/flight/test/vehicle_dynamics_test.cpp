@@ -41,6 +41,12 @@ TEST_CASE("Missing or non-physical vehicle parameters are refused naming the par
   doc["rotor_speed_max_rad_s"] = 600.0;  // 8.4 N of thrust for 14.7 N of weight
   expect_vehicle_error(doc, "thrust-to-weight");
   doc = vehicle_doc();
+  doc["mass_kg"] = 1e300;  // issue 20: values near the largest double flew
+  expect_vehicle_error(doc, "mass_kg: must be a finite number in (0, 1000], got 1e+300");
+  doc = vehicle_doc();
+  doc["radius_m"] = 50.0;
+  expect_vehicle_error(doc, "radius_m: must be a finite number in (0, 10]");
+  doc = vehicle_doc();
   doc["inertia_kg_m2"] = {0.01, 0.01, 0.05};
   expect_vehicle_error(doc, "triangle inequality");
   doc = vehicle_doc();

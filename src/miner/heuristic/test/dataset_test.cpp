@@ -263,6 +263,12 @@ TEST_CASE("A dataset folder that contradicts itself is refused naming the file a
         edit_json(q0 + "/test-index.json", [](miner::Json& d) { d[0]["map_seed"] = -1; });
       },
       "map_seed: expected an integer in [0, 2^64 - 1]");
+  // A path shorter than the straight line (issue 20: a cost of -5 merged).
+  refused(
+      [&](const std::string& q0, const std::string&) {
+        edit_json(q0 + "/train-index.json", [](miner::Json& d) { d[0]["astar_cost"] = -5; });
+      },
+      "astar_cost: is -5, shorter than the straight line from start to goal");
 }
 
 TEST_CASE("Bad dataset options are refused naming the option", "[REQ-HEUR-003]") {

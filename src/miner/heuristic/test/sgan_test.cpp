@@ -1,5 +1,7 @@
 #include <catch2/catch.hpp>
 
+#include <functional>
+
 #include <limits>
 
 #include <cstring>
@@ -170,6 +172,35 @@ TEST_CASE("A missing, truncated, altered or mismatched weights file is refused n
   CHECK_THROWS_WITH(heuristic::parse_tensor_file(tensor_blob({{"kind", "k"}, {"tensors", tensors}}, std::vector<float>(648)),
                                                  "x.bin", "k"),
                     Contains("past the data"));
+  // Issue 20: the header is strict. Unknown keys anywhere, a wrong layer list, tensors that
+  // share bytes or leave bytes over, and an input scale the network never saw are refused.
+  {
+    const miner::Json header = [&] {
+      const std::uint32_t n = static_cast<std::uint8_t>(good[8]) | static_cast<std::uint8_t>(good[9]) << 8 |
+                              static_cast<std::uint8_t>(good[10]) << 16 | static_cast<std::uint32_t>(static_cast<std::uint8_t>(good[11])) << 24;
+      return miner::parse_json(good.substr(12, n), "header");
+    }();
+    const std::string data = good.substr(good.size() - header["data_bytes"].get<std::size_t>());
+    const auto rewritten = [&](const miner::Json& h) {
+      const std::string text = h.dump();
+      const auto n = static_cast<std::uint32_t>(text.size());
+      return good.substr(0, 8) + std::string(reinterpret_cast<const char*>(&n), 4) + text + data;
+    };
+    const auto refuses = [&](const std::function<void(miner::Json&)>& edit, const std::string& message) {
+      miner::Json h = header;
+      edit(h);
+      INFO(message);
+      CHECK_THROWS_WITH(heuristic::Sgan::from_bytes(rewritten(h), "edited.bin"), Contains("edited.bin") && Contains(message));
+    };
+    CHECK_NOTHROW(heuristic::Sgan::from_bytes(rewritten(header), "same.bin"));
+    refuses([](miner::Json& h) { h["foo"] = 1; }, "foo: unknown key");
+    refuses([](miner::Json& h) { h["meta"]["architecture"]["foo"] = 1; }, "meta.architecture.foo: unknown key");
+    refuses([](miner::Json& h) { h["meta"]["architecture"]["layers"] = {"enc1"}; }, "layers: must list sgan-unet4's nine layers");
+    refuses([](miner::Json& h) { h["tensors"][1]["offset"] = 0; }, "two tensors overlap");
+    refuses([](miner::Json& h) { h["tensors"][1]["offset"] = 2593; }, "must be a multiple of 4");
+    refuses([](miner::Json& h) { h["tensors"][0]["extra"] = 1; }, "tensors[0].extra: unknown key");
+    refuses([](miner::Json& h) { h["meta"]["architecture"]["environment_scale"] = -1e300; }, "environment_scale: must be in [0, 1]");
+  }
   // Non-finite weights are refused before anything runs.
   miner::Json nan_arch = arch;
   nan_arch["width"] = 1;

@@ -41,7 +41,11 @@ TEST_CASE("Problem file errors name the file and the field", "[REQ-TRAJ-007]") {
   CHECK_THROWS_WITH(problem_from_json(doc, "p.json"), Contains("p.json: (top level): needs \"durations\" or \"limits\""));
   doc = problem();
   doc["limits"]["v_max"] = -2;
-  CHECK_THROWS_WITH(problem_from_json(doc, "p.json"), Contains("p.json: limits.v_max: must be positive"));
+  CHECK_THROWS_WITH(problem_from_json(doc, "p.json"), Contains("p.json: limits.v_max: must be in [1e-06, 1e+06] m/s, got -2"));
+  // Issue 20: 1e308 overflowed the trapezoid into NaN durations, blamed on "durations[0]".
+  doc = problem();
+  doc["limits"]["a_max"] = 1e308;
+  CHECK_THROWS_WITH(problem_from_json(doc, "p.json"), Contains("p.json: limits.a_max: must be in [1e-06, 1e+06] m/s^2"));
   doc = problem();
   doc["durations"] = {1.0, 0.0};
   CHECK_THROWS_WITH(problem_from_json(doc, "p.json"), Contains("p.json: durations[1]: must be positive and finite"));

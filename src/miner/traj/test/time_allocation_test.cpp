@@ -120,6 +120,6 @@ TEST_CASE("Allocation requests in problem files are checked", "[REQ-TRAJ-011]") 
   CHECK_THROWS_WITH(request_from_json(bad, "p.json"), Contains("rho: only used with"));
   bad = doc;
   bad["rho"] = -1;
-  CHECK_THROWS_WITH(request_from_json(bad, "p.json"), Contains("rho: must be positive"));
+  CHECK_THROWS_WITH(request_from_json(bad, "p.json"), Contains("rho: must be in [1e-09, 1e+09], got -1"));
   CHECK_THROWS_WITH(request_from_json(doc, "p.json", "", -2.0), Contains("--rho: must be positive"));
 }

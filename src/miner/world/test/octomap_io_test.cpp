@@ -196,6 +196,11 @@ TEST_CASE("Malformed OctoMap files are refused naming the fault, never crash", "
   refuses(header(1, "0.1", "ColorOcTree"), "binary tree id \"ColorOcTree\"");
   refuses("# Octomap OcTree binary file\nid OcTree\nsize 1\nres 0.1\ncolour red\ndata\n", "unknown header key \"colour\"");
   refuses(header(0), "empty (size 0)");
+  // Issue 20: resolutions outside a map's range (1e-300 overflowed the grid's inflation, 1e300
+  // made planning hang) and a header key given twice (the last one silently won).
+  refuses(header(1, "1e-300"), "header res 1e-300 m is outside the resolutions a map may have [0.001, 100] m");
+  refuses(header(1, "1e300"), "header res 1e300 m is outside");
+  refuses("# Octomap OcTree binary file\nid OcTree\nsize 1\nres 0.5\nres 5\ndata\n", "header key \"res\" is given twice");
   const auto [head, data] = valid_bt();
   refuses(head + data.substr(0, data.size() / 2), "data ends early");
   refuses(head + data + std::string("\x01\x02", 2), "2 bytes follow the tree's last node");

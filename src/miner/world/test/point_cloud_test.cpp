@@ -150,6 +150,31 @@ TEST_CASE("Malformed point clouds are refused naming the fault, never crash", "[
           "unknown or malformed header line \"SHAPE round\"");
   refuses("VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F I F\nPOINTS 1\nDATA ascii\n1 2 3\n", false,
           "field \"y\" is not a float");
+  // Issue 20: what does not match the header is refused, never dropped or guessed.
+  const std::string pcd_head = "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\n";
+  refuses(pcd_head + "WIDTH 2\nHEIGHT 1\nPOINTS 2\nDATA ascii\n0 0 1\n0.5 0 1\n7 7 7\n", false,
+          "data continues after the 2 points");
+  refuses(pcd_head + "WIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA ascii\n0 0 1 5 6\n", false, "point 0 has 5 values");
+  refuses(pcd_head + "WIDTH 5\nHEIGHT 1\nPOINTS 2\nDATA ascii\n0 0 1\n0 1 1\n", false,
+          "WIDTH x HEIGHT = 5 x 1 does not match POINTS 2");
+  refuses(pcd_head + "WIDTH 1\nHEIGHT 0\nPOINTS 1\nDATA ascii\n0 0 1\n", false, "HEIGHT is 0");
+  refuses(pcd_head + "POINTS 1\nPOINTS 1\nDATA ascii\n0 0 1\n", false, "header line POINTS is given twice");
+  refuses(pcd_head + "VIEWPOINT 0 0 0 0 0 0 0\nPOINTS 1\nDATA ascii\n0 0 1\n", false, "not a unit quaternion");
+  refuses(pcd_head + "POINTS 1\nDATA binary\n" + std::string(12 + 8, '\0'), false,
+          "8 bytes follow the 1 points");
+  refuses("ply\nformat ascii 2.0\nelement vertex 0\nproperty float x\nproperty float y\nproperty float z\nend_header\n",
+          true, "PLY version \"2.0\"");
+  refuses("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n"
+          "1 2 3\n4 5 6\n",
+          true, "data continues after the 1 points");
+  // A later element's data may follow the vertices.
+  CHECK(parse_point_cloud("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty "
+                          "float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n1 2 3\n3 0 0 0\n",
+                          true, "faces.ply")
+            .points.size() == 1);
+  CHECK_THROWS_WITH(integrate_clouds({{parse_point_cloud(pcd(wall_points(), false), false, "w.pcd"), V(0, 0, 0.5)}},
+                                     1e300, 0.0),
+                    Contains("resolution: 1e+300 m is outside"));
   PointCloud far;
   far.points = {V(1e9, 0, 0)};
   CHECK_THROWS_WITH(integrate_clouds({{far, V(0, 0, 0)}}, 0.05, 0.0), Contains("would walk"));

@@ -103,12 +103,19 @@ TEST_CASE("Bad scan settings are refused naming the setting", "[REQ-WORLD-016]")
   o.v_rays = 1000;
   refuses(o, path, "exceed the 1e+08 a scan may cast");
   o = ScanOptions();
-  o.resolution = 1e-5;
-  refuses(o, path, "would walk");
+  o.resolution = 1e-5;  // issue 20: below a map's resolutions, and a grid no map may have
+  refuses(o, path, "scan resolution: 1e-05 m is outside the resolutions a map may have");
   o = ScanOptions();
-  o.resolution = 1e-4;
+  o.resolution = 0.02;
+  o.h_rays = 10000;
+  o.v_rays = 100;
+  refuses(o, path, "would walk");
+  // A map 400 m from the origin at 1 cm: beyond OctoMap's 16-bit keys.
+  const Map far(Box{V(400, 400, 0), V(404, 404, 2)}, 0.05, {});
+  o = ScanOptions();
+  o.resolution = 0.01;
   o.h_rays = o.v_rays = 1;
-  refuses(o, path, "outside OctoMap's 32768 voxels");
+  CHECK_THROWS_WITH(validate_scan(o, far, {V(401, 401, 1), V(402, 401, 1)}), Contains("outside OctoMap's 32768 voxels"));
 }
 
 TEST_CASE("Paths are resampled at a fixed spacing, ends included", "[REQ-WORLD-016]") {

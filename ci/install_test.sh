@@ -35,4 +35,19 @@ fi
 "$work/examples/minco_waypoints"
 "$work/examples/plan_with_sgan" "$prefix/share/miner/maps/sim-1.json"
 "$work/examples/fly_scenario"
+# Python from the prefix (REQ-LIB-002), with Debian's python3 (numpy); an instrumented build's
+# extension needs its sanitizer runtime preloaded.
+if [ -e "$prefix/lib/python3/dist-packages/miner/__init__.py" ]; then
+  preload=""
+  case "$extra" in *-fsanitize=address*) preload=$(g++ -print-file-name=libasan.so) ;; esac
+  (cd "$work" && LD_PRELOAD="$preload" ASAN_OPTIONS=detect_leaks=0 PYTHONPATH="$prefix/lib/python3/dist-packages" \
+     /usr/bin/python3 -c "
+import miner
+m = miner.Map.load('$prefix/share/miner/maps/sim-1.json')
+r = miner.plan(m, planner='miner', region=miner.sgan_region(m), seed=1, iterations=2000)
+assert r.solved, r.reason
+t = miner.minco(r.path)
+print('python: miner', r.cost, 'm,', round(t.total_duration, 2), 's trajectory')
+")
+fi
 echo "install_test: installed, found with find_package(miner), three examples built and run"

@@ -28,6 +28,7 @@ PACKAGES=(
   gcovr                # coverage reports and thresholds
   clang-16 libclang-rt-16-dev libfuzzer-16-dev libomp-16-dev   # libFuzzer targets (ci/fuzz.sh; omp.h for sgan.cpp)
   python3              # traceability checker
+  pybind11-dev python3-dev python3-pytest   # the Python bindings (`import miner`, src/python) and their tests
   # learned heuristic
   libdnnl-dev          # oneDNN: the sGAN's 3D convolutions in C++ (~20x LibTorch's default CPU path)
   python3-torch python3-numpy python3-scipy   # sGAN training (src/python/sgan; scipy: connected components) and its test

@@ -13,7 +13,7 @@ add_test(NAME traceability
           --out ${PROJECT_BINARY_DIR}/traceability.md
           --extra-citations ${PROJECT_SOURCE_DIR}/ci/test_trace.py ${PROJECT_SOURCE_DIR}/ci/check_readme.py ${PROJECT_SOURCE_DIR}/ci/fuzz.sh
                             ${PROJECT_SOURCE_DIR}/ci/check_report.py ${PROJECT_SOURCE_DIR}/ci/cluster_test.sh
-                            ${PROJECT_SOURCE_DIR}/ci/install_test.sh)
+                            ${PROJECT_SOURCE_DIR}/ci/install_test.sh ${PROJECT_SOURCE_DIR}/src/python/tests/test_miner.py)
 add_test(NAME traceability-checker-selftest
   COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/ci/test_trace.py)
 add_test(NAME readme-quickstart

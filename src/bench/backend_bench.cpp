@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <functional>
 #include <iomanip>
+#include <limits>
 #include <map>
 #include <ostream>
 #include <sstream>
@@ -94,7 +96,8 @@ void time_methods(const traj::MincoProblem& p, const BackendBenchOptions& o, std
       c = out.coefficients();
     }
     r.max_rel_diff = (c - reference).norm() / reference.norm();
-    r.ratio_to_minco = minco_us > 0.0 ? median / minco_us : 0.0;
+    // Without MINCO timed in the same run there is no ratio (issue 20: 0.0 was printed).
+    r.ratio_to_minco = minco_us > 0.0 ? median / minco_us : std::numeric_limits<double>::quiet_NaN();
     records.push_back(r);
   }
 }
@@ -145,7 +148,8 @@ nlohmann::json to_json(const std::vector<BackendRecord>& records) {
       j["us_per_solve"] = nullptr;
     } else {
       j.update({{"us_per_solve", r.us_per_solve}, {"min_us", r.min_us}, {"samples", r.samples},
-                {"reps_per_sample", r.reps_per_sample}, {"ratio_to_minco", r.ratio_to_minco},
+                {"reps_per_sample", r.reps_per_sample},
+                {"ratio_to_minco", std::isnan(r.ratio_to_minco) ? nlohmann::json(nullptr) : nlohmann::json(r.ratio_to_minco)},
                 {"max_rel_diff", r.max_rel_diff}});
     }
     out.push_back(j);
@@ -173,7 +177,8 @@ void print_table(const std::vector<BackendRecord>& records, std::ostream& out) {
         cell << "skipped";
       } else {
         cell << std::fixed << std::setprecision(it->second->us_per_solve < 100 ? 2 : 0) << it->second->us_per_solve;
-        if (m != "minco") cell << " (" << std::setprecision(1) << it->second->ratio_to_minco << "x)";
+        if (m != "minco" && !std::isnan(it->second->ratio_to_minco))
+          cell << " (" << std::setprecision(1) << it->second->ratio_to_minco << "x)";
       }
       out << std::setw(24) << cell.str();
     }

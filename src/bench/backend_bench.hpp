@@ -34,7 +34,7 @@ struct BackendRecord {
   double min_us = 0.0;          ///< fastest batch
   int samples = 0;
   long reps_per_sample = 0;
-  double ratio_to_minco = 0.0;  ///< us_per_solve / MINCO's
+  double ratio_to_minco = 0.0;  ///< us_per_solve / MINCO's; NaN (JSON null) when MINCO was not timed
   double max_rel_diff = 0.0;    ///< ||c - c_minco|| / ||c_minco||
 };
 

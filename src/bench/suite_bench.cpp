@@ -213,10 +213,13 @@ SuiteDefinition load_suite(const std::string& path) {
   if (root.has("description")) (void)root.at("description").string();
   SuiteDefinition s;
   const JsonField steps = root.at("steps");
+  // Bounded work (issue 20: 10^5 steps ran for ever): each step is a whole campaign per map.
+  constexpr std::size_t kMaxSteps = 16, kMaxMaps = 64;
   if (steps.array_size() == 0) steps.fail("needs at least one steering step");
+  if (steps.array_size() > kMaxSteps) steps.fail("at most 16 steering steps, got " + std::to_string(steps.array_size()));
   for (std::size_t i = 0; i < steps.array_size(); ++i) {
     const double x = steps.at(i).positive_number();
-    if (x > 1.0) steps.at(i).fail("a steering step is a fraction of the map's diagonal in (0, 1], got " + f(x, 3));
+    if (x > 1.0) steps.at(i).fail("a steering step is a fraction of the map's diagonal in (0, 1], got " + steps.at(i).value().dump());
     if (std::find(s.step_fractions.begin(), s.step_fractions.end(), x) != s.step_fractions.end())
       steps.at(i).fail("repeated steering step " + f(x, 3));
     s.step_fractions.push_back(x);
@@ -230,6 +233,7 @@ SuiteDefinition load_suite(const std::string& path) {
   }
   const JsonField maps = root.at("maps");
   if (maps.array_size() == 0) maps.fail("needs at least one map");
+  if (maps.array_size() > kMaxMaps) maps.fail("at most 64 maps, got " + std::to_string(maps.array_size()));
   const auto presets = world::generator_preset_names();
   for (std::size_t i = 0; i < maps.array_size(); ++i) {
     const JsonField m = maps.at(i);

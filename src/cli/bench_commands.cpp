@@ -71,7 +71,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   b->add_option("--methods", o->bench.methods, "minco, dense-lu, closed-form, kkt-qp")->capture_default_str()->delimiter(',')
       ->check(CLI::IsMember({"minco", "dense-lu", "closed-form", "kkt-qp"}));
   b->add_option("--max-dense-segments", o->bench.max_dense_segments, "skip the O(M^3) baselines above this M")
-      ->capture_default_str()->check(integer_in(0, 1000000));
+      ->capture_default_str()->check(integer_in(0, 500));  // a dense (2sM)^2 LU: ~2 s at M = 500
   b->add_option("--budget", o->bench.budget_s, "seconds per (method, order, M)")->capture_default_str()
       ->check(finite_in(1e-4, 3600.0));
   b->add_option("--samples", o->bench.samples, "timed batches (median reported; fewer when one solve outlasts a batch)")
@@ -118,12 +118,16 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   fc->add_option("--throughput-iterations", f->bench.throughput_iterations,
                  "iterations of the rrtstar vs ompl:RRTstar throughput check (0: skip)")
       ->capture_default_str()
-      ->check(CLI::Range(0, kMaxIterations));
+      ->check(integer_in(0, 100000));  // two RRT* runs of this many iterations: ~1 min at the bound
   fc->add_option("--ompl-log", f->ompl_log, "also write OMPL's benchmark log format to this file")->check(kOutputFile);
-  fc->add_option("--shard", f->shard, "i/N: run only runs r with r % N == i (join the parts with `miner bench merge`)");
+  fc->add_option("--shard", f->shard, "i/N: run only runs r with r % N == i (join the parts with `miner bench merge`)")
+      ->check(kShard);
   fc->add_flag("--quiet", f->quiet, "no progress bar on stderr");
   add_output_options(fc, f->output);
-  fc->callback([f, &out] { run_frontend(*f, out); });
+  fc->callback([f, &out] {
+    require_distinct("--planners", f->bench.planners);
+    run_frontend(*f, out);
+  });
 
   struct HeuristicOptions {
     bench::HeuristicBenchOptions bench;

@@ -15,14 +15,15 @@
 #include <unistd.h>
 
 #include "miner/core/error.hpp"
+#include "miner/core/shard.hpp"
 
 namespace miner::cli {
 
 const CLI::Validator kFiniteNonNegative(
     [](std::string& text) -> std::string {
       double v = 0.0;
-      if (!CLI::detail::lexical_cast(text, v) || !std::isfinite(v) || v < 0.0) {
-        return "must be a finite number >= 0, got " + text;
+      if (!is_decimal_number(text) || !CLI::detail::lexical_cast(text, v) || !std::isfinite(v) || v < 0.0) {
+        return "must be a finite decimal number >= 0, got " + text;
       }
       return {};
     },
@@ -124,8 +125,8 @@ const CLI::Validator kOutputFileNewFolder(
 const CLI::Validator kPositive(
     [](std::string& text) -> std::string {
       double v = 0.0;
-      if (!CLI::detail::lexical_cast(text, v) || !std::isfinite(v) || !(v > 0.0))
-        return "must be a finite number > 0, got " + text;
+      if (!is_decimal_number(text) || !CLI::detail::lexical_cast(text, v) || !std::isfinite(v) || !(v > 0.0))
+        return "must be a finite decimal number > 0, got " + text;
       return {};
     },
     "POSITIVE");
@@ -137,8 +138,8 @@ CLI::Validator finite_in(double lo, double hi) {
   return CLI::Validator(
       [lo, hi, text_range](std::string& text) -> std::string {
         double v = 0.0;
-        if (!CLI::detail::lexical_cast(text, v) || !std::isfinite(v) || v < lo || v > hi)
-          return "must be a finite number in " + text_range + ", got " + text;
+        if (!is_decimal_number(text) || !CLI::detail::lexical_cast(text, v) || !std::isfinite(v) || v < lo || v > hi)
+          return "must be a finite decimal number in " + text_range + ", got " + text;
         return {};
       },
       "in " + text_range);
@@ -169,11 +170,22 @@ void require_distinct(const std::string& option, const std::vector<int>& values)
   require_distinct(option, text);
 }
 
+const CLI::Validator kShard(
+    [](std::string& text) -> std::string {
+      try {
+        (void)parse_shard(text);
+      } catch (const Error&) {
+        return "expected i/N with 0 <= i < N (e.g. 0/4), got \"" + text + "\"";
+      }
+      return {};
+    },
+    "i/N");
+
 const CLI::Validator kFinite(
     [](std::string& text) -> std::string {
       double v = 0.0;
-      if (!CLI::detail::lexical_cast(text, v) || !std::isfinite(v)) {
-        return "must be a finite number, got " + text;
+      if (!is_decimal_number(text) || !CLI::detail::lexical_cast(text, v) || !std::isfinite(v)) {
+        return "must be a finite decimal number, got " + text;
       }
       return {};
     },
@@ -264,6 +276,13 @@ void check_outputs_against_inputs(CLI::App* app) {
         else if (fs::exists(fs::path(value), ec)) inputs.emplace_back(o->get_name(), value);
       }
     }
+  // Two outputs of one command on one path: the second write would replace the first (issue
+  // 20: `map scan --out a.bt --map-out a.bt` left a map that references itself).
+  for (std::size_t i = 0; i < outputs.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (is_same_or_inside(outputs[j].second, outputs[i].second) || is_same_or_inside(outputs[i].second, outputs[j].second))
+        throw CLI::ValidationError(outputs[i].first, outputs[i].second + " is, holds or lies in " + outputs[j].second + " (" +
+                                                         outputs[j].first + "): two outputs of one command need two places");
   for (const auto& [out_name, out] : outputs)
     for (const auto& [in_name, in] : inputs) {
       if (is_same_or_inside(out, in))

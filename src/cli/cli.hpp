@@ -57,6 +57,8 @@ extern const CLI::Validator kDecimalInteger;
 /// A finite number > 0, with a short message ("must be a finite number > 0, got -3"):
 /// CLI11's PositiveNumber prints the largest double with all its 309 digits. REQ-CLI-002.
 extern const CLI::Validator kPositive;
+/// --shard i/N with 0 <= i < N, checked when the line is parsed (a usage error, exit 2).
+extern const CLI::Validator kShard;
 /// A finite number in [lo, hi] ("must be a finite number in [1e-06, 3600], got nan"); CLI11's
 /// Range lets NaN through and prints its bounds with six decimals. REQ-CLI-002.
 CLI::Validator finite_in(double lo, double hi);

@@ -27,7 +27,7 @@ struct ScenarioOptions {
 
 void add_scenario_options(CLI::App* cmd, ScenarioOptions& o) {
   cmd->add_option("--scenario", o.scenario, "miner-scenario-v1 file (default: the embedded indoor-1 scenario)");
-  cmd->add_option("--seed", o.seed, "override the scenario's seed")->check(kFiniteNonNegative)->check(kUnsigned64);
+  cmd->add_option("--seed", o.seed, "override the scenario's seed")->check(kUnsigned64);
 }
 
 flight::Scenario resolve_scenario(const ScenarioOptions& o) {
@@ -45,6 +45,14 @@ struct FlyCliOptions {
 
 void run_fly(const FlyCliOptions& o, std::ostream& out) {
   const flight::Scenario s = resolve_scenario(o.scenario);
+  // The run folder replaces its contents whole: it must hold none of the scenario's inputs,
+  // checked before any work (REQ-CLI-003).
+  const std::string run_dir = o.out.empty() ? "runs/" + s.name + "-seed" + std::to_string(s.seed) : o.out;
+  if (!o.scenario.scenario.empty())
+    for (const std::string& input : flight::scenario_inputs(read_json_file(o.scenario.scenario),
+                                                             std::filesystem::path(o.scenario.scenario).parent_path().string()))
+      if (is_same_or_inside(run_dir, input))
+        throw CLI::ValidationError("--out", run_dir + " holds " + input + ", which the scenario reads: the run folder would replace it");
   const flight::ReferencePlan reference = flight::build_reference(s);
   flight::FlyOptions options;
   options.use_ground_truth = o.ground_truth;
@@ -53,7 +61,7 @@ void run_fly(const FlyCliOptions& o, std::ostream& out) {
   auto stage_ms = reference.stage_ms;
   stage_ms.emplace_back("flight", elapsed_ms(t0));
 
-  const std::string dir = o.out.empty() ? "runs/" + s.name + "-seed" + std::to_string(s.seed) : o.out;
+  const std::string& dir = run_dir;
   Json summary = r.summary;
   summary["run_folder"] = dir;
   summary["report"] = dir + "/report.html";
@@ -133,7 +141,7 @@ void add_fly_commands(CLI::App& app, std::ostream& out) {
   auto b = std::make_shared<SimBenchCliOptions>();
   CLI::App* sim = bench_cmd->add_subcommand("sim", "real-time factor of the full flight loop on one core");
   add_scenario_options(sim, b->scenario);
-  sim->add_option("--runs", b->bench.runs, "flights to time")->capture_default_str()->check(kRunsRange);
+  sim->add_option("--runs", b->bench.runs, "flights to time")->capture_default_str()->check(integer_in(1, 100));
   // CVODE refuses (and leaks) below ~1e-15; above 1e-2 the flight is not integrated at all.
   sim->add_option("--rtol", b->bench.relative_tolerance, "CVODE relative tolerance")->capture_default_str()
       ->check(finite_in(1e-12, 1e-2));

@@ -93,7 +93,8 @@ void add_heuristic_commands(CLI::App& app, std::ostream& out) {
       ->check(integer_in(1, 1000000));
   d->add_option("--jobs", o->dataset.jobs, "worker threads (the output does not depend on it)")->capture_default_str()
       ->check(integer_in(1, 256));
-  d->add_option("--shard", o->shard, "i/N: write only part i of N (shard files j with j % N == i); join with --merge");
+  d->add_option("--shard", o->shard, "i/N: write only part i of N (shard files j with j % N == i); join with --merge")
+      ->check(kShard);
   d->add_option("--merge", o->merge, "join these part folders (made with --shard) into --out instead of generating");
   d->add_option("--out", o->out, "output folder (written as a whole)")->required()->check(kOutputFolder);
   d->callback([o, d, &out] {

@@ -88,6 +88,12 @@ TEST_CASE("A suite file is read strictly", "[REQ-REPORT-008]") {
   CHECK_THROWS_WITH(load_suite(bad("band.json", "[1, 1000000]", "[10, 1]")), Contains("band: hi is below lo"));
   CHECK_THROWS_WITH(load_suite(bad("name.json", "\"tiny\"", "\"a/b\"")), Contains("maps[0].name: a name is"));
   CHECK_THROWS_WITH(load_suite("/nonexistent/suite.json"), Contains("/nonexistent/suite.json"));
+  // Bounded work: each step is a campaign per map (issue 20: 10^5 steps ran for ever), and a
+  // step is printed as the file gives it (1e308 was a 47-digit number).
+  std::string many = "[";
+  for (int k = 1; k <= 17; ++k) many += (k > 1 ? ", " : "") + std::to_string(k / 20.0);
+  CHECK_THROWS_WITH(load_suite(bad("many.json", "[0.1, 0.4]", many + "]")), Contains("steps: at most 16 steering steps, got 17"));
+  CHECK_THROWS_WITH(load_suite(bad("huge.json", "0.4]", "1e308]")), Contains("got 1e+308"));
 }
 
 TEST_CASE("The suite runs every planner at every step and reports spread, n and misses", "[REQ-REPORT-008]") {

@@ -188,9 +188,9 @@ TEST_CASE("Bad input: each case names what is wrong and exits non-zero", "[REQ-C
        1, "resolution: -1 m is outside the resolutions a map may have"},
       {{"astar", "--map", map, "--start", "5", "5", "5", "--goal", "1", "1", "1"}, 1, "start (5, 5, 5) lies inside obstacle 0"},
       {{"astar", "--map", map, "--start", "1", "1", "1", "--goal", "1", "1", "11"}, 1, "goal (1, 1, 11) lies outside the map bounds"},
-      {{"astar", "--map", map, "--start", "nan", "1", "1", "--goal", "1", "1", "1"}, 2, "must be a finite number"},
+      {{"astar", "--map", map, "--start", "nan", "1", "1", "--goal", "1", "1", "1"}, 2, "must be a finite decimal number"},
       {{"astar", "--map", map, "--start", "1", "1", "--goal", "1", "1", "1"}, 2, "--start"},
-      {{"astar", "--map", map, "--start", "1", "1", "1", "--goal", "2", "2", "2", "--radius", "-1"}, 2, "--radius: must be a finite number in [0, 10], got -1"},
+      {{"astar", "--map", map, "--start", "1", "1", "1", "--goal", "2", "2", "2", "--radius", "-1"}, 2, "--radius: must be a finite decimal number in [0, 10], got -1"},
       {{"astar", "--map", map, "--start", "3.2", "5", "5", "--goal", "9", "9", "9", "--radius", "0.5"}, 1, "lies in an occupied grid cell"},
       {{"map", "gen", "--preset", "swamp", "--out", dir() + "/x.json"}, 1, "unknown map preset \"swamp\""},
       {{"map", "info", "--map", write("garbage.bt", "not an octree")}, 1, "not an OctoMap file"},
@@ -304,12 +304,12 @@ TEST_CASE("Every numeric option of every command declares its range", "[REQ-CLI-
   // The behavioural half, one option per kind of check.
   const std::string map = write("pillar-ranges.json", kPillarMap);
   const std::vector<std::pair<std::vector<std::string>, std::string>> cases{
-      {{"bench", "backend", "--budget", "inf"}, "--budget: must be a finite number in [0.0001, 3600], got inf"},
+      {{"bench", "backend", "--budget", "inf"}, "--budget: must be a finite decimal number in [0.0001, 3600], got inf"},
       {{"bench", "backend", "--budget", "1e308"}, "--budget"},
       {{"bench", "backend", "--samples", "1"}, "--samples: must be an integer in [3, 10000], got 1"},
       {{"bench", "backend", "--max-dense-segments", "-1"}, "--max-dense-segments"},
       {{"bench", "backend", "--orders", "5"}, "--orders"},
-      {{"plan", "--map", map, "--goal-bias", "nan"}, "--goal-bias: must be a finite number in [0, 0.999999]"},
+      {{"plan", "--map", map, "--goal-bias", "nan"}, "--goal-bias: must be a finite decimal number in [0, 0.999999]"},
       {{"plan", "--map", map, "--rewire-factor", "nan"}, "--rewire-factor"},
       {{"plan", "--map", map, "--target-factor", "1e308"}, "--target-factor"},
       {{"region", "astar", "--map", map, "--dilation", "2000000000", "--out", dir() + "/r.json"}, "--dilation"},
@@ -339,13 +339,33 @@ TEST_CASE("Unknown options are named with the nearest one; duplicates, exclusive
       {{"plan", "--map", map, "--target-cost", "1", "--target-factor", "1"}, "excludes"},
       {{"plan", "--map", map, "--planner", "informed", "--mu1", "0.5"}, "--mu1: applies to --planner miner only"},
       {{"plan", "--map", map, "--planner", "rrtstar", "--no-safeguard"}, "--no-safeguard: applies to --planner miner only"},
-      {{"dataset", "--merge", dir() + "/p0", "--count", "5", "--out", dir() + "/m"}, "--count: does not apply to --merge"}};
+      {{"dataset", "--merge", dir() + "/p0", "--count", "5", "--out", dir() + "/m"}, "--count: does not apply to --merge"},
+      {{"bench", "frontend", "--map", map, "--planners", "rrtstar,rrtstar"}, "--planners: lists rrtstar twice"},
+      // Numbers are decimal: strtod's hex floats are not (issue 20: --size 0x10 was 16 m).
+      {{"map", "gen", "--preset", "cluttered", "--size", "0x10", "10", "10", "--out", dir() + "/h.json"}, "--size: must be a finite decimal number"},
+      {{"astar", "--map", map, "--radius", "0x1p-2"}, "--radius: must be a finite decimal number"},
+      // Two outputs in one place: the second would replace the first.
+      {{"map", "scan", "--map", map, "--out", dir() + "/same.bt", "--map-out", dir() + "/same.bt"}, "two outputs of one command need two places"}};
   for (const auto& [args, message] : cases) {
     const Run r = miner_cli(args);
     INFO(r.err);
     CHECK(r.code == 2);
     CHECK_THAT(r.err, Contains(message));
   }
+  // Durations and limits together: the limits would not be applied; --rho is named as the
+  // option it is, not blamed on the file.
+  const std::string problem = write("dur-lim.json", R"({"order": 3, "points": [[0,0,1],[1,1,1],[3,1,2]],
+    "head": [[0,0,1],[0,0,0],[0,0,0]], "tail": [[3,1,2],[0,0,0],[0,0,0]], "durations": [1.5, 2.0],
+    "limits": {"v_max": 1, "a_max": 1}})");
+  const Run both = miner_cli({"traj", "solve", "--problem", problem});
+  CHECK(both.code == 1);
+  CHECK_THAT(both.err, Contains("limits: durations are given: the limits would not be applied"));
+  miner::Json p = miner::read_json_file(problem);
+  p.erase("durations");
+  const std::string limits_only = write("lim.json", p.dump());
+  const Run rho = miner_cli({"traj", "solve", "--problem", limits_only, "--rho", "5"});
+  CHECK(rho.code == 1);
+  CHECK_THAT(rho.err, Contains("--rho: only used with --allocate optimise"));
   // Negative numbers are values, not options.
   std::ostringstream out, err;
   INFO(err.str());
@@ -368,6 +388,21 @@ TEST_CASE("No output replaces an input, and outputs are probed for writing befor
   CHECK(inside.code == 2);
   CHECK_THAT(inside.err, Contains("is, or holds, the input"));
   CHECK(std::filesystem::exists(scenario));
+  // A run folder holding a file the scenario reads (its map): refused before the flight, the
+  // map kept (issue 20: the run's path.json replaced it).
+  const std::string data = dir() + "/fly-data";
+  std::filesystem::create_directories(data);
+  std::filesystem::copy_file(std::string(MINER_SOURCE_DIR) + "/fixtures/maps/indoor-1.json", data + "/path.json",
+                             std::filesystem::copy_options::overwrite_existing);
+  miner::Json sc = miner::read_json_file(std::string(MINER_SOURCE_DIR) + "/fixtures/scenarios/default.json");
+  sc["map"] = "fly-data/path.json";
+  sc["vehicle"] = std::string(MINER_SOURCE_DIR) + "/fixtures/vehicles/n3-1500g.json";
+  const std::string sc_path = write("fly-holds-map.json", sc.dump());
+  const std::string before = read(data + "/path.json");
+  const Run holds = miner_cli({"fly", "--scenario", sc_path, "--out", data});
+  CHECK(holds.code == 2);
+  CHECK_THAT(holds.err, Contains("which the scenario reads"));
+  CHECK(read(data + "/path.json") == before);
   // A folder that says it is writable but is not (root in /proc): refused at once.
   if (std::filesystem::is_directory("/proc/self")) {
     const Run proc = miner_cli({"astar", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5", "--out", "/proc/x"});
@@ -784,7 +819,11 @@ TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[RE
     CHECK_THAT(miner_cli({"bench", "merge", parts[0], parts[1], no_records}).err,
                Contains("run_records[0].planner: missing required field"));
   }
-  for (const char* bad : {"3/3", "-1/2", "1", "a/b", "1/2x"}) CHECK(miner_cli(with({"--shard", bad})).code == 1);
+  for (const char* bad : {"3/3", "-1/2", "1", "a/b", "1/2x"}) {
+    const Run r = miner_cli(with({"--shard", bad}));
+    CHECK(r.code == 2);  // a malformed option value: a usage error, before any run
+    CHECK_THAT(r.err, Contains("--shard: expected i/N with 0 <= i < N"));
+  }
 
   // Datasets: the merged parts are byte-identical to the unsharded folder.
   const std::vector<std::string> gen{"dataset", "--count", "4", "--test-count", "2", "--shard-size", "1", "--seed", "5", "--preset", "indoor"};
@@ -1051,7 +1090,7 @@ TEST_CASE("miner map scan writes a deterministic OctoMap and a map that referenc
   // Bad settings name themselves.
   CHECK_THAT(miner_cli({"map", "scan", "--map", src, "--out", dir() + "/scan.json"}).err, Contains("must end in .bt"));
   CHECK_THAT(miner_cli({"map", "scan", "--map", src, "--fov", "400", "60", "--out", bt}).err,
-             Contains("--fov: must be a finite number in [0, 360], got 400"));
+             Contains("--fov: must be a finite decimal number in [0, 360], got 400"));
   CHECK_THAT(miner_cli({"map", "info", "--map", json, "--unknown", "maybe"}).err, Contains("--unknown"));
 }
 

@@ -92,6 +92,12 @@ void write_folder_atomic(const std::string& path, const std::vector<std::pair<st
 /// folder that is replaced whole must not hold an input (issue 20).
 bool is_same_or_inside(const std::string& folder, const std::string& path);
 
+/// Whether `text` is a decimal number: optional sign, digits with an optional point, an
+/// optional exponent ("1", "-0.5", ".5e3"); not hex ("0x10", "0x1p-2"), "inf" or "nan", which
+/// strtod also reads (issue 20: `--size 0x10` was 16 m). Command-line numbers and text file
+/// headers are read through it.
+bool is_decimal_number(const std::string& text);
+
 /// JSON text as the project writes it: 2-space indent, trailing newline.
 std::string dump_json(const Json& j);
 

@@ -241,6 +241,40 @@ Json self_contained_scenario(Json doc, const std::string& base_dir) {
   return doc;
 }
 
+std::vector<std::string> scenario_inputs(const Json& doc, const std::string& base_dir) {
+  std::vector<std::string> files;
+  if (!doc.is_object()) return files;
+  const auto add = [&](const std::string& dir, const Json& v) {
+    if (v.is_string()) files.push_back(std::filesystem::absolute(resolve(dir, v.get<std::string>())).lexically_normal().string());
+  };
+  if (doc.contains("map")) {
+    const Json& m = doc["map"];
+    add(base_dir, m);
+    // The map's voxel file, relative to the map's own folder (or the scenario's, inlined).
+    Json map_doc = m;
+    std::string map_dir = base_dir;
+    if (m.is_string() && std::filesystem::path(m.get<std::string>()).extension() == ".json") {
+      const std::string map_path = resolve(base_dir, m.get<std::string>());
+      map_dir = std::filesystem::path(map_path).parent_path().string();
+      std::error_code ec;
+      if (std::filesystem::is_regular_file(map_path, ec)) {
+        try {
+          map_doc = read_json_file(map_path);
+        } catch (const Error&) {
+          map_doc = nullptr;  // scenario_from_json names the fault
+        }
+      }
+    }
+    if (map_doc.is_object() && map_doc.contains("voxels") && map_doc["voxels"].is_object() &&
+        map_doc["voxels"].contains("file"))
+      add(map_dir, map_doc["voxels"]["file"]);
+  }
+  if (doc.contains("vehicle")) add(base_dir, doc["vehicle"]);
+  for (const auto& [block, key] : {std::pair{"trajectory", "file"}, std::pair{"planner", "weights"}})
+    if (doc.contains(block) && doc[block].is_object() && doc[block].contains(key)) add(base_dir, doc[block][key]);
+  return files;
+}
+
 Scenario load_scenario(const std::string& path) {
   return scenario_from_json(read_json_file(path), path, std::filesystem::path(path).parent_path().string());
 }

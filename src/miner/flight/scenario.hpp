@@ -111,6 +111,10 @@ const char* default_scenario_text();
 /// other file references (an OctoMap map, a trajectory file, sGAN weights) made absolute
 /// against `base_dir`. What `miner fly` stores as its run folder's scenario.json.
 Json self_contained_scenario(Json doc, const std::string& base_dir);
+/// Every file a scenario document reads (map, the map's voxel file, vehicle, trajectory file,
+/// sGAN weights), absolute: a run folder must not hold any of them (issue 20: `fly --out` the
+/// map's folder replaced the map with the run's path.json).
+std::vector<std::string> scenario_inputs(const Json& doc, const std::string& base_dir);
 /// The default scenario as such a document.
 Json default_scenario_document();
 

@@ -179,6 +179,17 @@ void validate(const DatasetOptions& o) {
   if (o.dilation < 0 || o.dilation > plan::HeuristicRegion::kMaxDilation)
     throw Error("dataset: --dilation must be in [0, " + std::to_string(plan::HeuristicRegion::kMaxDilation) + "]");
   if (o.shard_size < 1) throw Error("dataset: --shard-size must be >= 1");
+  // Bounded output, refused before any sample is drawn (issue 20: 10^7 samples of 256^3 cells
+  // asked for 5e14 bytes and ran until killed). 2^38 bytes = 256 GiB.
+  constexpr double kMaxDatasetBytes = 274877906944.0;
+  const double bytes = (static_cast<double>(o.count) + static_cast<double>(o.test_count)) * 3.0 *
+                       static_cast<double>(o.dims.x()) * o.dims.y() * o.dims.z();
+  if (bytes > kMaxDatasetBytes) {
+    std::ostringstream os;
+    os << "dataset: --count + --test-count samples of 3 x " << o.dims.x() << " x " << o.dims.y() << " x " << o.dims.z()
+       << " cells are " << bytes << " bytes, more than the " << kMaxDatasetBytes << " (256 GiB) a dataset may have";
+    throw Error(os.str());
+  }
   if (o.jobs < 1 || o.jobs > 256) throw Error("dataset: --jobs must be in [1, 256]");
   require_shard(o.shard_index, o.shard_count);
   if (!(o.min_separation >= 0.0 && o.min_separation < 1.0)) throw Error("dataset: min_separation must be in [0, 1)");

@@ -32,6 +32,9 @@ MincoProblem problem_from_json(const Json& doc, const std::string& origin) {
   p.head = rows_of(root.at("head"));
   p.tail = rows_of(root.at("tail"));
   if (root.has("durations")) {
+    // Durations fix the timing; limits beside them would be ignored (issue 20: the answer
+    // exceeded the v_max the file gave, without a word).
+    if (root.has("limits")) root.at("limits").fail("durations are given: the limits would not be applied (give one of them)");
     const JsonField d = root.at("durations");
     for (std::size_t i = 0; i < d.array_size(); ++i) p.durations.push_back(d.at(i).number());
   } else {
@@ -68,7 +71,8 @@ TrajectoryRequest request_from_json(const Json& doc, const std::string& origin, 
     (root.has("allocation") && allocation_override.empty() ? root.at("allocation") : root)
         .fail("allocation: expected \"trapezoid\" or \"optimise\", got \"" + method + "\"");
   if (method == "trapezoid") {
-    if (root.has("rho") || rho_override) root.fail("rho: only used with \"allocation\": \"optimise\"");
+    if (rho_override) throw Error("--rho: only used with --allocate optimise");
+    if (root.has("rho")) root.at("rho").fail("only used with \"allocation\": \"optimise\"");
     return r;
   }
   if (root.has("durations"))

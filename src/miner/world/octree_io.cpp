@@ -84,7 +84,7 @@ Header parse_header(const std::string& bytes, const std::string& origin) {
     } else if (key == "res") {
       char* end = nullptr;
       h.res = std::strtod(value.c_str(), &end);
-      if (end == value.c_str() || *end != '\0' || !std::isfinite(h.res) || !(h.res > 0.0))
+      if (!is_decimal_number(value) || end == value.c_str() || *end != '\0' || !std::isfinite(h.res) || !(h.res > 0.0))
         fail(origin, "header res \"" + value + "\" is not a positive resolution in m");
       if (h.res < kMinResolution || h.res > kMaxResolution) {
         std::ostringstream os;

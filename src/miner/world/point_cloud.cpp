@@ -176,6 +176,10 @@ std::array<int, 3> find_xyz(const std::vector<Field>& fields, const std::string&
   for (std::size_t i = 0; i < fields.size(); ++i)
     for (int a = 0; a < 3; ++a)
       if (fields[i].name == std::string(1, "xyz"[a])) xyz[a] = static_cast<int>(i);
+  for (std::size_t i = 0; i < fields.size(); ++i)
+    for (int a = 0; a < 3; ++a)
+      if (fields[i].name == std::string(1, "xyz"[a]) && xyz[a] != static_cast<int>(i))
+        fail(origin, std::string("field \"") + "xyz"[a] + "\" is declared twice");
   for (int a = 0; a < 3; ++a)
     if (xyz[a] < 0) fail(origin, std::string("the points have no \"") + "xyz"[a] + "\" field");
   for (int a = 0; a < 3; ++a)
@@ -256,7 +260,12 @@ PointCloud parse_pcd(const std::string& bytes, const std::string& origin) {
     if (std::find(seen.begin(), seen.end(), w[0]) != seen.end())
       fail(origin, "header line " + w[0] + " is given twice");
     seen.push_back(w[0]);
-    if (w[0] == "VERSION") continue;
+    if (w[0] == "VERSION") {
+      // PCL writes 0.7 (".7" in older files); other versions lay their header out differently.
+      if (rest.size() != 1 || (rest[0] != "0.7" && rest[0] != ".7"))
+        fail(origin, "PCD VERSION \"" + (rest.empty() ? std::string() : rest[0]) + "\" (MINER reads version 0.7)");
+      continue;
+    }
     if (w[0] == "FIELDS") names = rest;
     else if (w[0] == "SIZE") sizes = rest;
     else if (w[0] == "TYPE") types = rest;

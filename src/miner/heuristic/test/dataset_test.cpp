@@ -284,6 +284,11 @@ TEST_CASE("Bad dataset options are refused naming the option", "[REQ-HEUR-003]")
   o = small_options();
   o.jobs = 0;
   CHECK_THROWS_WITH(heuristic::validate(o), Contains("--jobs"));
+  // Bounded output, refused before any sample (issue 20: 5e14 bytes were attempted).
+  o = small_options();
+  o.count = 10000000;
+  o.dims = Eigen::Vector3i(256, 256, 256);
+  CHECK_THROWS_WITH(heuristic::validate(o), Contains("more than the 2.74878e+11 (256 GiB) a dataset may have"));
   CHECK_FALSE(std::filesystem::exists(temp_dir() + "/bad"));
 }
 

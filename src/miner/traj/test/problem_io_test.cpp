@@ -47,8 +47,13 @@ TEST_CASE("Problem file errors name the file and the field", "[REQ-TRAJ-007]") {
   doc["limits"]["a_max"] = 1e308;
   CHECK_THROWS_WITH(problem_from_json(doc, "p.json"), Contains("p.json: limits.a_max: must be in [1e-06, 1e+06] m/s^2"));
   doc = problem();
+  doc.erase("limits");
   doc["durations"] = {1.0, 0.0};
   CHECK_THROWS_WITH(problem_from_json(doc, "p.json"), Contains("p.json: durations[1]: must be positive and finite"));
+  // Both: the limits would not be applied to given durations (issue 20: exceeded silently).
+  doc["durations"] = {1.0, 1.0};
+  doc["limits"] = {{"v_max", 1.0}, {"a_max", 1.0}};
+  CHECK_THROWS_WITH(problem_from_json(doc, "p.json"), Contains("p.json: limits: durations are given"));
   doc = problem();
   doc["order"] = 3.5;
   CHECK_THROWS_WITH(problem_from_json(doc, "p.json"), Contains("order: expected an integer"));

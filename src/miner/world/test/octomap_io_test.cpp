@@ -200,6 +200,7 @@ TEST_CASE("Malformed OctoMap files are refused naming the fault, never crash", "
   // made planning hang) and a header key given twice (the last one silently won).
   refuses(header(1, "1e-300"), "header res 1e-300 m is outside the resolutions a map may have [0.001, 100] m");
   refuses(header(1, "1e300"), "header res 1e300 m is outside");
+  refuses(header(1, "0x1p-1"), "header res \"0x1p-1\" is not a positive resolution");  // strtod reads hex
   refuses("# Octomap OcTree binary file\nid OcTree\nsize 1\nres 0.5\nres 5\ndata\n", "header key \"res\" is given twice");
   const auto [head, data] = valid_bt();
   refuses(head + data.substr(0, data.size() / 2), "data ends early");

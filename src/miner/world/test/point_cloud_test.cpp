@@ -167,6 +167,13 @@ TEST_CASE("Malformed point clouds are refused naming the fault, never crash", "[
   refuses("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n"
           "1 2 3\n4 5 6\n",
           true, "data continues after the 1 points");
+  refuses("VERSION 0.7\nFIELDS x x y z\nSIZE 4 4 4 4\nTYPE F F F F\nPOINTS 1\nDATA ascii\n0 1 2 3\n", false,
+          "field \"x\" is declared twice");
+  refuses("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float x\nproperty float y\nproperty float z\n"
+          "end_header\n0 1 2 3\n",
+          true, "field \"x\" is declared twice");
+  refuses("VERSION 9.9\n" + pcd_head.substr(pcd_head.find('\n') + 1) + "POINTS 1\nDATA ascii\n0 0 1\n", false,
+          "PCD VERSION \"9.9\"");
   // A later element's data may follow the vertices.
   CHECK(parse_point_cloud("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty "
                           "float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n1 2 3\n3 0 0 0\n",

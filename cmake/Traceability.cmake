@@ -13,9 +13,11 @@ add_test(NAME traceability
           --out ${PROJECT_BINARY_DIR}/traceability.md
           --extra-citations ${PROJECT_SOURCE_DIR}/ci/test_trace.py ${PROJECT_SOURCE_DIR}/ci/check_readme.py ${PROJECT_SOURCE_DIR}/ci/fuzz.sh
                             ${PROJECT_SOURCE_DIR}/ci/check_report.py ${PROJECT_SOURCE_DIR}/ci/cluster_test.sh
-                            ${PROJECT_SOURCE_DIR}/ci/install_test.sh ${PROJECT_SOURCE_DIR}/src/python/tests/test_miner.py)
+                            ${PROJECT_SOURCE_DIR}/ci/install_test.sh ${PROJECT_SOURCE_DIR}/src/python/tests/test_miner.py
+                            ${PROJECT_SOURCE_DIR}/ci/check_layout.py)
 add_test(NAME traceability-checker-selftest
   COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/ci/test_trace.py)
+add_test(NAME layout COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/ci/check_layout.py ${PROJECT_SOURCE_DIR})
 add_test(NAME readme-quickstart
   COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/ci/check_readme.py ${PROJECT_SOURCE_DIR})
-set_tests_properties(traceability traceability-checker-selftest readme-quickstart PROPERTIES LABELS unit)
+set_tests_properties(traceability traceability-checker-selftest readme-quickstart layout PROPERTIES LABELS unit)

@@ -6,16 +6,16 @@
 
 #include "miner/core/error.hpp"
 #include "miner/flight/closed_loop.hpp"
-#include "miner/flight/scenario.hpp"
+#include "miner/pipeline/scenario.hpp"
 
 int main(int argc, char** argv) {
   try {
-    const miner::flight::Scenario scenario =
-        argc > 1 ? miner::flight::load_scenario(argv[1]) : miner::flight::default_scenario();
-    const miner::flight::ReferencePlan reference = miner::flight::build_reference(scenario);
+    const miner::pipeline::Scenario scenario =
+        argc > 1 ? miner::pipeline::load_scenario(argv[1]) : miner::pipeline::default_scenario();
+    const miner::pipeline::ReferencePlan reference = miner::pipeline::build_reference(scenario);
     miner::flight::FlyOptions options;
     options.record_log = false;
-    const miner::flight::FlightResult flight = miner::flight::fly(scenario, reference, options);
+    const miner::flight::FlightResult flight = miner::pipeline::fly(scenario, reference, options);
     std::printf("%s: %s reference of %.2f s, flown %.2f s; position RMSE %.4f m, %d collisions, goal %s\n",
                 scenario.name.c_str(), reference.source.c_str(), reference.trajectory.total_duration(),
                 flight.flight_time, flight.position_rmse, flight.collisions,

@@ -2,13 +2,15 @@
 #include <catch2/catch.hpp>
 
 #include "miner/flight/closed_loop.hpp"
+#include "miner/pipeline/scenario.hpp"
 #include "miner/testing/golden.hpp"
 
 namespace flight = miner::flight;
+namespace pipeline = miner::pipeline;
 
 TEST_CASE("The default scenario's seed-1 flight keeps its log and summary", "[REQ-FLIGHT-009][REQ-HARNESS-002]") {
-  const flight::Scenario s = flight::default_scenario();
-  const flight::FlightResult r = flight::fly(s, flight::build_reference(s));
+  const pipeline::Scenario s = pipeline::default_scenario();
+  const flight::FlightResult r = pipeline::fly(s, pipeline::build_reference(s));
   nlohmann::json summary = r.summary;
   // One row per second of the 100 Hz log, every column, named.
   nlohmann::json rows = nlohmann::json::array();

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "miner/flight/closed_loop.hpp"
+#include "miner/pipeline/scenario.hpp"
 #include "miner/testing/flight_scenarios.hpp"
 #include "miner/testing/property.hpp"
 #include "miner/traj/time_allocation.hpp"
@@ -12,6 +13,8 @@
 using miner::testing::open_room_scenario;
 using miner::testing::property;
 namespace flight = miner::flight;
+namespace pipeline = miner::pipeline;
+namespace traj = miner::traj;
 
 namespace {
 
@@ -56,19 +59,19 @@ TEST_CASE("Tracking error stays under the derived bound on random feasible traje
     const double v_max = *rc::gen::inRange(5, 21) / 10.0;
     const double a_max = *rc::gen::inRange(5, 21) / 10.0;
     const auto seed = static_cast<std::uint64_t>(*rc::gen::inRange(1, 1000000));
-    flight::Scenario s = open_room_scenario(points, v_max, a_max, seed);
+    pipeline::Scenario s = open_room_scenario(points, v_max, a_max, seed);
     s.hover_after_s = 2.0;
-    flight::ReferencePlan ref = flight::build_reference(s);
+    pipeline::ReferencePlan ref = pipeline::build_reference(s);
     // Re-time so the tighter of the two limits is met with equality (build_reference
     // only ever stretches): the property covers trajectories at their limits.
     const double k = std::max(ref.max_speed / v_max, std::sqrt(ref.max_acceleration / a_max));
     miner::traj::scale_time(ref.trajectory, k);
-    const auto [v, a] = flight::trajectory_extremes(ref.trajectory, 1e-3);
+    const auto [v, a] = traj::trajectory_extremes(ref.trajectory, 1e-3);
     RC_ASSERT(v <= v_max * (1 + 1e-6));
     RC_ASSERT(a <= a_max * (1 + 1e-6));
     flight::FlyOptions options;
     options.record_log = false;
-    const flight::FlightResult r = flight::fly(s, ref, options);
+    const flight::FlightResult r = pipeline::fly(s, ref, options);
     const double j = max_jerk(ref.trajectory);
     RC_LOG() << "v_max " << v_max << " a_max " << a_max << " max jerk " << j << " max error "
              << r.max_position_error << " rmse " << r.position_rmse << "\n";
@@ -90,9 +93,9 @@ TEST_CASE("At the paper's speeds the tracking MSE is at or below the paper's rea
     doc["map"] = std::string("../maps/") + map + ".json";
     doc["trajectory"]["v_max"] = 0.5;  // paper: 1.73 and 1.45 km/h average,
     doc["trajectory"]["a_max"] = 0.2;  // 0.2 and 0.15 m/s^2 maximum
-    const flight::Scenario s = flight::scenario_from_json(doc, map, std::string(MINER_SOURCE_DIR) + "/fixtures/scenarios");
-    const flight::ReferencePlan ref = flight::build_reference(s);
-    const flight::FlightResult r = flight::fly(s, ref);
+    const pipeline::Scenario s = pipeline::scenario_from_json(doc, map, std::string(MINER_SOURCE_DIR) + "/fixtures/scenarios");
+    const pipeline::ReferencePlan ref = pipeline::build_reference(s);
+    const flight::FlightResult r = pipeline::fly(s, ref);
     INFO(map << "\n" << flight::tracking_table(map, r));
     CHECK(r.goal_reached);
     CHECK(r.collisions == 0);
@@ -111,10 +114,10 @@ TEST_CASE("Planned with the tracking margin, fixture-map flights never touch the
       miner::Json doc = miner::read_json_file(std::string(MINER_SOURCE_DIR) + "/fixtures/scenarios/default.json");
       doc["map"] = std::string("../maps/") + map + ".json";
       doc["seed"] = seed;
-      const flight::Scenario s = flight::scenario_from_json(doc, map, std::string(MINER_SOURCE_DIR) + "/fixtures/scenarios");
+      const pipeline::Scenario s = pipeline::scenario_from_json(doc, map, std::string(MINER_SOURCE_DIR) + "/fixtures/scenarios");
       flight::FlyOptions options;
       options.record_log = false;
-      const flight::FlightResult r = flight::fly(s, flight::build_reference(s), options);
+      const flight::FlightResult r = pipeline::fly(s, pipeline::build_reference(s), options);
       INFO(map << " seed " << seed << ": max error " << r.max_position_error);
       CHECK(r.collisions == 0);
       CHECK(r.goal_reached);

@@ -6,9 +6,11 @@
 
 #include "miner/core/statistics.hpp"
 #include "miner/flight/closed_loop.hpp"
+#include "miner/pipeline/scenario.hpp"
 #include "miner/testing/flight_scenarios.hpp"
 
 namespace flight = miner::flight;
+namespace pipeline = miner::pipeline;
 
 TEST_CASE("EKF NEES and NIS stay inside their chi-square bounds over Monte Carlo flights", "[REQ-FLIGHT-005]") {
   constexpr int kRuns = 20;
@@ -17,14 +19,14 @@ TEST_CASE("EKF NEES and NIS stay inside their chi-square bounds over Monte Carlo
   std::vector<std::vector<double>> nees;
   std::vector<double> nis;
   for (int run = 0; run < kRuns; ++run) {
-    flight::Scenario s = miner::testing::open_room_scenario(points, 1.5, 1.5, 1000 + run);
+    pipeline::Scenario s = miner::testing::open_room_scenario(points, 1.5, 1.5, 1000 + run);
     s.pose.outlier_probability = 0.0;  // outliers are tested on their own
     s.ekf.pose = s.pose;
-    const flight::ReferencePlan ref = flight::build_reference(s);
+    const pipeline::ReferencePlan ref = pipeline::build_reference(s);
     flight::FlyOptions options;
     options.record_log = false;
     options.record_consistency = true;
-    const flight::FlightResult r = flight::fly(s, ref, options);
+    const flight::FlightResult r = pipeline::fly(s, ref, options);
     nees.push_back(r.nees);
     nis.insert(nis.end(), r.nis.begin(), r.nis.end());
   }

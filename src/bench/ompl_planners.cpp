@@ -31,7 +31,7 @@ namespace miner::bench {
 
 std::uint32_t ompl_run_seed(std::uint64_t campaign_seed, int run) {
   // Stream 2^40 + run: far from the project planners' streams (the run number itself).
-  Rng rng(campaign_seed, (std::uint64_t{1} << 40) + static_cast<std::uint64_t>(run));
+  Rng rng(campaign_seed, streams::kOmplRunBase + static_cast<std::uint64_t>(run));
   const auto s = static_cast<std::uint32_t>(rng.next_u64() >> 33);  // [0, 2^31)
   return s == 0 ? 1u : s;
 }

@@ -18,7 +18,7 @@
 #include "miner/core/error.hpp"
 #include "miner/core/json_io.hpp"
 #include "miner/flight/closed_loop.hpp"
-#include "miner/flight/scenario.hpp"
+#include "miner/pipeline/scenario.hpp"
 #include "miner/heuristic/dataset.hpp"
 #include "miner/report/svg_plot.hpp"
 #include "miner/world/map.hpp"
@@ -161,17 +161,17 @@ PaperBenchResult run_paper_bench(const PaperBenchOptions& o, const std::string& 
     maps.push_back(world::Map::load(path));
     if (!maps.back().query()) throw Error(path + ": the map stores no query (start, goal, robot radius)");
   }
-  std::vector<flight::Scenario> scenarios;
+  std::vector<pipeline::Scenario> scenarios;
   if (o.scenarios.empty()) {
-    scenarios.push_back(flight::default_scenario());
+    scenarios.push_back(pipeline::default_scenario());
     for (const auto& m : o.tracking_maps) {
-      Json doc = flight::default_scenario_document();
+      Json doc = pipeline::default_scenario_document();
       doc["map"] = read_json_file(m);
       doc["name"] = map_label(m);
-      scenarios.push_back(flight::scenario_from_json(doc, m, ""));
+      scenarios.push_back(pipeline::scenario_from_json(doc, m, ""));
     }
   } else {
-    for (const auto& s : o.scenarios) scenarios.push_back(flight::load_scenario(s));
+    for (const auto& s : o.scenarios) scenarios.push_back(pipeline::load_scenario(s));
   }
   if (!o.weights.empty())
     for (auto& s : scenarios) s.weights = o.weights;
@@ -245,8 +245,8 @@ PaperBenchResult run_paper_bench(const PaperBenchOptions& o, const std::string& 
   // Tracking.
   for (const auto& s : scenarios) {
     if (progress) *progress << "flying " << s.name << "\n";
-    const auto reference = flight::build_reference(s);
-    const auto r = flight::fly(s, reference);
+    const auto reference = pipeline::build_reference(s);
+    const auto r = pipeline::fly(s, reference);
     out.tracking.push_back({s.name, r.position_mse, r.velocity_mse, r.max_position_error, r.collisions, r.goal_reached});
   }
   out.total_s = std::chrono::duration<double>(Clock::now() - t0).count();

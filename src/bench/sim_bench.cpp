@@ -11,9 +11,9 @@
 
 namespace miner::bench {
 
-SimBenchResult run_sim_bench(const flight::Scenario& scenario, const SimBenchOptions& options) {
+SimBenchResult run_sim_bench(const pipeline::Scenario& scenario, const SimBenchOptions& options) {
   if (options.runs < 1) throw Error("bench sim: --runs must be >= 1");
-  const flight::ReferencePlan reference = flight::build_reference(scenario);
+  const pipeline::ReferencePlan reference = pipeline::build_reference(scenario);
   flight::FlyOptions fly_options;
   fly_options.record_log = false;
   fly_options.integrator.relative_tolerance = options.relative_tolerance;
@@ -24,10 +24,10 @@ SimBenchResult run_sim_bench(const flight::Scenario& scenario, const SimBenchOpt
   std::vector<double> walls, factors;
   // One untimed flight first: page faults, allocator growth and cold caches belong to
   // process start-up, not to the loop being measured.
-  flight::fly(scenario, reference, fly_options);
+  pipeline::fly(scenario, reference, fly_options);
   for (int i = 0; i < options.runs; ++i) {
     const auto start = std::chrono::steady_clock::now();
-    const flight::FlightResult flight = flight::fly(scenario, reference, fly_options);
+    const flight::FlightResult flight = pipeline::fly(scenario, reference, fly_options);
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     walls.push_back(wall);
     factors.push_back(flight.flight_time / wall);

@@ -8,7 +8,7 @@
 #include <iosfwd>
 
 #include "miner/core/json_io.hpp"
-#include "miner/flight/scenario.hpp"
+#include "miner/pipeline/scenario.hpp"
 
 namespace miner::bench {
 
@@ -29,7 +29,7 @@ struct SimBenchResult {
   long ticks = 0;
 };
 
-SimBenchResult run_sim_bench(const flight::Scenario& scenario, const SimBenchOptions& options);
+SimBenchResult run_sim_bench(const pipeline::Scenario& scenario, const SimBenchOptions& options);
 Json to_json(const SimBenchResult& r);
 void print_table(const SimBenchResult& r, std::ostream& out);
 

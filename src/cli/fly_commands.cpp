@@ -30,8 +30,8 @@ void add_scenario_options(CLI::App* cmd, ScenarioOptions& o) {
   cmd->add_option("--seed", o.seed, "override the scenario's seed")->check(kUnsigned64);
 }
 
-flight::Scenario resolve_scenario(const ScenarioOptions& o) {
-  flight::Scenario s = o.scenario.empty() ? flight::default_scenario() : flight::load_scenario(o.scenario);
+pipeline::Scenario resolve_scenario(const ScenarioOptions& o) {
+  pipeline::Scenario s = o.scenario.empty() ? pipeline::default_scenario() : pipeline::load_scenario(o.scenario);
   if (o.seed >= 0) s.seed = static_cast<std::uint64_t>(o.seed);
   return s;
 }
@@ -44,20 +44,20 @@ struct FlyCliOptions {
 };
 
 void run_fly(const FlyCliOptions& o, std::ostream& out) {
-  const flight::Scenario s = resolve_scenario(o.scenario);
+  const pipeline::Scenario s = resolve_scenario(o.scenario);
   // The run folder replaces its contents whole: it must hold none of the scenario's inputs,
   // checked before any work (REQ-CLI-003).
   const std::string run_dir = o.out.empty() ? "runs/" + s.name + "-seed" + std::to_string(s.seed) : o.out;
   if (!o.scenario.scenario.empty())
-    for (const std::string& input : flight::scenario_inputs(read_json_file(o.scenario.scenario),
+    for (const std::string& input : pipeline::scenario_inputs(read_json_file(o.scenario.scenario),
                                                              std::filesystem::path(o.scenario.scenario).parent_path().string()))
       if (is_same_or_inside(run_dir, input))
         throw CLI::ValidationError("--out", run_dir + " holds " + input + ", which the scenario reads: the run folder would replace it");
-  const flight::ReferencePlan reference = flight::build_reference(s);
+  const pipeline::ReferencePlan reference = pipeline::build_reference(s);
   flight::FlyOptions options;
   options.use_ground_truth = o.ground_truth;
   const auto t0 = std::chrono::steady_clock::now();
-  const flight::FlightResult r = flight::fly(s, reference, options);
+  const flight::FlightResult r = pipeline::fly(s, reference, options);
   auto stage_ms = reference.stage_ms;
   stage_ms.emplace_back("flight", elapsed_ms(t0));
 
@@ -78,8 +78,8 @@ void run_fly(const FlyCliOptions& o, std::ostream& out) {
   std::vector<std::pair<std::string, std::string>> files{
       {"scenario.json",
        dump_json(o.scenario.scenario.empty()
-                     ? flight::default_scenario_document()
-                     : flight::self_contained_scenario(read_json_file(o.scenario.scenario),
+                     ? pipeline::default_scenario_document()
+                     : pipeline::self_contained_scenario(read_json_file(o.scenario.scenario),
                                                        std::filesystem::path(o.scenario.scenario).parent_path().string()))},
       {"map.json", dump_json(s.map->to_json())}};
   if (reference.region) {

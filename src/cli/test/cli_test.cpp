@@ -12,7 +12,7 @@
 #include "bench/ompl_planners.hpp"
 #include "cli/cli.hpp"
 #include "miner/core/json_io.hpp"
-#include "miner/flight/scenario.hpp"
+#include "miner/pipeline/scenario.hpp"
 #include "miner/plan/heuristic_region.hpp"
 
 using Catch::Matchers::Contains;
@@ -628,7 +628,7 @@ TEST_CASE("miner fly runs sGAN region, MINER RRT*, MINCO and flight and keeps ev
   CHECK(again.code == 0);
   CHECK(read(dir() + "/again/flight_log.csv") == read(run + "/flight_log.csv"));
   CHECK(miner::world::Map::load(run + "/map.json").obstacles().size() ==
-        miner::flight::default_scenario().map->obstacles().size());
+        miner::pipeline::default_scenario().map->obstacles().size());
   const auto region = miner::plan::HeuristicRegion::load(run + "/region.json");
   CHECK(region.source() == "sgan-filtered");
   const miner::Json tree = miner::read_json_file(run + "/tree.json");

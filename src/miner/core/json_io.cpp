@@ -172,6 +172,12 @@ double JsonField::positive_number() const {
   return v;
 }
 
+void JsonField::require_format(const std::string& tag) const {
+  if (!value_->is_object()) fail("expected a JSON object with \"format\": \"" + tag + "\"");
+  const std::string format = at("format").string();
+  if (format != tag) at("format").fail("unknown format tag \"" + format + "\", expected \"" + tag + "\"");
+}
+
 double JsonField::number_in(double lo, double hi, const std::string& unit) const {
   const double v = number();
   if (v < lo || v > hi) {

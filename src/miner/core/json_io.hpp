@@ -54,6 +54,9 @@ class JsonField {
   /// max(2, length / 3) edits ("did you mean"), and the known ones.
   void only_keys(const std::vector<std::string>& known) const;
 
+  /// The document is an object whose "format" is `tag`; otherwise throws naming what it is
+  /// (the one format check of every file kind: map, region, scenario, vehicle).
+  void require_format(const std::string& tag) const;
   /// Throws Error("<origin>: <path>: <message>").
   [[noreturn]] void fail(const std::string& message) const;
 

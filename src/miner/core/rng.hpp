@@ -27,6 +27,21 @@ inline std::uint64_t retry_stream(std::uint64_t attempt) { return attempt == 0 ?
 double ziggurat_top_layer_area();
 
 /// Seeded random number generator.
+/// The project's named random streams (issue 22: their numbers were literals in six files).
+/// A draw is Rng(seed, stream); keeping every use of a seed on its own stream keeps the uses
+/// independent and each one reproducible alone. Indexed families (a campaign's run r, a
+/// generator's retry a, a scan's pose k) use their index as the stream, offset where noted.
+namespace streams {
+inline constexpr std::uint64_t kImuNoise = 1;          ///< flight: IMU noise and bias walks
+inline constexpr std::uint64_t kPoseNoise = 2;         ///< flight: pose noise and outliers
+inline constexpr std::uint64_t kInitialEstimate = 3;   ///< flight: the EKF's initial error
+inline constexpr std::uint64_t kSganNoise = 0x5347414e;  ///< heuristic: the generator's noise ("SGAN")
+/// heuristic: a dataset sample's query, on its map seed (a stream the map generator never uses)
+inline constexpr std::uint64_t kDatasetQuery = 0x9e3779b97f4a7c15ULL;
+/// bench: OMPL's run r draws from kOmplRunBase + r (above every run index of our planners)
+inline constexpr std::uint64_t kOmplRunBase = std::uint64_t{1} << 40;
+}  // namespace streams
+
 class Rng {
  public:
   /// Stream `stream` of master seed `seed`: engine seeded with SplitMix64(seed ^ stream),

@@ -58,7 +58,7 @@ Json vec_json(const Eigen::Vector3d& v) { return vec3_json(v); }
 
 }  // namespace
 
-FlightResult fly(const Scenario& s, const ReferencePlan& reference, const FlyOptions& options) {
+FlightResult fly(const FlightSetup& s, const ReferenceTrajectory& reference, const FlyOptions& options) {
   FlightResult out;
   const double dt = 1.0 / s.n3.rate_hz;
   const int control_every = static_cast<int>(std::lround(s.n3.rate_hz / s.controller.rate_hz));
@@ -69,7 +69,8 @@ FlightResult fly(const Scenario& s, const ReferencePlan& reference, const FlyOpt
   const double t_traj = trajectory.total_duration();
   const long total_ticks = static_cast<long>(std::ceil((t_traj + s.hover_after_s) / dt));
 
-  Rng imu_rng(s.seed, 1), pose_rng(s.seed, 2), init_rng(s.seed, 3);
+  Rng imu_rng(s.seed, streams::kImuNoise), pose_rng(s.seed, streams::kPoseNoise),
+      init_rng(s.seed, streams::kInitialEstimate);
   QuadState truth = hover_state(s.vehicle, s.start, 0.0);
   ImuModel imu(s.imu, dt, imu_rng);
   NavState estimate0;
@@ -134,7 +135,7 @@ FlightResult fly(const Scenario& s, const ReferencePlan& reference, const FlyOpt
       }
       sum_est2 += (est.p - truth.p).squaredNorm();
       ++estimated;
-      const bool colliding = !s.map->is_free(truth.p, s.vehicle.radius);
+      const bool colliding = s.collides && s.collides(truth.p);
       if (colliding && !was_colliding) ++out.collisions;
       if (colliding) out.collision_time_s += control_dt;
       was_colliding = colliding;

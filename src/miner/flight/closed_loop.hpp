@@ -8,19 +8,60 @@
 /// The controller reads the EKF. `use_ground_truth` exists only as a diagnostic (to
 /// separate estimation from control error); the summary says which one it flew on.
 
+#include <cstdint>
+#include <functional>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
 
 #include "miner/core/json_io.hpp"
+#include "miner/flight/controller.hpp"
 #include "miner/flight/dynamics.hpp"
 #include "miner/flight/ekf.hpp"
-#include "miner/flight/scenario.hpp"
+#include "miner/flight/n3.hpp"
+#include "miner/flight/sensors.hpp"
+#include "miner/flight/vehicle.hpp"
+#include "miner/traj/polynomial_trajectory.hpp"
 
 namespace miner::flight {
 
 inline constexpr const char* kSummaryFormat = "miner-flight-summary-v1";
+
+/// What a closed-loop flight of a given trajectory needs: the vehicle, its sensors, N3,
+/// controller and estimator, where it starts and should end, the seed of every noise
+/// stream, and what counts as touching the world. The simulator knows no map, planner or
+/// network (docs/layout.md): pipeline::Scenario extends this with them.
+struct FlightSetup {
+  std::string name = "scenario";
+  VehicleParams vehicle;
+  Eigen::Vector3d start = Eigen::Vector3d::Zero();
+  Eigen::Vector3d goal = Eigen::Vector3d::Zero();
+  std::uint64_t seed = 1;
+  double hover_after_s = 3.0;  ///< hover after the reference ends, s
+  double goal_tolerance = 0.3;  ///< m
+  ImuParams imu;
+  PoseParams pose;
+  n3::Config n3;
+  ControllerParams controller;
+  EkfParams ekf;  ///< imu and pose are copies of the above
+  /// The companion computer stays silent in [t0, t1) s (the N3's stream-timeout failsafe).
+  std::optional<std::pair<double, double>> command_dropout;
+  /// Whether the vehicle at a position touches an obstacle (counted as a collision); empty:
+  /// nothing to touch.
+  std::function<bool(const Eigen::Vector3d&)> collides;
+};
+
+/// The trajectory a flight follows, and what the flight's summary says of it.
+struct ReferenceTrajectory {
+  traj::PolynomialTrajectory trajectory;
+  Eigen::MatrixX3d path;        ///< the waypoints MINCO went through (after repair)
+  std::string source;           ///< "waypoints", "planner" or "file"
+  double time_scale = 1.0;      ///< durations were stretched by this to meet the limits
+  double max_speed = 0.0, max_acceleration = 0.0;  ///< of the trajectory
+};
 
 struct FlyOptions {
   bool use_ground_truth = false;  ///< diagnostic: the controller reads the true state
@@ -58,7 +99,9 @@ struct FlightResult {
   Json summary;
 };
 
-FlightResult fly(const Scenario& scenario, const ReferencePlan& reference, const FlyOptions& options = {});
+/// Flies `reference` from setup.start in closed loop until it ends plus the hover; the same
+/// setup (seed included) gives the same bytes.
+FlightResult fly(const FlightSetup& setup, const ReferenceTrajectory& reference, const FlyOptions& options = {});
 
 /// The log as CSV with a header row, numbers printed with 9 significant digits (the same
 /// bytes for the same flight).

@@ -16,6 +16,7 @@
 #include <Eigen/Core>
 
 #include "miner/core/json_io.hpp"
+#include "miner/core/units.hpp"
 #include "miner/flight/ekf.hpp"
 #include "miner/flight/n3.hpp"
 #include "miner/flight/vehicle.hpp"
@@ -28,7 +29,7 @@ struct ControllerParams {
   Eigen::Vector3d kv{3.0, 3.0, 5.5};      ///< 1/s
   Eigen::Vector3d ki{0.1, 0.1, 0.1};      ///< 1/s^3
   double integral_limit = 1.0;            ///< m/s^2, the integral term's share of a_cmd
-  double max_tilt_deg = 35.0;
+  double max_tilt_deg = kN3MaxTiltDeg;
 };
 ControllerParams controller_params_from_json(const JsonField& f);
 Json to_json(const ControllerParams& c);

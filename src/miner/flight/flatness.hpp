@@ -13,10 +13,12 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "miner/core/units.hpp"
+
 namespace miner::flight {
 
-inline constexpr double kPi = 3.14159265358979323846;
-inline double deg2rad(double d) { return d * kPi / 180.0; }
+using miner::deg2rad;
+using miner::kPi;
 
 /// Scales the horizontal part of `thrust_vector` (world, z up) so its angle from the
 /// vertical is at most max_tilt (rad); a non-positive z is lifted to keep the direction

@@ -61,7 +61,7 @@ struct Config {
   double timeout_s = 0.1;            ///< command-stream timeout
   Failsafe failsafe = Failsafe::kHover;
   double land_speed = 0.5;           ///< m/s, failsafe kLand descent
-  double max_tilt_deg = 35.0;
+  double max_tilt_deg = kN3MaxTiltDeg;
   double max_yaw_rate_deg = 150.0;
   double max_horizontal_speed = 10.0;  ///< m/s, VELOCITY mode
   double max_vertical_speed = 4.0;     ///< m/s, VELOCITY mode

@@ -6,13 +6,12 @@
 #include <Eigen/LU>
 
 #include "miner/core/error.hpp"
-#include "miner/world/map.hpp"
+#include "miner/core/units.hpp"
 
 namespace miner::flight {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kTiltLimitRad = 35.0 * kPi / 180.0;
+constexpr double kTiltLimitRad = deg2rad(kN3MaxTiltDeg);
 
 [[noreturn]] void bad(const std::string& origin, const std::string& field, const std::string& why) {
   throw Error(origin + ": " + field + ": " + why);
@@ -47,7 +46,7 @@ void validate(const VehicleParams& v, const std::string& origin) {
   positive(v.rotor_speed_max, "rotor_speed_max_rad_s", 1e5);
   positive(v.motor_time_constant_up, "motor_time_constant_up_s", 1.0);
   positive(v.motor_time_constant_down, "motor_time_constant_down_s", 1.0);
-  positive(v.radius, "radius_m", world::kMaxRobotRadius);
+  positive(v.radius, "radius_m", kMaxRobotRadius);
   for (int i = 0; i < 3; ++i) {
     if (!std::isfinite(v.linear_drag[i]) || v.linear_drag[i] < 0.0 || v.linear_drag[i] > 100.0)
       bad(origin, "linear_drag_N_s_per_m", "must be finite and in [0, 100]");
@@ -72,10 +71,7 @@ void validate(const VehicleParams& v, const std::string& origin) {
 
 VehicleParams vehicle_from_json(const Json& doc, const std::string& origin) {
   const JsonField root(doc, "", origin);
-  if (!doc.is_object()) root.fail(std::string("expected a JSON object with \"format\": \"") + kVehicleFormat + "\"");
-  const std::string format = root.at("format").string();
-  if (format != kVehicleFormat)
-    root.at("format").fail("unknown format tag \"" + format + "\", expected \"" + kVehicleFormat + "\"");
+  root.require_format(kVehicleFormat);
   root.only_keys({"format", "name", "mass_kg", "inertia_kg_m2", "arm_length_m", "thrust_coefficient_N_per_rad_s2",
                   "torque_to_thrust_ratio_m", "rotor_speed_min_rad_s", "rotor_speed_max_rad_s",
                   "motor_time_constant_up_s", "motor_time_constant_down_s", "linear_drag_N_s_per_m", "radius_m"});

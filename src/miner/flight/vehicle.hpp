@@ -17,12 +17,13 @@
 #include <Eigen/Core>
 
 #include "miner/core/json_io.hpp"
+#include "miner/core/units.hpp"
 
 namespace miner::flight {
 
 inline constexpr const char* kVehicleFormat = "miner-vehicle-v1";
 /// Standard gravity used by the dynamics, the N3 and the estimator alike (m/s^2).
-inline constexpr double kGravity = 9.81;
+using miner::kGravity;
 
 struct VehicleParams {
   std::string name = "n3-class-1.5kg";

@@ -204,7 +204,7 @@ Sample make_sample(const DatasetOptions& o, std::uint64_t k) {
   const world::VoxelGrid grid(map, r);
   const world::Box& b = map.bounds();
   const double min_distance = o.min_separation * (b.max - b.min).norm();
-  Rng rng(s.map_seed, 0x9e3779b97f4a7c15ULL);  // a stream the generator never uses
+  Rng rng(s.map_seed, streams::kDatasetQuery);
   std::optional<world::GridPath> path;
   for (int attempt = 0; attempt < kMaxQueryAttempts && !path; ++attempt) {
     Eigen::Vector3d p[2];

@@ -17,7 +17,7 @@ namespace miner::heuristic {
 namespace {
 
 /// RNG stream of the generator's noise ("SGAN"), apart from the planners' streams.
-constexpr std::uint64_t kNoiseStream = 0x5347414e;
+constexpr std::uint64_t kNoiseStream = streams::kSganNoise;
 
 template <typename F>
 void for_neighbours(const Eigen::Vector3i& dims, const Eigen::Vector3i& c, F&& f) {

@@ -73,11 +73,7 @@ HeuristicRegion::HeuristicRegion(world::Box bounds, Eigen::Vector3i dims,
 
 HeuristicRegion HeuristicRegion::from_json(const Json& doc, const std::string& origin) {
   const JsonField root(doc, "", origin);
-  if (!doc.is_object()) root.fail(std::string("expected a JSON object with \"format\": \"") + kRegionFormat + "\"");
-  const std::string format = root.at("format").string();
-  if (format != kRegionFormat) {
-    root.at("format").fail("unknown format tag \"" + format + "\", expected \"" + kRegionFormat + "\"");
-  }
+  root.require_format(kRegionFormat);
   root.only_keys({"format", "bounds", "dims", "threshold", "source", "probabilities"});  // issue 20: no ignored key
   const JsonField jb = root.at("bounds");
   jb.only_keys({"min", "max"});

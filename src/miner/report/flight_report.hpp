@@ -12,13 +12,13 @@
 
 #include "miner/core/json_io.hpp"
 #include "miner/flight/closed_loop.hpp"
-#include "miner/flight/scenario.hpp"
+#include "miner/pipeline/scenario.hpp"
 
 namespace miner::report {
 
 struct FlightReportInput {
-  const flight::Scenario& scenario;
-  const flight::ReferencePlan& reference;
+  const pipeline::Scenario& scenario;
+  const pipeline::ReferencePlan& reference;
   const flight::FlightResult& flight;
   /// Wall-clock time of each stage in order (ms): region, plan, trajectory, flight.
   std::vector<std::pair<std::string, double>> stage_ms;

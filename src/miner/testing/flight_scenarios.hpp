@@ -4,16 +4,16 @@
 
 #include <memory>
 
-#include "miner/flight/scenario.hpp"
+#include "miner/pipeline/scenario.hpp"
 #include "miner/world/map.hpp"
 
 namespace miner::testing {
 
 /// An empty 20 x 20 x 10 m room with the default vehicle, sensors, N3 and controller;
 /// the reference goes through `points` (first: start, last: goal, at least two).
-inline flight::Scenario open_room_scenario(const Eigen::MatrixX3d& points, double v_max = 1.0,
+inline pipeline::Scenario open_room_scenario(const Eigen::MatrixX3d& points, double v_max = 1.0,
                                            double a_max = 1.0, std::uint64_t seed = 1) {
-  flight::Scenario s;
+  pipeline::Scenario s;
   s.name = "open-room";
   s.origin = "<test scenario>";
   s.map = std::make_shared<const world::Map>(world::Box{{0, 0, 0}, {20, 20, 10}}, 0.5, std::vector<world::Box>{});

@@ -283,4 +283,18 @@ AllocationResult optimise_allocation(const MincoProblem& problem, const Allocati
   return r;
 }
 
+std::pair<double, double> trajectory_extremes(const traj::PolynomialTrajectory& t, double step) {
+  double v = 0.0, a = 0.0;
+  for (int i = 0; i < t.segments(); ++i) {
+    const double T = t.durations()[static_cast<std::size_t>(i)];
+    const int n = std::max(1, static_cast<int>(std::ceil(T / step)));
+    for (int k = 0; k <= n; ++k) {
+      const double tau = T * k / n;
+      v = std::max(v, t.evaluate_segment(i, tau, 1).norm());
+      a = std::max(a, t.evaluate_segment(i, tau, 2).norm());
+    }
+  }
+  return {v, a};
+}
+
 }  // namespace miner::traj

@@ -36,6 +36,9 @@ void scale_time(PolynomialTrajectory& t, double k);
 /// (both ends included), then a golden-section search around the largest sample (to 1e-9 of
 /// the sample step): bounded work whatever the durations.
 std::pair<double, double> sampled_extremes(const PolynomialTrajectory& t, int samples);
+/// Maximum speed and acceleration of a trajectory, sampled every `step` seconds and at every
+/// segment end (the flight envelope's dense check).
+std::pair<double, double> trajectory_extremes(const PolynomialTrajectory& t, double step);
 
 struct AllocationOptions {
   double rho = 1.0;           ///< weight of the total time in F (cost units per second)

@@ -214,11 +214,7 @@ std::optional<std::size_t> Map::query_index(const Box& region, double r2, const 
 
 Map Map::from_json(const Json& doc, const std::string& origin) {
   const JsonField root(doc, "", origin);
-  if (!doc.is_object()) root.fail("expected a JSON object with \"format\": \"miner-map-v1\"");
-  const std::string format = root.at("format").string();
-  if (format != kMapFormat) {
-    root.at("format").fail("unknown format tag \"" + format + "\", expected \"" + kMapFormat + "\"");
-  }
+  root.require_format(kMapFormat);
   root.only_keys({"format", "bounds", "resolution", "obstacles", "query", "voxels"});
   std::optional<VoxelSource> voxels;
   if (root.has("voxels")) {

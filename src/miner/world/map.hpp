@@ -27,6 +27,7 @@
 #include <Eigen/Core>
 
 #include "miner/core/json_io.hpp"
+#include "miner/core/units.hpp"
 #include "miner/world/box.hpp"
 #include "miner/world/voxel_layer.hpp"
 
@@ -47,8 +48,8 @@ inline constexpr double kMaxResolution = 100.0;
 /// 1000 km from the origin: double then keeps metres to ~1e-10 m, and a map of the Earth's
 /// scale still fits; beyond it a local frame is what the user needs.
 inline constexpr double kMaxCoordinate = 1e6;
-/// A vehicle 20 m across; the scan's swept body has the same bound.
-inline constexpr double kMaxRobotRadius = 10.0;
+/// A vehicle 20 m across; the scan's swept body has the same bound (core/units.hpp).
+using miner::kMaxRobotRadius;
 /// Throws miner::Error "<field>: ..." unless `resolution` is finite and in [kMinResolution,
 /// kMaxResolution].
 void check_resolution(double resolution, const std::string& field);

@@ -17,7 +17,7 @@
 
 #include "miner/core/error.hpp"
 #include "miner/flight/closed_loop.hpp"
-#include "miner/flight/scenario.hpp"
+#include "miner/pipeline/scenario.hpp"
 #include "miner/heuristic/region_filter.hpp"
 #include "miner/heuristic/sgan.hpp"
 #include "miner/plan/heuristic_region.hpp"
@@ -211,26 +211,26 @@ PYBIND11_MODULE(_miner, m) {
       "ends; durations given, or from the trapezoidal profile of v_max and a_max. Every answer is checked.");
 
   // ----------------------------------------------------------------------- flight
-  py::class_<miner::flight::Scenario>(m, "Scenario", "A miner-scenario-v1 flight: map, vehicle, query, sensors, controller.")
-      .def_static("load", &miner::flight::load_scenario, py::arg("path"))
-      .def_static("default", &miner::flight::default_scenario, "the built-in indoor-1 scenario")
+  py::class_<miner::pipeline::Scenario>(m, "Scenario", "A miner-scenario-v1 flight: map, vehicle, query, sensors, controller.")
+      .def_static("load", &miner::pipeline::load_scenario, py::arg("path"))
+      .def_static("default", &miner::pipeline::default_scenario, "the built-in indoor-1 scenario")
       .def_static("from_json", [](const std::string& text, const std::string& base_dir) {
-            return miner::flight::scenario_from_json(miner::parse_json(text, "<string>"), "<string>", base_dir);
+            return miner::pipeline::scenario_from_json(miner::parse_json(text, "<string>"), "<string>", base_dir);
           }, py::arg("text"), py::arg("base_dir") = ".")
-      .def_readonly("name", &miner::flight::Scenario::name)
-      .def_readonly("seed", &miner::flight::Scenario::seed)
-      .def_property_readonly("start", [](const miner::flight::Scenario& s) { return V3(s.start); })
-      .def_property_readonly("goal", [](const miner::flight::Scenario& s) { return V3(s.goal); })
-      .def_property_readonly("map", [](const miner::flight::Scenario& s) { return std::make_shared<miner::world::Map>(*s.map); });
-  py::class_<miner::flight::ReferencePlan>(m, "Reference", "The trajectory a flight follows and where it came from.")
-      .def_readonly("trajectory", &miner::flight::ReferencePlan::trajectory)
-      .def_readonly("path", &miner::flight::ReferencePlan::path)
-      .def_readonly("source", &miner::flight::ReferencePlan::source)
-      .def_readonly("max_speed", &miner::flight::ReferencePlan::max_speed)
-      .def_readonly("max_acceleration", &miner::flight::ReferencePlan::max_acceleration);
-  m.def("build_reference", [](const miner::flight::Scenario& s) {
+      .def_readonly("name", &miner::pipeline::Scenario::name)
+      .def_readonly("seed", &miner::pipeline::Scenario::seed)
+      .def_property_readonly("start", [](const miner::pipeline::Scenario& s) { return V3(s.start); })
+      .def_property_readonly("goal", [](const miner::pipeline::Scenario& s) { return V3(s.goal); })
+      .def_property_readonly("map", [](const miner::pipeline::Scenario& s) { return std::make_shared<miner::world::Map>(*s.map); });
+  py::class_<miner::pipeline::ReferencePlan>(m, "Reference", "The trajectory a flight follows and where it came from.")
+      .def_readonly("trajectory", &miner::pipeline::ReferencePlan::trajectory)
+      .def_readonly("path", &miner::pipeline::ReferencePlan::path)
+      .def_readonly("source", &miner::pipeline::ReferencePlan::source)
+      .def_readonly("max_speed", &miner::pipeline::ReferencePlan::max_speed)
+      .def_readonly("max_acceleration", &miner::pipeline::ReferencePlan::max_acceleration);
+  m.def("build_reference", [](const miner::pipeline::Scenario& s) {
         py::gil_scoped_release unlocked;
-        return miner::flight::build_reference(s);
+        return miner::pipeline::build_reference(s);
       }, py::arg("scenario"), "Plan (MINER RRT* on the sGAN region unless the scenario says otherwise), repair and smooth.");
   py::class_<miner::flight::FlightResult>(m, "Flight", "A closed-loop flight: truth, estimate, commands per controller tick.")
       .def_readonly("position_mse", &miner::flight::FlightResult::position_mse)
@@ -249,11 +249,11 @@ PYBIND11_MODULE(_miner, m) {
             for (const auto& row : r.log) out = std::copy(row.begin(), row.end(), out);
             return a;
           }, "(ticks, columns) array; names in log_columns");
-  m.def("fly", [](const miner::flight::Scenario& s, const miner::flight::ReferencePlan& reference, bool log) {
+  m.def("fly", [](const miner::pipeline::Scenario& s, const miner::pipeline::ReferencePlan& reference, bool log) {
         miner::flight::FlyOptions o;
         o.record_log = log;
         py::gil_scoped_release unlocked;
-        return miner::flight::fly(s, reference, o);
+        return miner::pipeline::fly(s, reference, o);
       }, py::arg("scenario"), py::arg("reference"), py::arg("log") = true,
       "Flies the reference with the scenario's vehicle, sensors, N3, EKF and controller (same seed, same bytes).");
 }

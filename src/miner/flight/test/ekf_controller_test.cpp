@@ -5,12 +5,14 @@
 #include "miner/core/rng.hpp"
 #include "miner/core/statistics.hpp"
 #include "miner/flight/closed_loop.hpp"
+#include "miner/pipeline/scenario.hpp"
 #include "miner/flight/controller.hpp"
 #include "miner/flight/ekf.hpp"
 #include "miner/flight/flatness.hpp"
 #include "miner/testing/flight_scenarios.hpp"
 
 namespace flight = miner::flight;
+namespace pipeline = miner::pipeline;
 
 TEST_CASE("Chi-square quantiles match tabulated values", "[REQ-CORE-005]") {
   CHECK(miner::chi_square_quantile(0.95, 1) == Approx(3.841458820694124).epsilon(1e-10));
@@ -82,10 +84,10 @@ TEST_CASE("The EKF rejects a pose outlier by its NIS gate", "[REQ-FLIGHT-005]") 
 TEST_CASE("In flight the EKF rejects injected outliers and its biases converge", "[REQ-FLIGHT-005]") {
   Eigen::MatrixX3d points(4, 3);
   points << 5, 5, 3, 10, 7, 4, 12, 12, 3, 6, 12, 5;
-  flight::Scenario s = miner::testing::open_room_scenario(points, 1.0, 1.0, 21);
+  pipeline::Scenario s = miner::testing::open_room_scenario(points, 1.0, 1.0, 21);
   s.pose.outlier_probability = 0.05;
   s.ekf.pose = s.pose;
-  const auto r = flight::fly(s, flight::build_reference(s));
+  const auto r = pipeline::fly(s, pipeline::build_reference(s));
   REQUIRE(r.outliers_injected > 20);
   CHECK(r.outliers_rejected == r.outliers_injected);
   CHECK(r.rejected - r.outliers_rejected <= r.fused / 100 + 3);  // gate at 99.9 %
@@ -139,12 +141,12 @@ TEST_CASE("The controller flies on the EKF estimate, not silently on the truth",
   Eigen::MatrixX3d points(2, 3);
   points << 5, 5, 3, 11, 9, 4;
   auto run = [&](double position_sigma, bool truth) {
-    flight::Scenario s = miner::testing::open_room_scenario(points, 1.0, 1.0, 4);
+    pipeline::Scenario s = miner::testing::open_room_scenario(points, 1.0, 1.0, 4);
     s.pose.position_sigma = position_sigma;
     s.ekf.pose = s.pose;
     flight::FlyOptions o;
     o.use_ground_truth = truth;
-    return flight::fly(s, flight::build_reference(s), o);
+    return pipeline::fly(s, pipeline::build_reference(s), o);
   };
   const auto quiet = run(0.01, false), noisy = run(0.10, false);
   CHECK(noisy.position_rmse > 2.0 * quiet.position_rmse);  // sensor noise shows in tracking

@@ -5,6 +5,7 @@
 #include "miner/core/rng.hpp"
 #include "miner/core/statistics.hpp"
 #include "miner/flight/closed_loop.hpp"
+#include "miner/pipeline/scenario.hpp"
 #include "miner/flight/dynamics.hpp"
 #include "miner/flight/flatness.hpp"
 #include "miner/flight/n3.hpp"
@@ -12,6 +13,7 @@
 #include "miner/testing/flight_scenarios.hpp"
 
 namespace flight = miner::flight;
+namespace pipeline = miner::pipeline;
 namespace n3 = miner::flight::n3;
 using flight::deg2rad;
 
@@ -162,9 +164,9 @@ TEST_CASE("VELOCITY mode flies ground and body frame velocities", "[REQ-FLIGHT-0
 TEST_CASE("A command dropout in flight: failsafe hover, control regained, goal reached", "[REQ-FLIGHT-003]") {
   Eigen::MatrixX3d points(2, 3);
   points << 5, 5, 3, 12, 9, 4;
-  flight::Scenario s = miner::testing::open_room_scenario(points, 1.0, 1.0, 3);
+  pipeline::Scenario s = miner::testing::open_room_scenario(points, 1.0, 1.0, 3);
   s.command_dropout = std::make_pair(3.0, 4.0);
-  const auto r = flight::fly(s, flight::build_reference(s));
+  const auto r = pipeline::fly(s, pipeline::build_reference(s));
   CHECK(r.n3_timeouts == 1);
   CHECK(r.goal_reached);
   double failsafe_time = 0.0;

@@ -10,11 +10,13 @@
 
 #include "miner/core/error.hpp"
 #include "miner/flight/closed_loop.hpp"
+#include "miner/pipeline/scenario.hpp"
 #include "miner/traj/problem_io.hpp"
 #include "miner/testing/flight_scenarios.hpp"
 
 using Catch::Matchers::Contains;
 namespace flight = miner::flight;
+namespace pipeline = miner::pipeline;
 
 namespace {
 const std::string kScenarios = std::string(MINER_SOURCE_DIR) + "/fixtures/scenarios";
@@ -22,7 +24,7 @@ const std::string kScenarios = std::string(MINER_SOURCE_DIR) + "/fixtures/scenar
 miner::Json default_doc() { return miner::read_json_file(kScenarios + "/default.json"); }
 
 void expect_scenario_error(const miner::Json& doc, const std::string& needle) {
-  REQUIRE_THROWS_WITH(flight::build_reference(flight::scenario_from_json(doc, "s.json", kScenarios)), Contains(needle));
+  REQUIRE_THROWS_WITH(pipeline::build_reference(pipeline::scenario_from_json(doc, "s.json", kScenarios)), Contains(needle));
 }
 
 std::string temp_dir() {
@@ -33,14 +35,14 @@ std::string temp_dir() {
 }  // namespace
 
 TEST_CASE("The embedded default scenario is the fixture file and flies to its goal", "[REQ-FLIGHT-007][REQ-FLIGHT-009]") {
-  const flight::Scenario s = flight::default_scenario();
-  const flight::Scenario f = flight::load_scenario(kScenarios + "/default.json");
+  const pipeline::Scenario s = pipeline::default_scenario();
+  const pipeline::Scenario f = pipeline::load_scenario(kScenarios + "/default.json");
   CHECK(s.name == f.name);
   CHECK(s.start == f.start);
   CHECK(s.map->obstacles().size() == f.map->obstacles().size());
-  const auto ref = flight::build_reference(s);
+  const auto ref = pipeline::build_reference(s);
   CHECK(ref.source == "planner");
-  const auto r = flight::fly(s, ref);
+  const auto r = pipeline::fly(s, ref);
   CHECK(r.goal_reached);
   CHECK(r.collisions == 0);
   for (const char* key : {"goal_reached", "collisions", "position_mse", "velocity_mse", "max_position_error"})
@@ -52,12 +54,12 @@ TEST_CASE("Same scenario and seed give the same flight log bytes; another seed d
   Eigen::MatrixX3d points(3, 3);
   points << 5, 5, 3, 8, 7, 4, 11, 6, 3;
   const auto s = miner::testing::open_room_scenario(points, 1.0, 1.0, 9);
-  const auto ref = flight::build_reference(s);
-  const std::string a = flight::flight_log_csv(flight::fly(s, ref));
-  const std::string b = flight::flight_log_csv(flight::fly(s, ref));
+  const auto ref = pipeline::build_reference(s);
+  const std::string a = flight::flight_log_csv(pipeline::fly(s, ref));
+  const std::string b = flight::flight_log_csv(pipeline::fly(s, ref));
   CHECK(a == b);
   const auto other = miner::testing::open_room_scenario(points, 1.0, 1.0, 10);
-  CHECK(flight::flight_log_csv(flight::fly(other, ref)) != a);
+  CHECK(flight::flight_log_csv(pipeline::fly(other, ref)) != a);
   CHECK(a.substr(0, a.find('\n')).find("true_x") != std::string::npos);
 }
 
@@ -153,11 +155,11 @@ TEST_CASE("Bad scenarios are refused before flight with the fault named", "[REQ-
 TEST_CASE("A scenario's trajectory.allocation optimise gives a lower J + rho T within the limits", "[REQ-TRAJ-011][REQ-FLIGHT-007]") {
   miner::Json doc = default_doc();
   doc["planner"]["region"] = "astar";  // the path does not depend on the network
-  const auto trapezoid = flight::build_reference(flight::scenario_from_json(doc, "s.json", kScenarios));
+  const auto trapezoid = pipeline::build_reference(pipeline::scenario_from_json(doc, "s.json", kScenarios));
   doc["trajectory"]["allocation"] = "optimise";
   doc["trajectory"]["rho"] = 2.0;
-  const auto s = flight::scenario_from_json(doc, "s.json", kScenarios);
-  const auto optimised = flight::build_reference(s);
+  const auto s = pipeline::scenario_from_json(doc, "s.json", kScenarios);
+  const auto optimised = pipeline::build_reference(s);
   REQUIRE(optimised.allocation);
   CHECK(optimised.allocation->objective <= optimised.allocation->start_objective);
   const double F_trapezoid = trapezoid.trajectory.cost() + 2.0 * trapezoid.trajectory.total_duration();
@@ -179,7 +181,7 @@ TEST_CASE("A trajectory file that exceeds the limits or misses the start is refu
   Eigen::MatrixX3d points(2, 3);
   points << 5, 5, 3, 12, 9, 4;
   auto s = miner::testing::open_room_scenario(points, 2.0, 2.0);
-  const auto fast = flight::build_reference(s).trajectory;
+  const auto fast = pipeline::build_reference(s).trajectory;
   const std::string path = temp_dir() + "/fast.json";
   miner::write_file_atomic(path, miner::dump_json(miner::traj::answer_to_json(fast)));
   miner::Json doc = default_doc();
@@ -190,7 +192,7 @@ TEST_CASE("A trajectory file that exceeds the limits or misses the start is refu
   doc["trajectory"] = {{"file", path}, {"v_max", 0.5}, {"a_max", 0.5}};
   expect_scenario_error(doc, "exceed the limits");
   doc["trajectory"] = {{"file", path}, {"v_max", 2.0}, {"a_max", 2.0}};
-  CHECK(flight::build_reference(flight::scenario_from_json(doc, "s.json", kScenarios)).source == "file");
+  CHECK(pipeline::build_reference(pipeline::scenario_from_json(doc, "s.json", kScenarios)).source == "file");
   doc["start"] = {5, 6, 3};
   expect_scenario_error(doc, "must start at start");
 }

@@ -4,12 +4,14 @@
 
 #include "miner/core/error.hpp"
 #include "miner/flight/closed_loop.hpp"
+#include "miner/pipeline/scenario.hpp"
 #include "miner/flight/dynamics.hpp"
 #include "miner/flight/vehicle.hpp"
 #include "miner/testing/flight_scenarios.hpp"
 
 using Catch::Matchers::Contains;
 namespace flight = miner::flight;
+namespace pipeline = miner::pipeline;
 
 namespace {
 std::string fixture(const std::string& rel) { return std::string(MINER_SOURCE_DIR) + "/fixtures/" + rel; }
@@ -113,13 +115,13 @@ TEST_CASE("A torque-free spin conserves angular momentum and energy and keeps q 
 TEST_CASE("The flight does not depend on the integrator's internal step: rtol 1e-6 and 1e-9 agree", "[REQ-FLIGHT-002]") {
   Eigen::MatrixX3d points(3, 3);
   points << 5, 5, 3, 9, 6, 4, 12, 10, 3;
-  const flight::Scenario s = miner::testing::open_room_scenario(points, 1.5, 1.5, 7);
-  const flight::ReferencePlan ref = flight::build_reference(s);
+  const pipeline::Scenario s = miner::testing::open_room_scenario(points, 1.5, 1.5, 7);
+  const pipeline::ReferencePlan ref = pipeline::build_reference(s);
   flight::FlyOptions coarse, fine;
   coarse.integrator.relative_tolerance = 1e-6;
   fine.integrator.relative_tolerance = 1e-9;
-  const auto a = flight::fly(s, ref, coarse);
-  const auto b = flight::fly(s, ref, fine);
+  const auto a = pipeline::fly(s, ref, coarse);
+  const auto b = pipeline::fly(s, ref, fine);
   REQUIRE(a.log.size() == b.log.size());
   // Columns 7-9 are the true position: the stated bound is 1e-4 m over the whole flight
   // (CVODE's local error control at 1e-6 gives ~1e-6 per tick; the closed loop damps it).

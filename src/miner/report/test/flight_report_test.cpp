@@ -12,14 +12,14 @@ namespace {
 
 /// One short flight of the default scenario with the A* region (fast under sanitizers).
 struct Fixture {
-  flight::Scenario scenario = [] {
-    auto s = flight::default_scenario();
+  pipeline::Scenario scenario = [] {
+    auto s = pipeline::default_scenario();
     s.region = "astar";
     s.planner_iterations = 800;
     return s;
   }();
-  flight::ReferencePlan reference = flight::build_reference(scenario);
-  flight::FlightResult result = flight::fly(scenario, reference);
+  pipeline::ReferencePlan reference = pipeline::build_reference(scenario);
+  flight::FlightResult result = pipeline::fly(scenario, reference);
 };
 
 const Fixture& fixture() {

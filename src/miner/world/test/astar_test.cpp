@@ -49,7 +49,7 @@ TEST_CASE("Start and goal in one cell: the straight segment; start == goal costs
 }
 
 TEST_CASE("A* goes through the only door of a wall and its path is collision-free", "[REQ-WORLD-007][REQ-WORLD-008]") {
-  const Map map = miner::world::test::wall_with_door_map();
+  const Map map = miner::world::test::narrow_door_map();
   const VoxelGrid grid(map, 0.0);
   const auto path = astar(map, grid, V(1, 1, 0.5), V(9, 1, 0.5));
   bool through_door = false;

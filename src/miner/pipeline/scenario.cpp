@@ -1,4 +1,4 @@
-#include "miner/flight/scenario.hpp"
+#include "miner/pipeline/scenario.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -16,7 +16,10 @@
 #include "miner/traj/problem_io.hpp"
 #include "miner/traj/time_allocation.hpp"
 
-namespace miner::flight {
+namespace miner::pipeline {
+
+// The flight setup's parameter readers (vehicle, sensors, N3, controller) are the simulator's.
+using namespace flight;
 
 namespace {
 
@@ -40,10 +43,7 @@ int ticks_per(const JsonField& where, double loop_rate, double rate, const char*
 
 Scenario scenario_from_json(const Json& doc, const std::string& origin, const std::string& base_dir) {
   const JsonField root(doc, "", origin);
-  if (!doc.is_object()) root.fail(std::string("expected a JSON object with \"format\": \"") + kScenarioFormat + "\"");
-  const std::string format = root.at("format").string();
-  if (format != kScenarioFormat)
-    root.at("format").fail("unknown format tag \"" + format + "\", expected \"" + kScenarioFormat + "\"");
+  root.require_format(kScenarioFormat);
   root.only_keys({"format", "name", "map", "vehicle", "start", "goal", "waypoints", "trajectory", "planner", "seed",
                   "hover_after_s", "goal_tolerance_m", "planning_margin_m", "imu", "pose", "n3", "controller", "ekf",
                   "command_dropout_s"});
@@ -279,19 +279,6 @@ Scenario load_scenario(const std::string& path) {
   return scenario_from_json(read_json_file(path), path, std::filesystem::path(path).parent_path().string());
 }
 
-std::pair<double, double> trajectory_extremes(const traj::PolynomialTrajectory& t, double step) {
-  double v = 0.0, a = 0.0;
-  for (int i = 0; i < t.segments(); ++i) {
-    const double T = t.durations()[static_cast<std::size_t>(i)];
-    const int n = std::max(1, static_cast<int>(std::ceil(T / step)));
-    for (int k = 0; k <= n; ++k) {
-      const double tau = T * k / n;
-      v = std::max(v, t.evaluate_segment(i, tau, 1).norm());
-      a = std::max(a, t.evaluate_segment(i, tau, 2).norm());
-    }
-  }
-  return {v, a};
-}
 
 namespace {
 
@@ -349,7 +336,7 @@ ReferencePlan build_reference(const Scenario& s) {
     for (int i = 0; i < m; ++i) r.path.row(i) = r.trajectory.evaluate_segment(i, 0.0).transpose();
     r.path.row(m) = r.trajectory.evaluate(r.trajectory.total_duration()).transpose();
     require_flight_length(s, r.trajectory);
-    const auto [v, a] = trajectory_extremes(r.trajectory, kLimitSampleStep);
+    const auto [v, a] = traj::trajectory_extremes(r.trajectory, kLimitSampleStep);
     if (v > s.limits.v_max * (1 + kLimitSlack) || a > s.limits.a_max * (1 + kLimitSlack))
       throw Error(s.origin + ": trajectory file: maximum speed " + std::to_string(v) + " m/s and acceleration " +
                   std::to_string(a) + " m/s^2 exceed the limits v_max " + std::to_string(s.limits.v_max) +
@@ -410,7 +397,7 @@ ReferencePlan build_reference(const Scenario& s) {
     r.trajectory = std::move(repaired.trajectory);
     r.path = std::move(repaired.waypoints);
     require_flight_length(s, r.trajectory);
-    const auto [v, a] = trajectory_extremes(r.trajectory, kLimitSampleStep);
+    const auto [v, a] = traj::trajectory_extremes(r.trajectory, kLimitSampleStep);
     const double k = std::max({1.0, v / s.limits.v_max, std::sqrt(a / s.limits.a_max)});
     if (k > 1.0 + kLimitSlack) {
       r.time_scale = k * (1.0 + kLimitSlack);
@@ -429,10 +416,18 @@ ReferencePlan build_reference(const Scenario& s) {
     if (r.trajectory.evaluate(0.0, k).norm() > kEndpointTolerance || r.trajectory.evaluate(T, k).norm() > kEndpointTolerance)
       throw Error(s.origin + ": the reference trajectory must start and end at rest (the vehicle starts hovering)");
   check_envelope(s, r.trajectory);
-  const auto [v, a] = trajectory_extremes(r.trajectory, kLimitSampleStep);
+  const auto [v, a] = traj::trajectory_extremes(r.trajectory, kLimitSampleStep);
   r.max_speed = v;
   r.max_acceleration = a;
   return r;
 }
 
-}  // namespace miner::flight
+flight::FlightResult fly(const Scenario& scenario, const ReferencePlan& reference, const flight::FlyOptions& options) {
+  flight::FlightSetup setup = scenario;
+  const std::shared_ptr<const world::Map> map = scenario.map;
+  const double radius = scenario.vehicle.radius;
+  setup.collides = [map, radius](const Eigen::Vector3d& p) { return !map->is_free(p, radius); };
+  return flight::fly(setup, reference, options);
+}
+
+}  // namespace miner::pipeline

@@ -27,18 +27,14 @@
 #include <Eigen/Core>
 
 #include "miner/core/json_io.hpp"
-#include "miner/flight/controller.hpp"
-#include "miner/flight/ekf.hpp"
-#include "miner/flight/n3.hpp"
-#include "miner/flight/sensors.hpp"
-#include "miner/flight/vehicle.hpp"
+#include "miner/flight/closed_loop.hpp"
 #include "miner/plan/heuristic_region.hpp"
 #include "miner/traj/polynomial_trajectory.hpp"
 #include "miner/traj/time_allocation.hpp"
 #include "miner/traj/trapezoidal_allocation.hpp"
 #include "miner/world/map.hpp"
 
-namespace miner::flight {
+namespace miner::pipeline {
 
 inline constexpr const char* kScenarioFormat = "miner-scenario-v1";
 /// Longest simulated flight (reference + hover, s): bounds the work and the log of one
@@ -60,13 +56,12 @@ inline constexpr double kMaxPlanningMargin = 10.0;  ///< m
 /// The planner's iteration budget (the CLI's --iterations bound: a tree of ~1 GB).
 inline constexpr long long kMaxPlannerIterations = 10000000;
 
-struct Scenario {
-  std::string name = "scenario";
+/// A whole run as the paper's system does it: the world, how the reference is found (given
+/// waypoints, a trajectory file, or MINER RRT* on the sGAN's region), its limits, and the
+/// flight setup (vehicle, sensors, N3, controller, EKF, seed) the simulator flies it with.
+struct Scenario : flight::FlightSetup {
   std::string origin;                       ///< where it was read from (messages)
   std::shared_ptr<const world::Map> map;  ///< never null after loading
-  VehicleParams vehicle;
-  Eigen::Vector3d start = Eigen::Vector3d::Zero();
-  Eigen::Vector3d goal = Eigen::Vector3d::Zero();
   std::optional<Eigen::MatrixX3d> waypoints;  ///< interior waypoints, one per row
   int order = 4;                            ///< s: 3 jerk, 4 snap
   traj::Limits limits{0.8, 0.5};
@@ -74,18 +69,9 @@ struct Scenario {
   std::string allocation = "trapezoid";
   double rho = 1.0;
   std::optional<traj::PolynomialTrajectory> trajectory_file;
-  std::uint64_t seed = 1;
-  double hover_after_s = 3.0;               ///< <= kMaxFlightSeconds
-  double goal_tolerance = 0.3;              ///< m
   /// Added to the vehicle radius when planning and repairing the reference (m): room for
   /// the tracking error (REQ-FLIGHT-008's noise floor is 0.10 m).
   double planning_margin = 0.1;
-  ImuParams imu;
-  PoseParams pose;
-  n3::Config n3;
-  ControllerParams controller;
-  EkfParams ekf;                            ///< imu and pose are copied from the above
-  std::optional<std::pair<double, double>> command_dropout;
   /// How the path is found when the scenario gives neither waypoints nor a trajectory
   /// file: MINER RRT* (Alg. 1) sampling the sGAN's filtered region ("sgan", the paper's
   /// system) or the A*-dilated oracle region ("astar").
@@ -122,14 +108,9 @@ Json default_scenario_document();
 /// the rest is left to the feedback loop.
 inline constexpr double kEnvelopeMargin = 0.8;
 
-/// The reference the vehicle flies and where it came from.
-struct ReferencePlan {
-  traj::PolynomialTrajectory trajectory;
-  Eigen::MatrixX3d path;        ///< the waypoints MINCO went through (after repair)
-  std::string source;           ///< "waypoints", "planner" or "file"
-  double time_scale = 1.0;      ///< durations were stretched by this to meet the limits
+/// The reference the vehicle flies, where it came from and what each stage did.
+struct ReferencePlan : flight::ReferenceTrajectory {
   std::optional<traj::AllocationResult> allocation;  ///< with "allocation": "optimise"
-  double max_speed = 0.0, max_acceleration = 0.0;  ///< of the final trajectory
   std::size_t planner_iterations = 0;
   /// With source "planner": the heuristic region the planner sampled, its final tree
   /// (vertices, parent indices, -1 for the root) and the path it returned (before repair).
@@ -148,8 +129,8 @@ struct ReferencePlan {
 /// tilt or thrust than the vehicle's envelope allows.
 ReferencePlan build_reference(const Scenario& s);
 
-/// Maximum speed and acceleration of a trajectory, sampled every `step` seconds and at
-/// every segment end.
-std::pair<double, double> trajectory_extremes(const traj::PolynomialTrajectory& t, double step);
+/// Flies the reference with the scenario's flight setup, a collision being the vehicle's
+/// radius touching the scenario's map (flight::fly with FlightSetup::collides from the map).
+flight::FlightResult fly(const Scenario& scenario, const ReferencePlan& reference, const flight::FlyOptions& options = {});
 
-}  // namespace miner::flight
+}  // namespace miner::pipeline

@@ -17,7 +17,6 @@ PACKAGES=(
   libsundials-dev      # CVODE integrates the quadrotor rigid body
   # world model and I/O
   liboctomap-dev       # OctoMap: scan integration (miner map scan), oracle for the .bt/.ot reader tests
-  libnanoflann-dev     # k-d tree for planners' nearest-neighbour queries
   nlohmann-json3-dev   # map / scenario / result JSON
   libcli11-dev         # the `miner` command line
   # benchmark peers

@@ -100,7 +100,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   fc->add_option("--target-factor", f->bench.target_factor, "target cost = this x the A* reference cost")
       ->check(finite_in(0.01, 100.0))
       ->capture_default_str();
-  fc->add_option("--max-iterations", f->bench.max_iterations, "iteration budget per run")
+  fc->add_option("--iterations,--max-iterations", f->bench.max_iterations, "iteration budget per run (as plan --iterations)")
       ->check(kIterationsRange)
       ->capture_default_str();
   fc->add_option("--time-limit", f->bench.time_limit_s, "wall-clock cap per run in s")
@@ -114,7 +114,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
                "miner, miner-sgan: the paper's fixed mu, without the safeguard (REQ-PLAN-020)");
   fc->add_option("--region", f->bench.region_file, "miner's region file (default: the A*-dilated region)");
   fc->add_option("--weights", f->bench.weights_file, "miner-sgan's weights (default: the shipped fixtures/sgan/sgan.bin)");
-  fc->add_option("--region-dims", f->region_dims, "A*-dilated region grid")->expected(3)->check(integer_in(1, 4096));
+  fc->add_option("--dims,--region-dims", f->region_dims, "A*-dilated region grid nx ny nz (as plan --dims)")->expected(3)->check(integer_in(1, 4096));
   fc->add_option("--throughput-iterations", f->bench.throughput_iterations,
                  "iterations of the rrtstar vs ompl:RRTstar throughput check (0: skip)")
       ->capture_default_str()

@@ -303,6 +303,10 @@ void add_commands(CLI::App& app, std::ostream& out) {
   add_plan_commands(app, out);
   add_fly_commands(app, out);
   add_heuristic_commands(app, out);
+  // Hidden: the generated option reference (docs/cli-reference.md).
+  app.add_subcommand("docs", "print the generated option reference (docs/cli-reference.md)")
+      ->group("")
+      ->callback([&out] { out << cli_reference_markdown(); });
   decimal_integers(&app);
 }
 
@@ -361,6 +365,43 @@ std::string unknown_option(CLI::App* cmd, const std::string& path, const std::ve
 }
 
 }  // namespace
+
+std::string cli_reference_markdown() {
+  std::ostringstream sink;
+  CLI::App app{"miner", "miner"};
+  add_commands(app, sink);
+  const auto escape = [](std::string text) {
+    std::string out;
+    for (char c : text) out += c == '|' ? std::string("\\|") : std::string(1, c);
+    return out;
+  };
+  std::ostringstream md;
+  md << "# `miner` options, generated\n\n"
+     << "Generated from the command line's own definitions by `miner docs` (do not edit: the ctest\n"
+     << "`cli reference is current` fails when this file and the program disagree). Every number's\n"
+     << "range is enforced (REQ-CLI-002); prose, examples and file formats: [cli.md](cli.md).\n";
+  for (CLI::App* cmd : command_tree(&app)) {
+    if (cmd == &app || !cmd->get_subcommands([](CLI::App*) { return true; }).empty() || cmd->get_group().empty()) continue;
+    std::string path = cmd->get_name();
+    for (const CLI::App* p = cmd->get_parent(); p != nullptr && p->get_parent() != nullptr; p = p->get_parent())
+      path = p->get_name() + " " + path;
+    md << "\n## miner " << path << "\n\n" << cmd->get_description() << "\n\n"
+       << "| option | value | default | meaning |\n|---|---|---|---|\n";
+    for (const CLI::Option* o : cmd->get_options()) {
+      if (o->get_name() == "--help") continue;
+      std::string names;
+      for (const std::string& n : o->get_lnames()) names += (names.empty() ? "" : ", ") + ("`--" + n + "`");
+      if (names.empty()) names = "`" + o->get_name() + "`";
+      const std::string type = o->get_type_name();
+      std::string value = type.empty() ? "flag" : type;
+      if (o->get_expected_max() > 1 && o->get_expected_max() < 100) value += " x " + std::to_string(o->get_expected_max());
+      else if (o->get_expected_max() >= 100) value += " ...";
+      md << "| " << names << (o->get_required() ? " (required)" : "") << " | " << escape(value) << " | "
+         << escape(o->get_default_str()) << " | " << escape(o->get_description()) << " |\n";
+    }
+  }
+  return md.str();
+}
 
 std::vector<std::string> numeric_options_without_checks() {
   std::ostringstream sink;

@@ -29,6 +29,11 @@ int run_cli(const std::vector<std::string>& args, std::ostream& out, std::ostrea
 /// fuzz target src/fuzz/fuzz_cli.cpp drives it (REQ-HARNESS-006); never throws, never writes.
 int check_cli_arguments(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 
+/// The option reference of every command, as Markdown, from the commands' own definitions
+/// (names, value type and range, default, meaning): docs/cli-reference.md is this text, and
+/// a test fails when they differ (issue 22: docs/cli.md had drifted). `miner docs` prints it.
+std::string cli_reference_markdown();
+
 /// Every numeric option of every command that has no check of its value besides the decimal
 /// form ("plan --goal-bias"): each must declare its range (issue 20: unbounded or silently
 /// altered values). The CLI test asserts the list is empty (REQ-CLI-002).

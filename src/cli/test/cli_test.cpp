@@ -326,6 +326,19 @@ TEST_CASE("Every numeric option of every command declares its range", "[REQ-CLI-
   }
 }
 
+TEST_CASE("cli reference is current: docs/cli-reference.md is what the commands define", "[REQ-CLI-001]") {
+  // Regenerate with: build/release/miner docs > docs/cli-reference.md
+  const std::string generated = miner::cli::cli_reference_markdown();
+  CHECK(read(std::string(MINER_SOURCE_DIR) + "/docs/cli-reference.md") == generated);
+  const Run printed = miner_cli({"docs"});
+  CHECK(printed.code == 0);
+  CHECK(printed.out == generated);
+  // Every command and every option appears, with its range.
+  CHECK_THAT(generated, Contains("## miner plan") && Contains("`--goal-bias`") && Contains("[0, 0.999999]"));
+  CHECK_THAT(generated, Contains("## miner map scan") && Contains("## miner bench frontend") && Contains("## miner fly"));
+  CHECK_THAT(generated, !Contains("## miner docs"));
+}
+
 TEST_CASE("Unknown options are named with the nearest one; duplicates, exclusive and misplaced options are refused",
           "[REQ-CLI-002]") {
   const std::string map = write("pillar-unknown.json", kPillarMap);

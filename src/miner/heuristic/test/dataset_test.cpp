@@ -86,6 +86,16 @@ TEST_CASE("A cell covered only by the union of two boxes is covered; a gap of an
   CHECK_FALSE(heuristic::box_covered(cell, {Box{{-1, -1, -1}, {0.4, 2, 2}}, Box{{0.41, -1, -1}, {2, 2, 2}}}));
   CHECK_FALSE(heuristic::box_covered(cell, {Box{{-1, -1, -1}, {2, 2, 0.999}}}));
   CHECK_FALSE(heuristic::box_covered(cell, {}));
+  // Through the encoder, whose volume bound skips the cut when the boxes cannot fill a cell
+  // (issue 16): two halves fill cell (0, 0, 0); with a gap, or too little volume, they do not.
+  const auto encode = [](std::vector<Box> boxes) {
+    const miner::world::Map map(Box{{0, 0, 0}, {4, 4, 4}}, 0.5, std::move(boxes));
+    return heuristic::encode_environment(map, Eigen::Vector3i(4, 4, 4), 0.0)[0];
+  };
+  CHECK(encode({Box{{0, 0, 0}, {0.4, 1, 1}}, Box{{0.4, 0, 0}, {1, 1, 1}}}) == heuristic::kSolid);
+  CHECK(encode({Box{{0, 0, 0}, {0.4, 1, 1}}, Box{{0.41, 0, 0}, {1, 1, 1}}}) == heuristic::kPartial);
+  CHECK(encode({Box{{0, 0, 0}, {0.4, 1, 1}}, Box{{0.4, 0, 0}, {1, 1, 0.5}}, Box{{0.4, 0, 0.5}, {1, 1, 1}}}) ==
+        heuristic::kSolid);
 }
 
 TEST_CASE("Regions connect through faces, edges and corners only", "[REQ-HEUR-004]") {

@@ -39,7 +39,7 @@ fi
 # extension needs its sanitizer runtime preloaded.
 if [ -e "$prefix/lib/python3/dist-packages/miner/__init__.py" ]; then
   preload=""
-  case "$extra" in *-fsanitize=address*) preload=$(g++ -print-file-name=libasan.so) ;; esac
+  case "$extra" in *-fsanitize=address*) preload="$(g++ -print-file-name=libasan.so) $(g++ -print-file-name=libstdc++.so)" ;; esac
   (cd "$work" && LD_PRELOAD="$preload" ASAN_OPTIONS=detect_leaks=0 PYTHONPATH="$prefix/lib/python3/dist-packages" \
      /usr/bin/python3 -c "
 import miner

@@ -40,7 +40,7 @@ flags=(-std=c++17 -O1 -g -fno-omit-frame-pointer -Isrc -isystem /usr/include/eig
 lib_san=(-fsanitize=fuzzer-no-link,address,undefined)
 # The library code the parsers live in (the linker takes from the archive only what a target uses).
 sources=(src/miner/core/*.cpp src/miner/world/*.cpp src/miner/traj/*.cpp src/miner/plan/*.cpp
-         src/miner/flight/*.cpp src/miner/heuristic/*.cpp src/miner/report/*.cpp src/bench/*.cpp
+         src/miner/flight/*.cpp src/miner/pipeline/*.cpp src/miner/heuristic/*.cpp src/miner/report/*.cpp src/bench/*.cpp
          src/cli/cli.cpp src/cli/*_commands.cpp)
 # Objects, rebuilt when their source or any header is newer, two at a time; all of them when the
 # compiler or the flags change.

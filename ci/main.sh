@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # ci/main.sh — the README's first command: set up, build (Release) and run the main
-# job. Today the main job generates a seeded cluttered map, plans on it with A* and
-# with MINER-RRT* (A*-dilated heuristic region until the sGAN lands), then flies the
-# default scenario in closed loop (`miner fly`). Results go to run/quickstart/.
+# job: it generates a seeded 100 m cluttered map, plans on it with A* and with MINER-RRT*
+# on the shipped sGAN's filtered region, then flies the default scenario in closed loop
+# (`miner fly`). Results go to run/quickstart/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 

@@ -152,7 +152,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   hc->add_flag("!--no-planners", h->bench.planners, "quality only: do not run MINER and RRT*");
   add_output_options(hc, h->output);
   hc->callback([h, &out] {
-    const bench::HeuristicBenchResult r = bench::run_heuristic_bench(h->bench, terminal_stream());
+    const bench::HeuristicBenchResult r = bench::run_heuristic_bench(h->bench, progress_stream());
     emit(h->output, bench::to_json(r), bench::to_text(r), out);
   });
 

@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "miner/core/error.hpp"
+#include "miner/core/progress.hpp"
 #include "miner/core/shard.hpp"
 
 namespace miner::cli {
@@ -293,6 +294,20 @@ void check_outputs_against_inputs(CLI::App* app) {
 
 enum class Mode { kRun, kParseOnly };
 
+/// --quiet of the command line being run (run_cli resets it).
+thread_local bool g_quiet = false;
+
+/// Every command takes --quiet (no progress on stderr) and, where its result is a summary, --json.
+void quiet_everywhere(CLI::App* app) {
+  for (CLI::App* sub : app->get_subcommands([](CLI::App*) { return true; })) {
+    if (sub->get_subcommands([](CLI::App*) { return true; }).empty()) {
+      if (sub->get_option_no_throw("--quiet") == nullptr) sub->add_flag("--quiet", g_quiet, "no progress on stderr");
+    } else {
+      quiet_everywhere(sub);
+    }
+  }
+}
+
 /// Every command of `miner` registered on `app` (their callbacks write to `out`).
 void add_commands(CLI::App& app, std::ostream& out) {
   app.require_subcommand(1);
@@ -307,6 +322,7 @@ void add_commands(CLI::App& app, std::ostream& out) {
   app.add_subcommand("docs", "print the generated option reference (docs/cli-reference.md)")
       ->group("")
       ->callback([&out] { out << cli_reference_markdown(); });
+  quiet_everywhere(&app);
   decimal_integers(&app);
 }
 
@@ -438,6 +454,7 @@ std::vector<std::string> numeric_options_without_checks() {
 namespace {
 
 int cli_main(const std::vector<std::string>& args, std::ostream& out, std::ostream& err, Mode mode) {
+  g_quiet = false;
   CLI::App app{"miner — MINER-RRT* quadrotor planning and flight stack", "miner"};
   add_commands(app, out);
   app.parse_complete_callback([&app, mode] {
@@ -516,6 +533,13 @@ int cli_main(const std::vector<std::string>& args, std::ostream& out, std::ostre
 }
 
 }  // namespace
+
+std::ostream* progress_stream() { return g_quiet ? nullptr : terminal_stream(); }
+
+void report(bool json, const Json& doc, const std::string& human, std::ostream& out) {
+  if (json) out << dump_json(doc);
+  else out << human;
+}
 
 int run_cli(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
   return cli_main(args, out, err, Mode::kRun);

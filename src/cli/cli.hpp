@@ -39,6 +39,13 @@ std::string cli_reference_markdown();
 /// altered values). The CLI test asserts the list is empty (REQ-CLI-002).
 std::vector<std::string> numeric_options_without_checks();
 
+/// The stream progress bars draw to: the terminal (stderr when it is one), or none when the
+/// command line said --quiet (every command takes it; issue 22 item 4).
+std::ostream* progress_stream();
+/// A command whose product is a file: its one-line summary as text, or with --json the same
+/// facts as a JSON document on stdout.
+void report(bool json, const Json& doc, const std::string& human, std::ostream& out);
+
 /// Options shared by commands that produce a result: --json prints it as JSON instead
 /// of the human text, --out also writes the JSON to a file (atomically).
 struct OutputOptions {

@@ -27,6 +27,7 @@ struct DatasetCliOptions {
   std::string out;
   std::string shard;
   std::vector<std::string> merge;
+  bool json = false;
 };
 
 struct HeuristicCliOptions {
@@ -97,6 +98,7 @@ void add_heuristic_commands(CLI::App& app, std::ostream& out) {
       ->check(kShard);
   d->add_option("--merge", o->merge, "join these part folders (made with --shard) into --out instead of generating");
   d->add_option("--out", o->out, "output folder (written as a whole)")->required()->check(kOutputFolder);
+  d->add_flag("--json", o->json, "print the summary as JSON");
   d->callback([o, d, &out] {
     if (!o->merge.empty()) {
       // The parts carry their own options: generation options beside --merge would be ignored.
@@ -105,6 +107,11 @@ void add_heuristic_commands(CLI::App& app, std::ostream& out) {
         if (d->get_option(name)->count() > 0)
           throw CLI::ValidationError(name, "does not apply to --merge (the parts carry their own options)");
       const Json doc = heuristic::merge_dataset_parts(o->merge, o->out);
+      if (o->json) {
+        out << dump_json({{"out", o->out}, {"merged_parts", o->merge.size()}, {"train", doc["splits"]["train"]["count"]},
+                          {"val", doc["splits"]["val"]["count"]}, {"test", doc["splits"]["test"]["count"]}});
+        return;
+      }
       out << "merged " << o->merge.size() << " parts into " << o->out << ": " << doc["splits"]["train"]["count"]
           << " train, " << doc["splits"]["val"]["count"] << " val, " << doc["splits"]["test"]["count"] << " test samples\n";
       return;
@@ -112,8 +119,13 @@ void add_heuristic_commands(CLI::App& app, std::ostream& out) {
     heuristic::DatasetOptions options = o->dataset;
     if (!o->shard.empty()) std::tie(options.shard_index, options.shard_count) = parse_shard(o->shard);
     options.dims = Eigen::Vector3i(o->dims[0], o->dims[1], o->dims[2]);
-    const Json doc = heuristic::write_dataset(options, o->out, terminal_stream());
+    const Json doc = heuristic::write_dataset(options, o->out, progress_stream());
     const Json& s = doc["splits"];
+    if (o->json) {
+      out << dump_json({{"out", o->out}, {"train", s["train"]["count"]}, {"val", s["val"]["count"]},
+                        {"test", s["test"]["count"]}, {"dims", o->dims}});
+      return;
+    }
     out << "wrote " << o->out << ": " << s["train"]["count"] << " train, " << s["val"]["count"] << " val, "
         << s["test"]["count"] << " test samples of 3 x " << o->dims[0] << "x" << o->dims[1] << "x" << o->dims[2]
         << " (dataset.json describes the layout)\n";

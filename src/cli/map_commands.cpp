@@ -36,6 +36,7 @@ struct GenOptions {
   double resolution = std::numeric_limits<double>::quiet_NaN();  // NaN: not given (0 is refused, not ignored)
   std::string base;
   std::string out;
+  bool json = false;
 };
 
 void run_gen(const GenOptions& o, std::ostream& out) {
@@ -51,6 +52,16 @@ void run_gen(const GenOptions& o, std::ostream& out) {
     const world::VoxelLayer& layer = scan.map.voxels()->layer();
     const Eigen::Vector3d e = scan.map.bounds().extent();
     const world::ScanOptions& s = scan.sensor;
+    if (o.json) {
+      out << dump_json({{"out", o.out}, {"preset", "scan"}, {"seed", o.seed}, {"base", scan.base},
+                        {"extent_m", vec3_json(e)}, {"resolution_m", scan.map.resolution()},
+                        {"sensor", {{"h_fov_deg", s.h_fov_deg}, {"v_fov_deg", s.v_fov_deg}, {"range_m", s.range},
+                                    {"noise_m", s.noise}, {"dropout", s.dropout}}},
+                        {"voxels", {{"free", layer.count(world::VoxelState::kFree)},
+                                    {"occupied", layer.count(world::VoxelState::kOccupied)},
+                                    {"unknown", layer.count(world::VoxelState::kUnknown)}}}});
+      return;
+    }
     out << "wrote " << o.out << ": preset scan, seed " << o.seed << ", a mapping run over a " << scan.base << " map ("
         << (s.h_fov_deg >= 360.0 ? "lidar" : "depth camera") << ", " << s.h_fov_deg << " x " << s.v_fov_deg
         << " deg, range " << s.range << " m, noise " << s.noise << " m, dropout " << s.dropout << "): " << e.x()
@@ -62,6 +73,11 @@ void run_gen(const GenOptions& o, std::ostream& out) {
   const Map map = world::generate_map(preset, o.seed, overrides);
   map.save(o.out);
   const Eigen::Vector3d e = map.bounds().extent();
+  if (o.json) {
+    out << dump_json({{"out", o.out}, {"preset", o.preset}, {"seed", o.seed}, {"extent_m", vec3_json(e)},
+                      {"resolution_m", map.resolution()}, {"obstacles", map.obstacles().size()}});
+    return;
+  }
   out << "wrote " << o.out << ": preset " << o.preset << ", seed " << o.seed << ", " << e.x() << " x " << e.y()
       << " x " << e.z() << " m at " << map.resolution() << " m, " << map.obstacles().size() << " obstacles\n";
 }
@@ -144,14 +160,19 @@ void run_info(const InfoOptions& o, std::ostream& out) {
 
 struct ConvertOptions {
   std::string in, out;
+  bool json = false;
 };
 
 void run_convert(const ConvertOptions& o, std::ostream& out) {
   const Map map = Map::load(o.in);
   map.save(o.out);
-  out << "wrote " << o.out << " (" << map.obstacles().size() << " obstacles";
-  if (map.voxels()) out << ", " << map.voxels()->layer().count(world::VoxelState::kOccupied) << " occupied voxels";
-  out << " from " << o.in << ")\n";
+  std::ostringstream human;
+  human << "wrote " << o.out << " (" << map.obstacles().size() << " obstacles";
+  if (map.voxels()) human << ", " << map.voxels()->layer().count(world::VoxelState::kOccupied) << " occupied voxels";
+  human << " from " << o.in << ")\n";
+  Json doc{{"in", o.in}, {"out", o.out}, {"obstacles", map.obstacles().size()}};
+  if (map.voxels()) doc["occupied_voxels"] = map.voxels()->layer().count(world::VoxelState::kOccupied);
+  report(o.json, doc, human.str(), out);
 }
 
 struct AstarOptions {
@@ -199,6 +220,7 @@ struct ScanCliOptions {
   std::vector<double> fov{360.0, 60.0};
   std::vector<int> rays{180, 16};
   std::string out, map_out;
+  bool json = false;
 };
 
 void run_scan(const ScanCliOptions& o, std::ostream& out) {
@@ -230,6 +252,15 @@ void run_scan(const ScanCliOptions& o, std::ostream& out) {
     files.emplace_back(o.map_out, dump_json(doc));
   }
   write_files_atomic(files);
+  if (o.json) {
+    out << dump_json({{"map", o.query.map}, {"out", o.out}, {"map_out", o.map_out.empty() ? Json(nullptr) : Json(o.map_out)},
+                      {"poses", scan.poses}, {"path_m", route.cost}, {"rays", scan.rays}, {"returns", scan.returns},
+                      {"dims", {layer.dims().x(), layer.dims().y(), layer.dims().z()}}, {"resolution_m", layer.resolution()},
+                      {"voxels", {{"free", layer.count(world::VoxelState::kFree)},
+                                  {"occupied", layer.count(world::VoxelState::kOccupied)},
+                                  {"unknown", layer.count(world::VoxelState::kUnknown)}}}});
+    return;
+  }
   out << "scanned " << o.query.map << " along " << scan.poses << " poses (" << route.cost << " m): " << scan.rays
       << " rays, " << scan.returns << " returns\n"
       << "wrote " << o.out << ": " << layer.dims().x() << " x " << layer.dims().y() << " x " << layer.dims().z()
@@ -245,6 +276,7 @@ struct ImportOptions {
   double resolution = 0.05;
   double range = 0.0;
   std::string out;
+  bool json = false;
 };
 
 void run_import(const ImportOptions& o, std::ostream& out) {
@@ -266,6 +298,14 @@ void run_import(const ImportOptions& o, std::ostream& out) {
   }
   const auto layer = world::integrate_clouds(scans, o.resolution, o.range);
   world::write_octree_bt(*layer, o.out);
+  if (o.json) {
+    out << dump_json({{"clouds", o.clouds}, {"out", o.out}, {"points", points}, {"skipped_non_finite", skipped},
+                      {"dims", {layer->dims().x(), layer->dims().y(), layer->dims().z()}}, {"resolution_m", layer->resolution()},
+                      {"voxels", {{"free", layer->count(world::VoxelState::kFree)},
+                                  {"occupied", layer->count(world::VoxelState::kOccupied)},
+                                  {"unknown", layer->count(world::VoxelState::kUnknown)}}}});
+    return;
+  }
   out << "imported " << points << " points from " << o.clouds.size() << " cloud(s)";
   if (skipped) out << " (" << skipped << " non-finite points skipped)";
   out << "\nwrote " << o.out << ": " << layer->dims().x() << " x " << layer->dims().y() << " x " << layer->dims().z()
@@ -296,6 +336,7 @@ void add_map_commands(CLI::App& app, std::ostream& out) {
   g->add_option("--resolution", gen->resolution, "families: grid resolution in m instead of the drawn one")
       ->check(finite_in(world::kMinResolution, world::kMaxResolution));
   g->add_option("--out", gen->out, "output file (.json, or .bt for OctoMap)")->required()->check(kOutputFile);
+  g->add_flag("--json", gen->json, "print the summary as JSON");
   g->callback([gen, &out] { run_gen(*gen, out); });
 
   auto info = std::make_shared<InfoOptions>();
@@ -312,6 +353,7 @@ void add_map_commands(CLI::App& app, std::ostream& out) {
   CLI::App* c = map->add_subcommand("convert", "convert between miner-map-v1 JSON and OctoMap .bt (a voxel map's JSON references its .bt by path and SHA-256)");
   c->add_option("--in", conv->in, "input map (.json, .bt or .ot)")->required();
   c->add_option("--out", conv->out, "output map (.json or .bt)")->required()->check(kOutputFile);
+  c->add_flag("--json", conv->json, "print the summary as JSON");
   c->callback([conv, &out] { run_convert(*conv, out); });
 
   auto scan = std::make_shared<ScanCliOptions>();
@@ -339,6 +381,7 @@ void add_map_commands(CLI::App& app, std::ostream& out) {
   sc->add_option("--out", scan->out, "the scan as an OctoMap binary tree (.bt)")->required()->check(kOutputFile);
   sc->add_option("--map-out", scan->map_out, "also a map file (.json) referencing the scan, with the query")
       ->check(kOutputFile);
+  sc->add_flag("--json", scan->json, "print the summary as JSON");
   sc->callback([scan, &out] { run_scan(*scan, out); });
 
   auto import = std::make_shared<ImportOptions>();
@@ -352,6 +395,7 @@ void add_map_commands(CLI::App& app, std::ostream& out) {
   im->add_option("--range", import->range, "longest ray in m; farther points only free the ray up to it (default: no limit)")
       ->check(finite_in(0.01, 1e4));
   im->add_option("--out", import->out, "the map as an OctoMap binary tree (.bt)")->required()->check(kOutputFile);
+  im->add_flag("--json", import->json, "print the summary as JSON");
   im->callback([import, &out] { run_import(*import, out); });
 
   auto astar = std::make_shared<AstarOptions>();

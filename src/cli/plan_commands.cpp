@@ -160,6 +160,7 @@ struct RegionCliOptions {
   QueryOptions query;
   RegionGridOptions grid;
   std::string out;
+  bool json = false;
 };
 
 void run_region_astar(const RegionCliOptions& o, std::ostream& out) {
@@ -169,8 +170,12 @@ void run_region_astar(const RegionCliOptions& o, std::ostream& out) {
   const Eigen::Vector3i dims(o.grid.dims[0], o.grid.dims[1], o.grid.dims[2]);
   const auto region = plan::astar_dilated_region(problem, reference, dims, o.grid.dilation);
   region.save(o.out);
-  out << "wrote " << o.out << ": " << region.cells().size() << " of " << dims.prod()
-      << " cells around the A* path (cost " << std::fixed << std::setprecision(3) << reference.cost << " m)\n";
+  std::ostringstream human;
+  human << "wrote " << o.out << ": " << region.cells().size() << " of " << dims.prod()
+        << " cells around the A* path (cost " << std::fixed << std::setprecision(3) << reference.cost << " m)\n";
+  report(o.json, {{"out", o.out}, {"cells", region.cells().size()}, {"dims", {dims.x(), dims.y(), dims.z()}},
+                  {"astar_cost", reference.cost}},
+         human.str(), out);
 }
 
 }  // namespace
@@ -243,6 +248,7 @@ void add_plan_commands(CLI::App& app, std::ostream& out) {
   add_query_options(ra, ro->query);
   add_region_grid_options(ra, ro->grid);
   ra->add_option("--out", ro->out, "output region file (miner-region-v1 JSON)")->required()->check(kOutputFile);
+  ra->add_flag("--json", ro->json, "print the summary as JSON");
   ra->callback([ro, &out] { run_region_astar(*ro, out); });
 }
 

@@ -339,6 +339,37 @@ TEST_CASE("cli reference is current: docs/cli-reference.md is what the commands 
   CHECK_THAT(generated, !Contains("## miner docs"));
 }
 
+TEST_CASE("Every command takes --quiet, and commands that write a file summarise it as JSON with --json",
+          "[REQ-CLI-001]") {
+  // Every leaf command of the reference lists --quiet (issue 22 item 4: one set of options).
+  const std::string reference = miner::cli::cli_reference_markdown();
+  std::size_t commands = 0, quiet = 0;
+  for (std::size_t at = reference.find("\n## miner "); at != std::string::npos; at = reference.find("\n## miner ", at + 1)) {
+    ++commands;
+    const std::size_t next = reference.find("\n## miner ", at + 1);
+    if (reference.substr(at, next == std::string::npos ? std::string::npos : next - at).find("`--quiet`") != std::string::npos)
+      ++quiet;
+  }
+  CHECK(commands >= 20);
+  CHECK(quiet == commands);
+  const std::string map = write("pillar-json.json", kPillarMap);
+  const auto json_of = [](const std::vector<std::string>& args) {
+    const Run r = miner_cli(args);
+    INFO(r.err);
+    REQUIRE(r.code == 0);
+    return miner::parse_json(r.out, "stdout");
+  };
+  const miner::Json gen = json_of({"map", "gen", "--preset", "indoor", "--seed", "2", "--out", dir() + "/j.json", "--json", "--quiet"});
+  CHECK(gen["preset"] == "indoor");
+  CHECK(gen["obstacles"].get<int>() > 0);
+  const miner::Json conv = json_of({"map", "convert", "--in", map, "--out", dir() + "/j.bt", "--json"});
+  CHECK(conv["out"] == dir() + "/j.bt");
+  const miner::Json region = json_of({"region", "astar", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5",
+                                      "--dims", "10", "10", "10", "--out", dir() + "/jr.json", "--json"});
+  CHECK(region["cells"].get<int>() > 0);
+  CHECK(region["astar_cost"].get<double>() >= 8.0);
+}
+
 TEST_CASE("Unknown options are named with the nearest one; duplicates, exclusive and misplaced options are refused",
           "[REQ-CLI-002]") {
   const std::string map = write("pillar-unknown.json", kPillarMap);
@@ -904,6 +935,9 @@ TEST_CASE("miner dataset writes the dataset folder and refuses a missing --out",
   INFO(r.err);
   REQUIRE(r.code == 0);
   CHECK_THAT(r.out, Contains("2 train, 0 val, 1 test"));
+  const Run j = miner_cli({"dataset", "--preset", "indoor", "--count", "2", "--test-count", "1", "--out", out, "--json", "--quiet"});
+  REQUIRE(j.code == 0);
+  CHECK(miner::parse_json(j.out, "stdout")["train"] == 2);
   CHECK(std::filesystem::exists(out + "/dataset.json"));
   CHECK(r.err.empty());  // not a terminal: no progress bar
   CHECK(miner_cli({"dataset", "--count", "2"}).code == 2);

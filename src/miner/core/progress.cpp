@@ -1,6 +1,7 @@
 #include "miner/core/progress.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <iostream>
 
 #include <unistd.h>
@@ -12,7 +13,7 @@ constexpr int kWidth = 30;
 }
 
 ProgressBar::ProgressBar(std::ostream* out, std::string label, std::size_t total)
-    : out_(out), label_(std::move(label)), total_(std::max<std::size_t>(total, 1)) {}
+    : out_(out), label_(std::move(label)), total_(std::max<std::size_t>(total, 1)), start_(Clock::now()) {}
 
 void ProgressBar::update(std::size_t done) {
   if (!out_ || finished_) return;
@@ -22,8 +23,17 @@ void ProgressBar::update(std::size_t done) {
   const int key = filled * 1000 + static_cast<int>(100 * done / total_);
   if (key == drawn_ && done != total_) return;
   drawn_ = key;
+  // Elapsed wall time, and the rest at the rate so far (terminal only: never in logs or files).
+  const double elapsed = std::chrono::duration<double>(Clock::now() - start_).count();
+  char times[64];
+  if (done > 0 && done < total_)
+    std::snprintf(times, sizeof times, "  %.0f s, ETA %.0f s   ", elapsed,
+                  elapsed / static_cast<double>(done) * static_cast<double>(total_ - done));
+  else
+    std::snprintf(times, sizeof times, "  %.0f s   ", elapsed);
   *out_ << '\r' << label_ << " [" << std::string(static_cast<std::size_t>(filled), '#')
-        << std::string(static_cast<std::size_t>(kWidth - filled), ' ') << "] " << done << '/' << total_ << std::flush;
+        << std::string(static_cast<std::size_t>(kWidth - filled), ' ') << "] " << done << '/' << total_ << times
+        << std::flush;
   if (done == total_) finish();
 }
 

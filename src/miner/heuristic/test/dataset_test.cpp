@@ -306,7 +306,9 @@ TEST_CASE("The progress bar draws only to a given stream and ends its line", "[R
   std::ostringstream os;
   {
     miner::ProgressBar bar(&os, "work", 4);
-    for (std::size_t i = 1; i <= 4; ++i) bar.update(i);
+    bar.update(1);
+    CHECK_THAT(os.str(), Contains("1/4") && Contains(" s, ETA "));  // elapsed and the rest
+    for (std::size_t i = 2; i <= 4; ++i) bar.update(i);
   }
   CHECK_THAT(os.str(), Contains("work [") && Contains("4/4"));
   CHECK(os.str().back() == '\n');

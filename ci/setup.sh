@@ -21,6 +21,7 @@ PACKAGES=(
   libcli11-dev         # the `miner` command line
   # benchmark peers
   libompl-dev ompl-demos libboost-filesystem-dev libboost-system-dev libboost-serialization-dev
+  libboost-dev         # Boost.Math: chi-square quantiles (EKF gate, NEES/NIS tests)
   # verification
   catch2               # unit tests (Catch2 v2)
   librapidcheck-dev    # property tests

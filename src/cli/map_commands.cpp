@@ -332,7 +332,7 @@ void add_map_commands(CLI::App& app, std::ostream& out) {
   g->add_option("--obstacles", gen->obstacles, "number of obstacles (default: the preset's range)")
       ->check(CLI::Range(0, kMaxObstacles));
   g->add_option("--size", gen->size, "families: extents X Y Z in m instead of drawn ones")->expected(3)
-      ->check(finite_in(0.0, 2.0 * world::kMaxCoordinate));
+      ->check(finite_in(3.0, 1000.0));  // the families' sizes (REQ-WORLD-011)
   g->add_option("--resolution", gen->resolution, "families: grid resolution in m instead of the drawn one")
       ->check(finite_in(world::kMinResolution, world::kMaxResolution));
   g->add_option("--out", gen->out, "output file (.json, or .bt for OctoMap)")->required()->check(kOutputFile);

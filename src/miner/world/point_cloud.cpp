@@ -361,6 +361,16 @@ std::shared_ptr<const VoxelLayer> integrate_clouds(const std::vector<CloudScan>&
   const auto point = [](const Eigen::Vector3d& p) {
     return octomap::point3d(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()));
   };
+  // Sensor origins first: one beyond the keys made the ray bound below infinite, blamed on the
+  // rays (issue 20); and a cloud of no finite point is named as such.
+  std::size_t finite_points = 0;
+  for (std::size_t s = 0; s < scans.size(); ++s) {
+    if (!(scans[s].origin.allFinite() && scans[s].origin.cwiseAbs().maxCoeff() < reach))
+      throw Error("cloud " + std::to_string(s) + ": the sensor origin " + format_point(scans[s].origin) +
+                  " lies beyond OctoMap's key range at this resolution (32767 voxels from the origin)");
+    finite_points += scans[s].cloud.points.size();
+  }
+  if (finite_points == 0) throw Error("point clouds: no finite point to integrate (non-finite points are skipped)");
   // Each point's ray walks |point - origin| / res voxels (at most max_range / res): bound the
   // total before OctoMap starts (it integrates ~1e7 voxels per second).
   constexpr double kMaxRaySteps = 2e9;

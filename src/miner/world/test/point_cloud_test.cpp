@@ -182,6 +182,12 @@ TEST_CASE("Malformed point clouds are refused naming the fault, never crash", "[
   CHECK_THROWS_WITH(integrate_clouds({{parse_point_cloud(pcd(wall_points(), false), false, "w.pcd"), V(0, 0, 0.5)}},
                                      1e300, 0.0),
                     Contains("resolution: 1e+300 m is outside"));
+  PointCloud none;
+  none.skipped = 3;
+  CHECK_THROWS_WITH(integrate_clouds({{none, V(0, 0, 0)}}, 0.05, 0.0), Contains("no finite point"));
+  PointCloud one;
+  one.points = {V(1, 0, 0)};
+  CHECK_THROWS_WITH(integrate_clouds({{one, V(1e308, 0, 0)}}, 0.05, 0.0), Contains("cloud 0: the sensor origin"));
   PointCloud far;
   far.points = {V(1e9, 0, 0)};
   CHECK_THROWS_WITH(integrate_clouds({{far, V(0, 0, 0)}}, 0.05, 0.0), Contains("would walk"));

@@ -20,10 +20,18 @@
 
 namespace miner::cli {
 
+namespace {
+/// A finite decimal number (no hex, inf or nan, which strtod also reads): every floating-point
+/// option goes through it.
+bool read_finite_decimal(const std::string& text, double& v) {
+  return is_decimal_number(text) && CLI::detail::lexical_cast(text, v) && std::isfinite(v);
+}
+}  // namespace
+
 const CLI::Validator kFiniteNonNegative(
     [](std::string& text) -> std::string {
       double v = 0.0;
-      if (!is_decimal_number(text) || !CLI::detail::lexical_cast(text, v) || !std::isfinite(v) || v < 0.0) {
+      if (!read_finite_decimal(text, v) || v < 0.0) {
         return "must be a finite decimal number >= 0, got " + text;
       }
       return {};
@@ -126,7 +134,7 @@ const CLI::Validator kOutputFileNewFolder(
 const CLI::Validator kPositive(
     [](std::string& text) -> std::string {
       double v = 0.0;
-      if (!is_decimal_number(text) || !CLI::detail::lexical_cast(text, v) || !std::isfinite(v) || !(v > 0.0))
+      if (!read_finite_decimal(text, v) || !(v > 0.0))
         return "must be a finite decimal number > 0, got " + text;
       return {};
     },
@@ -139,7 +147,7 @@ CLI::Validator finite_in(double lo, double hi) {
   return CLI::Validator(
       [lo, hi, text_range](std::string& text) -> std::string {
         double v = 0.0;
-        if (!is_decimal_number(text) || !CLI::detail::lexical_cast(text, v) || !std::isfinite(v) || v < lo || v > hi)
+        if (!read_finite_decimal(text, v) || v < lo || v > hi)
           return "must be a finite decimal number in " + text_range + ", got " + text;
         return {};
       },
@@ -185,7 +193,7 @@ const CLI::Validator kShard(
 const CLI::Validator kFinite(
     [](std::string& text) -> std::string {
       double v = 0.0;
-      if (!is_decimal_number(text) || !CLI::detail::lexical_cast(text, v) || !std::isfinite(v)) {
+      if (!read_finite_decimal(text, v)) {
         return "must be a finite decimal number, got " + text;
       }
       return {};
@@ -298,14 +306,23 @@ enum class Mode { kRun, kParseOnly };
 thread_local bool g_quiet = false;
 
 /// Every command takes --quiet (no progress on stderr) and, where its result is a summary, --json.
+/// `app` and every command below it, parents first.
+std::vector<CLI::App*> command_tree(CLI::App* app) {
+  std::vector<CLI::App*> chain{app};
+  for (std::size_t i = 0; i < chain.size(); ++i)
+    for (CLI::App* sub : chain[i]->get_subcommands([](CLI::App*) { return true; })) chain.push_back(sub);
+  return chain;
+}
+
+/// A command that runs (no subcommands of its own), below the top one.
+bool is_leaf_command(CLI::App* cmd) {
+  return cmd->get_parent() != nullptr && cmd->get_subcommands([](CLI::App*) { return true; }).empty();
+}
+
 void quiet_everywhere(CLI::App* app) {
-  for (CLI::App* sub : app->get_subcommands([](CLI::App*) { return true; })) {
-    if (sub->get_subcommands([](CLI::App*) { return true; }).empty()) {
-      if (sub->get_option_no_throw("--quiet") == nullptr) sub->add_flag("--quiet", g_quiet, "no progress on stderr");
-    } else {
-      quiet_everywhere(sub);
-    }
-  }
+  for (CLI::App* cmd : command_tree(app))
+    if (is_leaf_command(cmd) && cmd->get_option_no_throw("--quiet") == nullptr)
+      cmd->add_flag("--quiet", g_quiet, "no progress on stderr");
 }
 
 /// Every command of `miner` registered on `app` (their callbacks write to `out`).
@@ -326,28 +343,37 @@ void add_commands(CLI::App& app, std::ostream& out) {
   decimal_integers(&app);
 }
 
-/// `app` and every command below it, parents first.
-std::vector<CLI::App*> command_tree(CLI::App* app) {
-  std::vector<CLI::App*> chain{app};
-  for (std::size_t i = 0; i < chain.size(); ++i)
-    for (CLI::App* sub : chain[i]->get_subcommands([](CLI::App*) { return true; })) chain.push_back(sub);
-  return chain;
-}
-
-/// The command a line addresses: its path of command names from `app` ("miner plan").
-CLI::App* addressed_command(CLI::App* app, const std::vector<std::string>& args, std::string& path) {
+/// The command a line addresses and its path of command names from `app` ("miner plan").
+/// `unknown` is the first word that should name a command (its command has subcommands) but
+/// names none of them; empty otherwise.
+CLI::App* addressed_command(CLI::App* app, const std::vector<std::string>& args, std::string& path,
+                            std::string& unknown) {
   CLI::App* current = app;
   path = "miner";
+  unknown.clear();
   for (const std::string& a : args) {
     if (a.empty() || a[0] == '-') break;
+    const auto subs = current->get_subcommands([](CLI::App*) { return true; });
+    if (subs.empty()) break;  // the rest are the command's own arguments
     CLI::App* next = nullptr;
-    for (CLI::App* sub : current->get_subcommands([](CLI::App*) { return true; }))
+    for (CLI::App* sub : subs)
       if (sub->get_name() == a) next = sub;
-    if (!next) break;
+    if (!next) {
+      unknown = a;
+      break;
+    }
     current = next;
     path += " " + a;
   }
   return current;
+}
+
+/// "miner bench frontend" for the command `cmd` below the top one.
+std::string command_path(const CLI::App* cmd) {
+  std::string path = cmd->get_name();
+  for (const CLI::App* p = cmd->get_parent(); p != nullptr && p->get_parent() != nullptr; p = p->get_parent())
+    path = p->get_name() + " " + path;
+  return path;
 }
 
 /// An option-like argument of `cmd` that names no option of it (issue 20: `--mapp x` was
@@ -368,12 +394,7 @@ std::string unknown_option(CLI::App* cmd, const std::string& path, const std::ve
     if (a.size() <= dashes || a[0] != '-' || !std::isalpha(static_cast<unsigned char>(a[dashes]))) continue;
     const std::string name = a.substr(0, a.find('='));
     if (std::find(names.begin(), names.end(), name) != names.end()) continue;
-    std::string nearest;
-    std::size_t best = std::max<std::size_t>(2, name.size() / 3) + 1;
-    for (const std::string& n : names) {
-      const std::size_t d = edit_distance(name, n);
-      if (d < best) best = d, nearest = n;
-    }
+    const std::string nearest = nearest_name(name, names);
     return "unknown option " + name + " for `" + path + "`" +
            (nearest.empty() ? "" : ", did you mean " + nearest + "?");
   }
@@ -397,11 +418,8 @@ std::string cli_reference_markdown() {
      << "`cli reference is current` fails when this file and the program disagree). Every number's\n"
      << "range is enforced (REQ-CLI-002); prose, examples and file formats: [cli.md](cli.md).\n";
   for (CLI::App* cmd : command_tree(&app)) {
-    if (cmd == &app || !cmd->get_subcommands([](CLI::App*) { return true; }).empty() || cmd->get_group().empty()) continue;
-    std::string path = cmd->get_name();
-    for (const CLI::App* p = cmd->get_parent(); p != nullptr && p->get_parent() != nullptr; p = p->get_parent())
-      path = p->get_name() + " " + path;
-    md << "\n## miner " << path << "\n\n" << cmd->get_description() << "\n\n"
+    if (!is_leaf_command(cmd) || cmd->get_group().empty()) continue;
+    md << "\n## miner " << command_path(cmd) << "\n\n" << cmd->get_description() << "\n\n"
        << "| option | value | default | meaning |\n|---|---|---|---|\n";
     for (const CLI::Option* o : cmd->get_options()) {
       if (o->get_name() == "--help") continue;
@@ -440,12 +458,7 @@ std::vector<std::string> numeric_options_without_checks() {
           break;
         }
       }
-      if (checks < (integer ? 2 : 1)) {
-        std::string path = cmd->get_name();
-        for (const CLI::App* p = cmd->get_parent(); p != nullptr && p->get_parent() != nullptr; p = p->get_parent())
-          path = p->get_name() + " " + path;
-        unchecked.push_back(path + " " + o->get_name());
-      }
+      if (checks < (integer ? 2 : 1)) unchecked.push_back(command_path(cmd) + " " + o->get_name());
     }
   }
   return unchecked;
@@ -462,38 +475,24 @@ int cli_main(const std::vector<std::string>& args, std::ostream& out, std::ostre
     if (mode == Mode::kParseOnly) throw ParsedOnly{};
   });
 
-  // An unknown command is named, with the commands there are and the nearest one (CLI11
-  // alone says only "A subcommand is required").
   {
-    CLI::App* current = &app;
-    std::string path = "miner";
-    for (const std::string& a : args) {
-      if (a.empty() || a[0] == '-') break;
-      const auto subs = current->get_subcommands([](CLI::App*) { return true; });
-      if (subs.empty()) break;
-      CLI::App* next = nullptr;
-      std::string list, nearest;
-      std::size_t best = std::max<std::size_t>(2, a.size() / 3) + 1;
-      for (CLI::App* sub : subs) {
-        const std::string& name = sub->get_name();
-        list += (list.empty() ? "" : ", ") + name;
-        if (name == a) next = sub;
-        const std::size_t d = edit_distance(a, name);
-        if (d < best) best = d, nearest = name;
+    std::string path, unknown_command;
+    CLI::App* cmd = addressed_command(&app, args, path, unknown_command);
+    // An unknown command is named, with the commands there are and the nearest one (CLI11
+    // alone says only "A subcommand is required").
+    if (!unknown_command.empty()) {
+      std::vector<std::string> names;
+      std::string list;
+      for (CLI::App* sub : cmd->get_subcommands([](CLI::App*) { return true; })) {
+        names.push_back(sub->get_name());
+        list += (list.empty() ? "" : ", ") + sub->get_name();
       }
-      if (!next) {
-        err << "miner: usage error: unknown command \"" << a << "\" for `" << path << "`"
-            << (nearest.empty() ? "" : ", did you mean \"" + nearest + "\"?") << " (commands: " << list << ")\n"
-            << "run '" << path << " --help' for usage\n";
-        return static_cast<int>(ExitCode::kUsage);
-      }
-      current = next;
-      path += " " + a;
+      const std::string nearest = nearest_name(unknown_command, names);
+      err << "miner: usage error: unknown command \"" << unknown_command << "\" for `" << path << "`"
+          << (nearest.empty() ? "" : ", did you mean \"" + nearest + "\"?") << " (commands: " << list << ")\n"
+          << "run '" << path << " --help' for usage\n";
+      return static_cast<int>(ExitCode::kUsage);
     }
-  }
-  {
-    std::string path;
-    CLI::App* cmd = addressed_command(&app, args, path);
     const std::string unknown = unknown_option(cmd, path, args);
     if (!unknown.empty()) {
       err << "miner: usage error: " << unknown << "\nrun '" << path << " --help' for usage\n";

@@ -30,8 +30,19 @@ void add_scenario_options(CLI::App* cmd, ScenarioOptions& o) {
   cmd->add_option("--seed", o.seed, "override the scenario's seed")->check(kUnsigned64);
 }
 
-pipeline::Scenario resolve_scenario(const ScenarioOptions& o) {
-  pipeline::Scenario s = o.scenario.empty() ? pipeline::default_scenario() : pipeline::load_scenario(o.scenario);
+/// The scenario document as read once: --scenario's file, or the embedded default.
+struct ScenarioDocument {
+  Json doc;
+  std::string origin, base_dir;
+};
+
+ScenarioDocument read_scenario_document(const ScenarioOptions& o) {
+  if (o.scenario.empty()) return {pipeline::default_scenario_document(), "<default scenario>", ""};
+  return {read_json_file(o.scenario), o.scenario, std::filesystem::path(o.scenario).parent_path().string()};
+}
+
+pipeline::Scenario resolve_scenario(const ScenarioOptions& o, const ScenarioDocument& d) {
+  pipeline::Scenario s = pipeline::scenario_from_json(d.doc, d.origin, d.base_dir);
   if (o.seed >= 0) s.seed = static_cast<std::uint64_t>(o.seed);
   return s;
 }
@@ -44,13 +55,13 @@ struct FlyCliOptions {
 };
 
 void run_fly(const FlyCliOptions& o, std::ostream& out) {
-  const pipeline::Scenario s = resolve_scenario(o.scenario);
+  const ScenarioDocument document = read_scenario_document(o.scenario);
+  const pipeline::Scenario s = resolve_scenario(o.scenario, document);
   // The run folder replaces its contents whole: it must hold none of the scenario's inputs,
   // checked before any work (REQ-CLI-003).
   const std::string run_dir = o.out.empty() ? "runs/" + s.name + "-seed" + std::to_string(s.seed) : o.out;
   if (!o.scenario.scenario.empty())
-    for (const std::string& input : pipeline::scenario_inputs(read_json_file(o.scenario.scenario),
-                                                             std::filesystem::path(o.scenario.scenario).parent_path().string()))
+    for (const std::string& input : pipeline::scenario_inputs(document.doc, document.base_dir))
       if (is_same_or_inside(run_dir, input))
         throw CLI::ValidationError("--out", run_dir + " holds " + input + ", which the scenario reads: the run folder would replace it");
   const pipeline::ReferencePlan reference = pipeline::build_reference(s);
@@ -77,10 +88,8 @@ void run_fly(const FlyCliOptions& o, std::ostream& out) {
   Json path{{"source", reference.source}, {"points", points(reference.path)}};
   std::vector<std::pair<std::string, std::string>> files{
       {"scenario.json",
-       dump_json(o.scenario.scenario.empty()
-                     ? pipeline::default_scenario_document()
-                     : pipeline::self_contained_scenario(read_json_file(o.scenario.scenario),
-                                                       std::filesystem::path(o.scenario.scenario).parent_path().string()))},
+       dump_json(o.scenario.scenario.empty() ? document.doc
+                                             : pipeline::self_contained_scenario(document.doc, document.base_dir))},
       {"map.json", dump_json(s.map->to_json())}};
   if (reference.region) {
     files.emplace_back("region.json", reference.region->to_json().dump() + "\n");
@@ -147,7 +156,7 @@ void add_fly_commands(CLI::App& app, std::ostream& out) {
       ->check(finite_in(1e-12, 1e-2));
   add_output_options(sim, b->output);
   sim->callback([b, &out] {
-    const auto r = bench::run_sim_bench(resolve_scenario(b->scenario), b->bench);
+    const auto r = bench::run_sim_bench(resolve_scenario(b->scenario, read_scenario_document(b->scenario)), b->bench);
     std::ostringstream table;
     bench::print_table(r, table);
     emit(b->output, bench::to_json(r), table.str(), out);

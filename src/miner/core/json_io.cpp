@@ -127,6 +127,16 @@ std::size_t edit_distance(const std::string& a, const std::string& b) {
   return row[b.size()];
 }
 
+std::string nearest_name(const std::string& word, const std::vector<std::string>& candidates) {
+  std::string nearest;
+  std::size_t best = std::max<std::size_t>(2, word.size() / 3) + 1;
+  for (const auto& c : candidates) {
+    const std::size_t d = edit_distance(word, c);
+    if (d < best) best = d, nearest = c;
+  }
+  return nearest;
+}
+
 void JsonField::only_keys(const std::vector<std::string>& known) const {
   if (!value_->is_object()) fail(std::string("expected an object, got ") + type_name(*value_));
   for (auto it = value_->begin(); it != value_->end(); ++it) {
@@ -134,13 +144,7 @@ void JsonField::only_keys(const std::vector<std::string>& known) const {
     std::string list;
     for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
     const std::string child = path_.empty() ? it.key() : path_ + "." + it.key();
-    // The nearest known key by edit distance, when it is near enough to be a misspelling.
-    std::string nearest;
-    std::size_t best = std::max<std::size_t>(2, it.key().size() / 3) + 1;
-    for (const auto& k : known) {
-      const std::size_t d = edit_distance(it.key(), k);
-      if (d < best) best = d, nearest = k;
-    }
+    const std::string nearest = nearest_name(it.key(), known);
     throw Error(origin_ + ": " + child + ": unknown key" + (nearest.empty() ? "" : ", did you mean \"" + nearest + "\"?") +
                 " (known: " + list + ")");
   }
@@ -252,31 +256,7 @@ void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& 
   }
 }
 
-void write_file_atomic(const std::string& path, const std::string& content) {
-  namespace fs = std::filesystem;
-  const fs::path target(path);
-  const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  std::error_code ec;
-  if (!fs::is_directory(dir, ec)) throw Error(path + ": folder " + dir.string() + " does not exist");
-  const fs::path tmp = dir / ("." + target.filename().string() + ".tmp." + std::to_string(::getpid()));
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw Error(path + ": cannot write (temporary file " + tmp.string() + ")");
-    out << content;
-    out.flush();
-    if (!out) {
-      out.close();
-      fs::remove(tmp, ec);
-      throw Error(path + ": write failed");
-    }
-  }
-  fs::rename(tmp, target, ec);
-  if (ec) {
-    std::error_code ignored;
-    fs::remove(tmp, ignored);
-    throw Error(path + ": cannot replace file: " + ec.message());
-  }
-}
+void write_file_atomic(const std::string& path, const std::string& content) { write_files_atomic({{path, content}}); }
 
 void write_folder_atomic(const std::string& path, const std::vector<std::pair<std::string, std::string>>& files) {
   namespace fs = std::filesystem;

@@ -69,6 +69,10 @@ class JsonField {
 /// Levenshtein distance (insertions, deletions, substitutions): the "did you mean" of
 /// JsonField::only_keys.
 std::size_t edit_distance(const std::string& a, const std::string& b);
+/// The candidate nearest to `word` by edit distance when it is near enough to be a misspelling
+/// (fewer than max(2, |word| / 3) + 1 edits; the first of equals), else empty: the "did you
+/// mean" of unknown keys, commands and options.
+std::string nearest_name(const std::string& word, const std::vector<std::string>& candidates);
 
 /// [x, y, z] as a JSON array: what JsonField::vec3 reads back.
 Json vec3_json(const Eigen::Vector3d& v);

@@ -388,9 +388,7 @@ std::shared_ptr<const VoxelLayer> integrate_clouds(const std::vector<CloudScan>&
   }
   for (std::size_t s = 0; s < scans.size(); ++s) {
     const CloudScan& scan = scans[s];
-    const auto beyond = [&](const Eigen::Vector3d& p) { return !(p.cwiseAbs().maxCoeff() < reach); };
-    if (beyond(scan.origin)) throw Error("cloud " + std::to_string(s) + ": the sensor origin " + format_point(scan.origin) +
-                                         " lies beyond OctoMap's key range at this resolution");
+    const auto beyond = [&](const Eigen::Vector3d& p) { return !(p.cwiseAbs().maxCoeff() < reach); };  // origins checked above
     octomap::Pointcloud cloud;
     cloud.reserve(scan.cloud.points.size());
     for (std::size_t i = 0; i < scan.cloud.points.size(); ++i) {

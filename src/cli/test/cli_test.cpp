@@ -1065,8 +1065,26 @@ TEST_CASE("Training is deterministic for a seed and exports weights C++ loads an
   INFO(check.err);
   CHECK(check.code == 0);
   const miner::Json metrics = miner::read_json_file(dir() + "/train-a/metrics.json");
-  CHECK(metrics["training"]["data_seed"] == 21);
+  CHECK(metrics["training"]["data_seed"] == miner::Json::array({21}));
   CHECK_THAT(metrics["training"]["command"].get<std::string>(), Contains("train.py"));
+  CHECK(metrics["architecture"]["scale_channels"] == 3);  // REQ-HEUR-013
+  // Several families at once (one folder each): the validation quality is reported per family,
+  // and the C++ side agrees with the reference, scale input included.
+  const std::string indoor = dir() + "/train-indoor";
+  REQUIRE(miner_cli({"dataset", "--preset", "indoor", "--count", "10", "--test-count", "0", "--val-fraction", "0.2",
+                     "--seed", "22", "--out", indoor})
+              .code == 0);
+  REQUIRE(std::system((std::string(MINER_TORCH_PYTHON) + " " + MINER_SOURCE_DIR + "/src/python/sgan/train.py --data " +
+                       data + " " + indoor + " --epochs 1 --batch 4 --width 4 --threads 1 --seed 3 --out " + dir() +
+                       "/train-two > /dev/null")
+                          .c_str()) == 0);
+  const miner::Json two = miner::read_json_file(dir() + "/train-two/metrics.json");
+  CHECK(two["training"]["data_preset"] == miner::Json::array({"sim", "indoor"}));
+  CHECK(two["selected"]["by_family"]["sim"]["samples"] == 2);
+  CHECK(two["selected"]["by_family"]["indoor"]["samples"] == 2);
+  CHECK(miner_cli({"sgan", "check", "--weights", dir() + "/train-two/sgan.bin", "--reference",
+                   dir() + "/train-two/reference.bin"})
+            .code == 0);
   // Stopped after epoch 1 and resumed: the same bytes as the run straight through.
   const std::string ckpt = " --checkpoint " + dir() + "/train-e.ckpt";
   REQUIRE(std::system((train + ckpt + " --stop-after 1 --epochs 2 --out " + dir() + "/train-e > /dev/null 2> " + dir() +

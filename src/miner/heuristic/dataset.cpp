@@ -141,6 +141,14 @@ std::string read_shard(const std::string& dir, const ShardRecord& r, std::size_t
   return bytes;
 }
 
+/// A sample's map bounds {"min": [x, y, z], "max": [x, y, z]}, min < max on every axis.
+world::Box index_bounds(const JsonField& f) {
+  f.only_keys({"min", "max"});
+  const world::Box b{f.at("min").vec3(), f.at("max").vec3()};
+  if (!(b.min.array() < b.max.array()).all()) f.fail("min must be below max on every axis");
+  return b;
+}
+
 /// A split's index entries, checked: one per sample of the folder's shards, each with its k.
 std::vector<Json> read_index(const std::string& dir, const SplitLayout& S) {
   const std::string path = dir + "/" + S.index;
@@ -152,10 +160,13 @@ std::vector<Json> read_index(const std::string& dir, const SplitLayout& S) {
   std::vector<Json> out;
   for (std::size_t i = 0; i < f.array_size(); ++i) {
     const JsonField e = f.at(i);
-    e.only_keys({"k", "map_seed", "start", "goal", "astar_cost"});
+    e.only_keys({"k", "map_seed", "bounds", "start", "goal", "astar_cost"});
     for (const char* key : {"k", "map_seed"})
       if (!e.at(key).value().is_number_unsigned()) e.at(key).fail("expected an integer in [0, 2^64 - 1]");
     const Eigen::Vector3d start = e.at("start").vec3(), goal = e.at("goal").vec3();
+    const world::Box bounds = index_bounds(e.at("bounds"));
+    if (!bounds.contains(start)) e.at("start").fail("lies outside the sample's bounds");
+    if (!bounds.contains(goal)) e.at("goal").fail("lies outside the sample's bounds");
     // A path is never shorter than the straight line (issue 20: a cost of -5 merged); the
     // tolerance allows the cost's own rounding.
     constexpr double kCostRounding = 1e-9;
@@ -225,6 +236,7 @@ Sample make_sample(const DatasetOptions& o, std::uint64_t k) {
     path = world::astar(map, grid, s.start, s.goal);
   }
   s.astar_cost = path->cost;
+  s.bounds = b;
   s.environment = encode_environment(map, o.dims, r);
   s.state = encode_state(b, o.dims, s.start, s.goal, o.dilation);
   const auto region = plan::HeuristicRegion::from_path(b, o.dims, path->points, o.dilation, "astar-dilated");
@@ -293,6 +305,7 @@ Json write_dataset(const DatasetOptions& o, const std::string& dir, std::ostream
         for (const auto* channel : {&s.environment, &s.state, &s.target})
           shard.append(reinterpret_cast<const char*>(channel->data()), cells);
         index.push_back({{"k", first[sp] + static_cast<std::uint64_t>(i0 + i)}, {"map_seed", s.map_seed},
+                         {"bounds", {{"min", vec3_json(s.bounds.min)}, {"max", vec3_json(s.bounds.max)}}},
                          {"start", vec3_json(s.start)}, {"goal", vec3_json(s.goal)}, {"astar_cost", s.astar_cost}});
         if (++in_shard == o.shard_size) flush();
       }
@@ -421,6 +434,7 @@ std::vector<Sample> read_split(const std::string& dir, const std::string& split)
       sample.start = f.at("start").vec3();
       sample.goal = f.at("goal").vec3();
       sample.astar_cost = f.at("astar_cost").number();
+      sample.bounds = index_bounds(f.at("bounds"));
       const auto* base = reinterpret_cast<const std::uint8_t*>(bytes.data()) + s * 3 * L.cells;
       sample.environment.assign(base, base + L.cells);
       sample.state.assign(base + L.cells, base + 2 * L.cells);

@@ -18,7 +18,7 @@
 /// (train, val, test) is a series of shards `<split>-NNNNN.bin`, each the raw bytes of
 /// uint8[n][3][nz][ny][nx] (channel order E, S, T; x fastest), readable with
 /// numpy.fromfile(..., dtype=uint8).reshape(n, 3, nz, ny, nx); DIR/<split>-index.json
-/// lists each sample's map seed, start, goal and A* cost.
+/// lists each sample's map seed, map bounds, start, goal and A* cost.
 ///
 /// Seeds: sample k (0 <= k < count + test_count) uses map seed splitmix64(seed ^ k), a
 /// bijection of k, so the test samples (k >= count) come from map seeds never used in
@@ -69,6 +69,9 @@ struct Sample {
   Eigen::Vector3d start = Eigen::Vector3d::Zero();
   Eigen::Vector3d goal = Eigen::Vector3d::Zero();
   double astar_cost = 0.0;
+  /// The map's bounds: the grid covers them, so a cell is (max - min) / dims (the families
+  /// draw their extents per map; the sGAN's scale input, sgan.hpp, is computed from them).
+  world::Box bounds{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
   std::vector<std::uint8_t> environment, state, target;  ///< each dims.prod(), x fastest
 };
 

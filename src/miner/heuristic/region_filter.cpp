@@ -141,7 +141,7 @@ HeuristicQuery query_region(const Sgan& sgan, const world::Map& map, const Eigen
   const double encode_ms = elapsed_ms(t0);
   t0 = std::chrono::steady_clock::now();
   Rng rng(seed, kNoiseStream);
-  std::vector<float> prob = sgan.predict(env, state, rng);
+  std::vector<float> prob = sgan.predict(env, state, b, robot_radius, rng);
   const double inference_ms = elapsed_ms(t0);
   t0 = std::chrono::steady_clock::now();
   FilteredRegion f = filter_region(prob, env, dims, cell_of(b, dims, start), cell_of(b, dims, goal), arch.threshold);

@@ -164,7 +164,7 @@ struct Sgan::Impl {
   SganArchitecture arch;
   dnnl::engine engine{dnnl::engine::kind::cpu, 0};
   // Buffers, in graph order (model.py's names; cat* are the concatenated conv inputs).
-  Activation x0, cond1, a1, c2, a2, cat2, c4, a3, cat3, c8, a4, cat4, m1, m2, catd3, d3, catd2, d2, catd1, out;
+  Activation x0, cond1, a1, c2, a2, cat2, c4, a3, cat3, c8, a4, sigma, cat4, m1, m2, catd3, d3, catd2, d2, catd1, out;
   // The last layer streams plane by plane (catd1 is one plane of its input, taps a ring of three
   // planes of its tap products), so its 7.6 MB of full-grid buffers stay out of the caches.
   Activation taps;                      // 27 tap products per voxel (+5 zero channels), 3 planes
@@ -196,6 +196,16 @@ struct Sgan::Impl {
     cond1.data[2 * v + 1] = s;
   }
 
+  /// sigma, constant over the bottleneck's grid (nothing when the network has no scale input).
+  void set_scale(const std::vector<float>& scale) {
+    if (sigma.channels == 0) return;
+    if (scale.size() != static_cast<std::size_t>(sigma.channels))
+      throw Error("sgan: the network takes a scale input of " + std::to_string(sigma.channels) + " values, given " +
+                  std::to_string(scale.size()));
+    for (std::size_t v = 0; v < sigma.voxels(); ++v)
+      std::copy(scale.begin(), scale.end(), sigma.data.begin() + static_cast<std::ptrdiff_t>(v * scale.size()));
+  }
+
   /// The generator on the input set by set_input: R, one probability per voxel.
   std::vector<float> run();
 
@@ -216,7 +226,7 @@ void Sgan::Impl::build(const TensorFile& f, Sgan::FirstLayer first_layer) {
   const JsonField a(f.meta, "meta", f.path);
   a.only_keys({"architecture", "final", "training"});
   const JsonField ar = a.at("architecture");
-  ar.only_keys({"name", "width", "dims", "environment_scale", "threshold", "layers"});
+  ar.only_keys({"name", "width", "dims", "environment_scale", "threshold", "layers", "scale_channels", "scale_divisor"});
   if (ar.at("name").string() != "sgan-unet4") ar.at("name").fail("unknown architecture (expected sgan-unet4)");
   if (ar.has("layers")) {  // optional (the tensors name the layers); when given it must be right
     const std::vector<std::string> expected{"enc1", "enc2", "enc3", "enc4", "mid1", "mid2", "dec3", "dec2", "dec1"};
@@ -238,6 +248,16 @@ void Sgan::Impl::build(const TensorFile& f, Sgan::FirstLayer first_layer) {
   if (!(arch.environment_scale > 0.0)) ar.at("environment_scale").fail("must be positive");
   arch.threshold = ar.at("threshold").number();
   if (!(arch.threshold > 0.0 && arch.threshold < 1.0)) ar.at("threshold").fail("must be in (0, 1)");
+  // Absent in the files written before the scale input (one family, one scale).
+  arch.scale_channels = ar.has("scale_channels") ? ar.at("scale_channels").integer() : 0;
+  if (arch.scale_channels != 0 && arch.scale_channels != 3) ar.at("scale_channels").fail("must be 0 or 3 (x, y, z)");
+  if (arch.scale_channels != 0) {
+    // sigma spans [-1, 1] for cells of 1/16 to 16 radii at divisor 4; outside [1, 64] the
+    // inputs would be squashed to nothing or blown up.
+    arch.scale_divisor = ar.at("scale_divisor").number_in(1.0, 64.0);
+  } else if (ar.has("scale_divisor")) {
+    ar.at("scale_divisor").fail("is given without scale_channels");
+  }
 
   const int w = arch.width;
   const Eigen::Vector3i n1 = arch.dims, n2 = n1 / 2, n4 = n1 / 4, n8 = n1 / 8;
@@ -252,7 +272,8 @@ void Sgan::Impl::build(const TensorFile& f, Sgan::FirstLayer first_layer) {
   cat3 = Activation(4 * w + 2, n4);
   c8 = Activation(2, n8);
   a4 = Activation(4 * w, n8);
-  cat4 = Activation(4 * w + 2, n8);
+  sigma = Activation(arch.scale_channels, n8);
+  cat4 = Activation(4 * w + 2 + arch.scale_channels, n8);
   m1 = Activation(4 * w, n8);
   m2 = Activation(4 * w, n8);
   catd3 = Activation(4 * w + 4 * w + 2, n4);
@@ -423,13 +444,29 @@ const std::string& Sgan::path() const { return impl_->path; }
 bool Sgan::planar_first_layer() const { return impl_->planar_input; }
 
 std::vector<float> Sgan::forward(const std::vector<float>& env, const std::vector<float>& state,
-                                 const std::vector<float>& noise) const {
+                                 const std::vector<float>& noise, const std::vector<float>& scale) const {
   Impl& g = *impl_;
   const std::size_t n = g.x0.voxels();
   if (env.size() != n || state.size() != n || noise.size() != n)
     throw Error("sgan: inputs must have " + std::to_string(n) + " cells each (the weights' grid)");
+  g.set_scale(scale);
   for (std::size_t v = 0; v < n; ++v) g.set_input(v, env[v], state[v], noise[v]);
   return g.run();
+}
+
+std::vector<float> scale_input(const world::Box& bounds, const Eigen::Vector3i& dims, double robot_radius,
+                               double divisor) {
+  if (!(std::isfinite(robot_radius) && robot_radius >= 0.0))
+    throw Error("sgan: the robot radius must be >= 0 and finite for the scale input");
+  std::vector<float> sigma(3);
+  for (int a = 0; a < 3; ++a) {
+    const double cell = (bounds.max[a] - bounds.min[a]) / dims[a];
+    if (!(std::isfinite(cell) && cell > 0.0)) throw Error("sgan: the grid's cells must have a positive finite size");
+    // A point robot (radius 0) has cells infinitely many radii wide: the limit.
+    const double v = robot_radius > 0.0 ? std::log2(cell / robot_radius) / divisor : kScaleLimit;
+    sigma[static_cast<std::size_t>(a)] = static_cast<float>(std::clamp(v, -kScaleLimit, kScaleLimit));
+  }
+  return sigma;
 }
 
 std::vector<float> Sgan::Impl::run() {
@@ -456,7 +493,7 @@ std::vector<float> Sgan::Impl::run() {
   run(2);  // a3
   concat(g.cat3, {{&g.a3, false}, {&g.c4, false}});
   run(3);  // a4
-  concat(g.cat4, {{&g.a4, false}, {&g.c8, false}});
+  concat(g.cat4, {{&g.a4, false}, {&g.c8, false}, {&g.sigma, false}});
   run(4);  // m1
   run(5);  // m2
   concat(g.catd3, {{&g.m2, true}, {&g.cat3, false}});
@@ -481,11 +518,12 @@ std::vector<float> Sgan::Impl::run() {
 }
 
 std::vector<float> Sgan::predict(const std::vector<std::uint8_t>& environment, const std::vector<std::uint8_t>& state,
-                                 Rng& rng) const {
+                                 const world::Box& bounds, double robot_radius, Rng& rng) const {
   Impl& g = *impl_;
   const std::size_t n = g.x0.voxels();
   if (environment.size() != n || state.size() != n)
     throw Error("sgan: E and S must have " + std::to_string(n) + " cells each (the weights' grid)");
+  if (g.arch.scale_channels != 0) g.set_scale(scale_input(bounds, g.arch.dims, robot_radius, g.arch.scale_divisor));
   const auto scale = static_cast<float>(g.arch.environment_scale);
   for (std::size_t v = 0; v < n; ++v)
     g.set_input(v, scale * static_cast<float>(environment[v]), static_cast<float>(state[v]),
@@ -502,8 +540,10 @@ std::vector<double> reference_errors(const Sgan& sgan, const std::string& refere
   std::vector<double> errors;
   for (int k = 0; k < samples.integer(); ++k) {
     const std::string p = std::to_string(k) + ".";
+    const int sc = sgan.architecture().scale_channels;
     const auto out = sgan.forward(ref.at(p + "environment", shape).values, ref.at(p + "state", shape).values,
-                                  ref.at(p + "noise", shape).values);
+                                  ref.at(p + "noise", shape).values,
+                                  sc ? ref.at(p + "scale", {sc}).values : std::vector<float>{});
     const auto& want = ref.at(p + "output", shape).values;
     double worst = 0.0;
     for (std::size_t i = 0; i < out.size(); ++i) {

@@ -6,7 +6,7 @@
 ///     a2 = relu(conv3_s2(a1))                2w x (n/2)^3
 ///     a3 = relu(conv3_s2([a2, c2]))          4w x (n/4)^3
 ///     a4 = relu(conv3_s2([a3, c4]))          4w x (n/8)^3
-///     m1 = relu(conv3([a4, c8]))             4w x (n/8)^3
+///     m1 = relu(conv3([a4, c8, sigma]))      4w x (n/8)^3   (sigma: the scale input, below)
 ///     m2 = relu(conv3(m1))                   4w x (n/8)^3
 ///     d3 = relu(conv3([up2(m2), a3, c4]))    2w x (n/4)^3
 ///     d2 = relu(conv3([up2(d3), a2, c2]))    2w x (n/2)^3
@@ -25,6 +25,7 @@
 
 #include "miner/core/json_io.hpp"
 #include "miner/plan/heuristic_region.hpp"
+#include "miner/world/box.hpp"
 
 namespace miner {
 class Rng;
@@ -34,6 +35,11 @@ namespace miner::heuristic {
 
 struct SganArchitecture {
   int width = 8;
+  /// 3 when the network is told its cells' metric size (issue 16 item 2): sigma, per axis
+  /// log2(cell side / robot radius) / scale_divisor, constant channels beside the bottleneck's
+  /// input; 0 for a network trained on one map family at one scale (no sigma).
+  int scale_channels = 0;
+  double scale_divisor = 4.0;
   Eigen::Vector3i dims = plan::HeuristicRegion::default_dims();  ///< nx, ny, nz; each divisible by 8
   double environment_scale = 0.5;   ///< E levels 0/1/2 enter the network as E * scale
   double threshold = 0.5;           ///< cell in the raw region iff R >= threshold
@@ -71,19 +77,32 @@ class Sgan {
   /// R = G(N | E, S) on the grid: three inputs of dims.prod() floats (x fastest) — the
   /// One query at a time per object (the buffers are reused). Inputs: the
   /// environment already scaled, the state, the noise — and dims.prod() probabilities out.
+  /// `scale` is sigma (ignored, and may be empty, when the network has no scale channels).
   std::vector<float> forward(const std::vector<float>& environment_scaled, const std::vector<float>& state,
-                             const std::vector<float>& noise) const;
+                             const std::vector<float>& noise, const std::vector<float>& scale = {}) const;
 
-  /// The same from the dataset encoding (E levels 0/1/2, S 0/1), with N(0, 1) noise drawn
-  /// from `rng`.
+  /// The same from the dataset encoding (E levels 0/1/2, S 0/1) of a grid over `bounds` for
+  /// a robot of `robot_radius` (which give sigma), with N(0, 1) noise drawn from `rng`.
   std::vector<float> predict(const std::vector<std::uint8_t>& environment, const std::vector<std::uint8_t>& state,
-                             Rng& rng) const;
+                             const world::Box& bounds, double robot_radius, Rng& rng) const;
 
  private:
   struct Impl;
   explicit Sgan(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };
+
+/// |sigma| is clamped here: the shipped network saw sigma in [-0.27, 1.14] (cells of 1/2 to 23
+/// radii); beyond 2 (cells of 256 radii at divisor 4) it would extrapolate further still, and
+/// a point robot (radius 0) has sigma = +2 instead of infinity.
+inline constexpr double kScaleLimit = 2.0;
+
+/// sigma for a grid of `dims` cells over `bounds` and a robot of `robot_radius`:
+/// sigma_a = clamp(log2(cell_a / robot_radius) / divisor, +-kScaleLimit), cell_a =
+/// (bounds.max_a - bounds.min_a) / dims_a (model.py's scale_input, the same doubles). Throws
+/// miner::Error unless every cell side is positive and finite and the radius finite and >= 0.
+std::vector<float> scale_input(const world::Box& bounds, const Eigen::Vector3i& dims, double robot_radius,
+                               double divisor);
 
 /// Agreement with PyTorch: float32 convolutions summed in another order differ by a few ulps
 /// per layer; the issue's bound on the probabilities.

@@ -11,13 +11,19 @@ grid, so every cell knows where both start and goal are):
     a2  = relu(conv3_stride2(a1))                       2w x (n/2)^3
     a3  = relu(conv3_stride2([a2, c2]))                 4w x (n/4)^3
     a4  = relu(conv3_stride2([a3, c4]))                 4w x (n/8)^3
-    m1  = relu(conv3([a4, c8]))                         4w x (n/8)^3
+    m1  = relu(conv3([a4, c8, sigma]))                  4w x (n/8)^3   sigma: the scale input
     m2  = relu(conv3(m1))                               4w x (n/8)^3
     d3  = relu(conv3([up2(m2), a3, c4]))                2w x (n/4)^3   decoder with skips
     d2  = relu(conv3([up2(d3), a2, c2]))                2w x (n/2)^3
     R   = sigmoid(conv3([up2(d2), a1, E/2, S]))         1  x n^3
 conv3: 3x3x3 kernel, padding 1, bias; up2: nearest-neighbour upsampling by 2; maxpool
-kernel = stride. The C++ inference (src/miner/heuristic/sgan.hpp) runs exactly this graph
+kernel = stride. sigma (scale_channels = 3; 0 in networks trained before it) tells the
+network the metric size of its cells, which the 32^3 grid over the map's bounds hides (a cell
+of a 10 m indoor map and of a 200 m forest look the same): per axis a,
+    sigma_a = log2(cell_a / robot_radius) / SCALE_DIVISOR,  cell_a = (bounds.max_a - bounds.min_a) / n_a,
+constant over the (n/8)^3 grid of the bottleneck (whose receptive field is the whole grid, so
+every cell of the decoder sees it; it costs 3 channels at 4^3, nothing next to the rest).
+The C++ inference (src/miner/heuristic/sgan.hpp) runs exactly this graph
 from the exported weights.
 
 Discriminator (Sec. IV-A.2: "four volumetric convolution layers and a sigmoid"):
@@ -31,30 +37,48 @@ import torch.nn.functional as F
 
 # The generator's layers in graph order, with their input/output widths as functions of w.
 # The weights file lists them in this order (export.py) and C++ checks the shapes.
+# (w, s): width and scale channels.
 GENERATOR_LAYERS = [
-    ("enc1", lambda w: (3, w), 1),
-    ("enc2", lambda w: (w, 2 * w), 2),
-    ("enc3", lambda w: (2 * w + 2, 4 * w), 2),
-    ("enc4", lambda w: (4 * w + 2, 4 * w), 2),
-    ("mid1", lambda w: (4 * w + 2, 4 * w), 1),
-    ("mid2", lambda w: (4 * w, 4 * w), 1),
-    ("dec3", lambda w: (4 * w + 4 * w + 2, 2 * w), 1),
-    ("dec2", lambda w: (2 * w + 2 * w + 2, 2 * w), 1),
-    ("dec1", lambda w: (2 * w + w + 2, 1), 1),
+    ("enc1", lambda w, s: (3, w), 1),
+    ("enc2", lambda w, s: (w, 2 * w), 2),
+    ("enc3", lambda w, s: (2 * w + 2, 4 * w), 2),
+    ("enc4", lambda w, s: (4 * w + 2, 4 * w), 2),
+    ("mid1", lambda w, s: (4 * w + 2 + s, 4 * w), 1),
+    ("mid2", lambda w, s: (4 * w, 4 * w), 1),
+    ("dec3", lambda w, s: (4 * w + 4 * w + 2, 2 * w), 1),
+    ("dec2", lambda w, s: (2 * w + 2 * w + 2, 2 * w), 1),
+    ("dec1", lambda w, s: (2 * w + w + 2, 1), 1),
 ]
+
+# sigma = log2(cell / robot radius) / SCALE_DIVISOR: cells of 1/16 to 16 robot radii (a 0.1 m
+# voxel for a 1.6 m drone to a 5 m cell for a 0.3 m one) map into [-1, 1].
+SCALE_DIVISOR = 4.0
+# |sigma| <= SCALE_LIMIT (C++ kScaleLimit): a point robot (radius 0) gets +SCALE_LIMIT.
+SCALE_LIMIT = 2.0
+
+
+def scale_input(lo, hi, dims, robot_radius):
+    """sigma (x, y, z) for a grid of dims = (nx, ny, nz) cells over the box [lo, hi]: the same
+    doubles as C++'s heuristic::scale_input, rounded to float32 by the caller."""
+    import math
+    def one(a):
+        v = math.log2((hi[a] - lo[a]) / dims[a] / robot_radius) / SCALE_DIVISOR if robot_radius > 0 else SCALE_LIMIT
+        return min(max(v, -SCALE_LIMIT), SCALE_LIMIT)
+    return [one(a) for a in range(3)]
 
 
 class Generator(nn.Module):
-    def __init__(self, width=8):
+    def __init__(self, width=8, scale_channels=3):
         super().__init__()
-        self.width = width
+        self.width, self.scale_channels = width, scale_channels
         self.convs = nn.ModuleDict()
         for name, io, stride in GENERATOR_LAYERS:
-            cin, cout = io(width)
+            cin, cout = io(width, scale_channels)
             self.convs[name] = nn.Conv3d(cin, cout, 3, stride=stride, padding=1)
 
-    def logits(self, env, state, noise):
-        """env: E/2 in {0, 0.5, 1}; state: S in {0, 1}; noise: N(0, 1); each B x 1 x n^3."""
+    def logits(self, env, state, noise, scale=None):
+        """env: E/2 in {0, 0.5, 1}; state: S in {0, 1}; noise: N(0, 1); each B x 1 x n^3;
+        scale: sigma, B x scale_channels (None when scale_channels is 0)."""
         c = self.convs
         cond1 = torch.cat([env, state], 1)
         c2, c4, c8 = (F.max_pool3d(cond1, k) for k in (2, 4, 8))
@@ -63,14 +87,17 @@ class Generator(nn.Module):
         a2 = F.relu(c["enc2"](a1))
         a3 = F.relu(c["enc3"](torch.cat([a2, c2], 1)))
         a4 = F.relu(c["enc4"](torch.cat([a3, c4], 1)))
-        m1 = F.relu(c["mid1"](torch.cat([a4, c8], 1)))
+        bottom = [a4, c8]
+        if self.scale_channels:
+            bottom.append(scale[:, :, None, None, None].expand(-1, -1, *a4.shape[2:]))
+        m1 = F.relu(c["mid1"](torch.cat(bottom, 1)))
         m2 = F.relu(c["mid2"](m1))
         d3 = F.relu(c["dec3"](torch.cat([up(m2), a3, c4], 1)))
         d2 = F.relu(c["dec2"](torch.cat([up(d3), a2, c2], 1)))
         return c["dec1"](torch.cat([up(d2), a1, cond1], 1))
 
-    def forward(self, env, state, noise):
-        return torch.sigmoid(self.logits(env, state, noise))
+    def forward(self, env, state, noise, scale=None):
+        return torch.sigmoid(self.logits(env, state, noise, scale))
 
 
 def upsample2(t):

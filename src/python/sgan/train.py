@@ -58,14 +58,18 @@ import tensors  # noqa: E402
 #                share of steps done, so the last epochs settle instead of oscillating
 #   select       "best": export the epoch (and threshold) with the best validation
 #                connectivity + safety (GAN training oscillates); "last": the last epoch
-#   val_samples  validation samples scored after each epoch (0: all of them)
+#   val_samples  validation samples scored after each epoch (0: all of them), the first of
+#                each family in turn
+#   scale_channels  3: the network is told sigma, its cells' metric size (model.py); 0: the
+#                graph of the weights trained before (one map family, one scale)
 DEFAULTS = dict(epochs=10, batch=32, lr_g=2e-3, lr_d=2e-4, kappa=1.0, alpha1=0.002, alpha2=1.0, alpha3=0.5,
-                alpha4=100.0, delta=0.5, pos_weight=8.0, width=8, threshold=0.5, seed=1, threads=2,
+                alpha4=100.0, delta=0.5, pos_weight=8.0, width=8, scale_channels=3, threshold=0.5, seed=1, threads=2,
                 max_train=0, references=2, thresholds="0.3,0.4,0.5,0.6,0.7,0.8", augment=1, schedule="cosine",
                 select="best", val_samples=400)
 
 
 def load_split(data, split):
+    """One folder's split: (meta, uint8 [N, 3, nz, ny, nx], float32 sigma [N, 3])."""
     path = os.path.join(data, "dataset.json")
     if not os.path.isfile(path):
         raise SystemExit(f"train: {path} not found (make one with `miner dataset`)")
@@ -81,9 +85,40 @@ def load_split(data, split):
         if raw.size != shard["count"] * 3 * nx * ny * nz:
             raise SystemExit(f"train: {path} is truncated")
         parts.append(raw.reshape(shard["count"], 3, nz, ny, nx))
-    if not parts:
-        return meta, np.zeros((0, 3, nz, ny, nx), np.uint8)
-    return meta, np.concatenate(parts)
+    x = np.concatenate(parts) if parts else np.zeros((0, 3, nz, ny, nx), np.uint8)
+    index_path = os.path.join(data, meta["splits"][split]["index"])
+    with open(index_path) as f:
+        index = json.load(f)
+    if len(index) != len(x) or any("bounds" not in e for e in index):
+        raise SystemExit(f"train: {index_path} must hold one entry with the map's bounds per sample "
+                         "(a dataset written before the bounds were recorded: generate it again)")
+    sigma = np.array([sgan.scale_input(e["bounds"]["min"], e["bounds"]["max"], meta["dims"], meta["robot_radius"])
+                      for e in index], dtype=np.float64).astype(np.float32).reshape(-1, 3)
+    return meta, x, sigma
+
+
+def load_families(folders, split):
+    """The folders' split joined: (metas, uint8 samples, float32 sigma, int family of each sample)."""
+    metas, xs, sigmas, family = [], [], [], []
+    for i, d in enumerate(folders):
+        meta, x, sigma = load_split(d, split)
+        if metas and meta["dims"] != metas[0]["dims"]:
+            raise SystemExit(f"train: {d} has a {meta['dims']} grid, {folders[0]} a {metas[0]['dims']} one")
+        metas.append(meta)
+        xs.append(x)
+        sigmas.append(sigma)
+        family.append(np.full(len(x), i, dtype=np.int64))
+    return metas, np.concatenate(xs), np.concatenate(sigmas), np.concatenate(family)
+
+
+def balanced_first(family, n):
+    """Indices of about n samples, the first of each family in turn (all when n is 0 or more
+    than there are), so a validation subset scores every family."""
+    if n == 0 or n >= len(family):
+        return np.arange(len(family))
+    groups = [np.flatnonzero(family == f) for f in np.unique(family)]
+    per = -(-n // len(groups))
+    return np.sort(np.concatenate([g[:per] for g in groups]))
 
 
 def to_inputs(batch):
@@ -93,16 +128,17 @@ def to_inputs(batch):
     return env * 0.5, state, target, (env == 2).float()
 
 
-def square_plan(meta):
-    """True when the x <-> y swap maps the map family onto itself: same cell count and extent."""
+def square_grid(meta):
+    """True when the x <-> y swap maps the grid onto itself (nx = ny); sigma's x and y are
+    swapped with it, so a 60 x 40 m floor becomes a 40 x 60 m one the network is told of."""
     nx, ny, _ = meta["dims"]
-    lo, hi = meta["bounds"]["min"], meta["bounds"]["max"]
-    return nx == ny and abs((hi[0] - lo[0]) - (hi[1] - lo[1])) < 1e-9
+    return nx == ny
 
 
-def augment(batch, code, swap_xy):
+def augment(batch, sigma, code, swap_xy):
     """Applies per sample the symmetry code (bit 0: mirror x, bit 1: mirror y, bit 2: swap x
-    and y) to uint8 [B, 3, nz, ny, nx]; code is an int tensor [B] on the batch's device."""
+    and y) to uint8 [B, 3, nz, ny, nx] and its sigma [B, 3]; code is an int tensor [B] on the
+    batch's device."""
     def where(bit, changed):
         mask = ((code >> bit) & 1).bool().view(-1, 1, 1, 1, 1)
         return torch.where(mask, changed, batch)
@@ -110,7 +146,9 @@ def augment(batch, code, swap_xy):
     batch = where(1, batch.flip(3))
     if swap_xy:
         batch = where(2, batch.transpose(3, 4))
-    return batch
+        swap = ((code >> 2) & 1).bool().view(-1, 1)
+        sigma = torch.where(swap, sigma[:, [1, 0, 2]], sigma)
+    return batch, sigma
 
 
 class ProgressBar:
@@ -143,7 +181,8 @@ def bce(p, label):
 
 def parse_args(argv):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--data", required=True, help="miner dataset folder")
+    ap.add_argument("--data", required=True, nargs="+",
+                    help="miner dataset folders (one per map family; the same grid dims)")
     ap.add_argument("--out", required=True, help="output folder (created)")
     for k, v in DEFAULTS.items():
         ap.add_argument("--" + k.replace("_", "-"), type=type(v), default=v)
@@ -153,6 +192,8 @@ def parse_args(argv):
     ap.add_argument("--stop-after", type=int, default=0,
                     help="stop after this many epochs in all, leaving the --checkpoint to resume from (no export)")
     a = ap.parse_args(argv)
+    if a.scale_channels not in (0, 3):
+        raise SystemExit("train: --scale-channels must be 0 or 3")
     if a.epochs < 1 or a.batch < 1 or a.width < 1 or a.threads < 1:
         raise SystemExit("train: --epochs, --batch, --width and --threads must be >= 1")
     if a.schedule not in ("constant", "cosine"):
@@ -190,21 +231,25 @@ def main(argv=None):
     torch.backends.cudnn.benchmark = False
     torch.manual_seed(a.seed)
     dev = torch.device(a.device)
-    meta, train = load_split(a.data, "train")
-    _, val = load_split(a.data, "val")
+    metas, train, train_sigma, _ = load_families(a.data, "train")
+    _, val, val_sigma, val_family = load_families(a.data, "val")
+    meta = metas[0]
     if a.max_train > 0:
-        train = train[:a.max_train]
+        train, train_sigma = train[:a.max_train], train_sigma[:a.max_train]
     if len(train) == 0 or len(val) == 0:
         raise SystemExit("train: the dataset needs train and val samples")
     if any(d % 8 for d in meta["dims"]):
         raise SystemExit("train: the grid dims must be divisible by 8")
     train = torch.from_numpy(train).to(dev)  # uint8 on the device: 96 KiB a sample
-    swap_xy = square_plan(meta)
+    train_sigma = torch.from_numpy(train_sigma).to(dev)
+    swap_xy = square_grid(meta)
     val_endpoints = [quality.endpoints(val[k, 1]) for k in range(len(val))]
+    val_set = {"x": val, "sigma": val_sigma, "family": val_family, "ends": val_endpoints,
+               "names": [m["preset"] for m in metas]}
 
     gen = torch.Generator().manual_seed(a.seed)  # shuffles and symmetries (CPU)
     noise_gen = torch.Generator(device=dev).manual_seed(a.seed + 3)  # noise, drawn on the device
-    G = sgan.Generator(a.width).to(dev)
+    G = sgan.Generator(a.width, a.scale_channels).to(dev)
     Dc, Ds = sgan.Discriminator().to(dev), sgan.Discriminator().to(dev)
     opt_g = torch.optim.Adam(G.parameters(), lr=a.lr_g, betas=(0.5, 0.99))
     opt_d = torch.optim.Adam(list(Dc.parameters()) + list(Ds.parameters()), lr=a.lr_d, betas=(0.5, 0.99))
@@ -238,12 +283,12 @@ def main(argv=None):
                     for group in opt.param_groups:
                         group["lr"] = lr * scale
             idx = torch.sort(order[step * a.batch:(step + 1) * a.batch]).values
-            batch = train[idx.to(dev)]
+            batch, sigma = train[idx.to(dev)], train_sigma[idx.to(dev)]
             if a.augment:
-                batch = augment(batch, codes[idx].to(dev), swap_xy)
+                batch, sigma = augment(batch, sigma, codes[idx].to(dev), swap_xy)
             env, state, target, solid = to_inputs(batch)
             noise = torch.randn(env.shape, generator=noise_gen, device=dev)
-            o = G(env, state, noise)
+            o = G(env, state, noise, sigma)
             # Discriminators: real = ground truth, fake = generated (Eqs. connectivity/safety_loss).
             l_dc = bce(Dc(target, state), 1.0) + bce(Dc(o.detach(), state), 0.0)
             l_ds = bce(Ds(target, env), 1.0) + bce(Ds(o.detach(), env), 0.0)
@@ -265,7 +310,7 @@ def main(argv=None):
             opt_g.step()
             sums += torch.stack([loss, adv, l_bce, l_cont, l_safe, l_dc + l_ds]).detach().double()
         bar.update(steps_per_epoch)
-        scan = evaluate(G, val, val_endpoints, a, dev)
+        scan = evaluate(G, val_set, a, dev)
         pick = best_threshold(scan)
         entry = {"epoch": epoch + 1,
                  **{k: float(v / steps_per_epoch) for k, v in
@@ -288,10 +333,11 @@ def main(argv=None):
     # again on the whole validation split.
     G.load_state_dict(best["G"])
     a.threshold = best["threshold"]
-    final = evaluate(G, val, val_endpoints, a, dev, all_samples=True)
+    final = evaluate(G, val_set, a, dev, all_samples=True)
     summary = {"selected_epoch": best["epoch"], "threshold": a.threshold,
                **quality_of(next(q for q in final if q["threshold"] == a.threshold)),
-               "threshold_scan": final}
+               "by_family": next(q for q in final if q["threshold"] == a.threshold)["by_family"],
+               "threshold_scan": [{k: v for k, v in q.items() if k != "by_family"} for q in final]}
     print(json.dumps({k: v for k, v in summary.items() if k != "threshold_scan"}), flush=True)
     os.makedirs(a.out, exist_ok=True)
     args = list(argv if argv is not None else sys.argv[1:])
@@ -305,7 +351,7 @@ def main(argv=None):
             if x.startswith(flag + "="):
                 del args[i]
                 break
-    export(G, a, meta, val, log, summary, args)
+    export(G, a, metas, val_set, log, summary, args)
 
 
 def options_key(a):
@@ -335,33 +381,44 @@ def best_threshold(scan):
     return max(scan, key=lambda q: (q["val_connectivity_rate_raw"] + q["val_safety_rate_raw"], -abs(q["threshold"] - 0.5)))
 
 
-def evaluate(G, val, val_endpoints, a, dev, all_samples=False):
+def evaluate(G, val_set, a, dev, all_samples=False):
     """Raw connectivity and safety rates on the validation split (quality.py, REQ-HEUR-004) at
-    every candidate threshold; the first --val-samples samples unless all_samples."""
+    every candidate threshold, over all and per family; the first --val-samples samples
+    (balanced over the families) unless all_samples."""
     G.eval()
-    n = len(val) if all_samples or a.val_samples == 0 else min(a.val_samples, len(val))
-    conn = np.zeros(len(a.candidates))
-    safe = np.zeros(len(a.candidates))
+    pick = balanced_first(val_set["family"], 0 if all_samples else a.val_samples)
+    names = val_set["names"]
+    conn = np.zeros((len(a.candidates), len(names)))
+    safe = np.zeros((len(a.candidates), len(names)))
+    count = np.bincount(val_set["family"][pick], minlength=len(names))
     gen = torch.Generator().manual_seed(a.seed + 1)
     with torch.no_grad():
-        for i in range(0, n, a.batch):
-            b = val[i:min(i + a.batch, n)]
+        for i in range(0, len(pick), a.batch):
+            ids = pick[i:i + a.batch]
+            b = val_set["x"][ids]
             env, state, _, _ = to_inputs(b)
             noise = torch.randn(env.shape, generator=gen)
-            p = G(env.to(dev), state.to(dev), noise.to(dev)).cpu().numpy()[:, 0]
-            for k in range(len(b)):
-                ends = val_endpoints[i + k]
+            sigma = torch.from_numpy(val_set["sigma"][ids])
+            p = G(env.to(dev), state.to(dev), noise.to(dev), sigma.to(dev)).cpu().numpy()[:, 0]
+            for k, v in enumerate(ids):
+                ends = val_set["ends"][v]
+                fam = val_set["family"][v]
                 solid = b[k, 0] == 2
                 for j, t in enumerate(a.candidates):
                     region = p[k] >= t
-                    conn[j] += ends[0] is not None and quality.connected(region, *ends)
-                    safe[j] += not bool((region & solid).any())
+                    conn[j, fam] += ends[0] is not None and quality.connected(region, *ends)
+                    safe[j, fam] += not bool((region & solid).any())
     G.train()
-    return [{"threshold": t, "val_connectivity_rate_raw": conn[j] / n, "val_safety_rate_raw": safe[j] / n}
+    n = len(pick)
+    return [{"threshold": t, "val_connectivity_rate_raw": conn[j].sum() / n, "val_safety_rate_raw": safe[j].sum() / n,
+             "by_family": {names[f]: {"samples": int(count[f]),
+                                      "val_connectivity_rate_raw": conn[j, f] / max(count[f], 1),
+                                      "val_safety_rate_raw": safe[j, f] / max(count[f], 1)}
+                           for f in range(len(names))}}
             for j, t in enumerate(a.candidates)]
 
 
-def export(G, a, meta, val, log, summary, argv):
+def export(G, a, metas, val_set, log, summary, argv):
     G = G.cpu().eval()
     names = [name for name, _, _ in sgan.GENERATOR_LAYERS]
     weights = []
@@ -369,27 +426,34 @@ def export(G, a, meta, val, log, summary, argv):
         conv = G.convs[name]
         weights.append((name + ".weight", conv.weight.detach().numpy()))
         weights.append((name + ".bias", conv.bias.detach().numpy()))
-    arch = {"name": "sgan-unet4", "width": a.width, "dims": meta["dims"], "layers": names,
-            "environment_scale": 0.5, "threshold": a.threshold}
+    arch = {"name": "sgan-unet4", "width": a.width, "dims": metas[0]["dims"], "layers": names,
+            "environment_scale": 0.5, "threshold": a.threshold, "scale_channels": a.scale_channels}
+    if a.scale_channels:
+        arch["scale_divisor"] = sgan.SCALE_DIVISOR
     training = {k: getattr(a, k) for k in DEFAULTS}
-    training.update({"data": os.path.basename(os.path.normpath(a.data)), "data_seed": meta["seed"],
-                     "data_preset": meta["preset"],
-                     "train_samples": int(min(meta["splits"]["train"]["count"], a.max_train or 1 << 30)),
+    training.update({"data": [os.path.basename(os.path.normpath(d)) for d in a.data],
+                     "data_seed": [m["seed"] for m in metas], "data_preset": [m["preset"] for m in metas],
+                     "train_samples": int(min(sum(m["splits"]["train"]["count"] for m in metas), a.max_train or 1 << 62)),
                      "command": "python3 src/python/sgan/train.py " + " ".join(argv) + " --out OUT"})
     tensors.write(os.path.join(a.out, "sgan.bin"), "sgan-weights", weights,
                   {"architecture": arch, "training": training, "final": {**log[-1], **summary}})
     # Reference tensors: the first validation samples with fixed noise, through PyTorch.
     refs = []
     gen = torch.Generator().manual_seed(a.seed + 2)
+    val = val_set["x"]
+    picks = balanced_first(val_set["family"], a.references)[:a.references] if len(val) else []
     with torch.no_grad():
-        for k in range(min(a.references, len(val))):
-            env, state, _, _ = to_inputs(val[k:k + 1])
+        for k, v in enumerate(picks):
+            env, state, _, _ = to_inputs(val[v:v + 1])
             noise = torch.randn(env.shape, generator=gen)
-            out = G(env, state, noise)
+            sigma = torch.from_numpy(val_set["sigma"][v:v + 1])
+            out = G(env, state, noise, sigma)
             refs += [(f"{k}.environment", env[0, 0].numpy()), (f"{k}.state", state[0, 0].numpy()),
                      (f"{k}.noise", noise[0, 0].numpy()), (f"{k}.output", out[0, 0].numpy())]
+            if a.scale_channels:
+                refs.append((f"{k}.scale", sigma[0].numpy()))
     tensors.write(os.path.join(a.out, "reference.bin"), "sgan-reference", refs,
-                  {"samples": min(a.references, len(val)), "weights": "sgan.bin"})
+                  {"samples": len(picks), "weights": "sgan.bin"})
     with open(os.path.join(a.out, "metrics.json"), "w") as f:
         json.dump({"format": "miner-sgan-training-v1", "architecture": arch, "training": training, "epochs": log,
                    "selected": summary},

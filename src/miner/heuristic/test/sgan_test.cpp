@@ -121,7 +121,9 @@ TEST_CASE("The first layer's planar and channels-last kernels agree with each ot
     noise[v] = static_cast<float>(rng.normal_ziggurat());
   }
   state[n / 3] = state[2 * n / 3] = 1.0f;
-  const std::vector<float> a = fast.forward(env, state, noise), b = last.forward(env, state, noise);
+  const std::vector<float> scale = fast.architecture().scale_channels ? std::vector<float>{0.5f, 0.4f, -0.2f}
+                                                                      : std::vector<float>{};
+  const std::vector<float> a = fast.forward(env, state, noise, scale), b = last.forward(env, state, noise, scale);
   double worst = 0.0;
   for (std::size_t v = 0; v < n; ++v) worst = std::max(worst, static_cast<double>(std::fabs(a[v] - b[v])));
   CHECK(worst <= 1e-5);
@@ -133,12 +135,45 @@ TEST_CASE("The same inputs and seed give the same region bytes", "[REQ-HEUR-005]
   std::vector<std::uint8_t> e(n, 0), s(n, 0);
   for (std::size_t i = 0; i < n; i += 7) e[i] = static_cast<std::uint8_t>(i % 3);
   s[5] = s[n - 9] = 1;
+  const miner::world::Box bounds{Eigen::Vector3d::Zero(), Eigen::Vector3d(100, 100, 40)};
   miner::Rng r1(3, 1), r2(3, 1), r3(4, 1);
-  const auto a = g.predict(e, s, r1), b = g.predict(e, s, r2), c = g.predict(e, s, r3);
+  const auto a = g.predict(e, s, bounds, 0.5, r1), b = g.predict(e, s, bounds, 0.5, r2),
+             c = g.predict(e, s, bounds, 0.5, r3);
   CHECK(a == b);
   CHECK(a != c);  // the noise enters the network
   for (float v : a) REQUIRE((v >= 0.0f && v <= 1.0f));
-  CHECK_THROWS_WITH(g.predict(std::vector<std::uint8_t>(10, 0), s, r1), Contains("cells"));
+  CHECK_THROWS_WITH(g.predict(std::vector<std::uint8_t>(10, 0), s, bounds, 0.5, r1), Contains("cells"));
+}
+
+TEST_CASE("The network is told its cells' metric size: sigma = log2(cell / radius) / divisor", "[REQ-HEUR-013]") {
+  // A 64 x 32 x 8 m box on a 32^3 grid for a 0.5 m robot: cells of 2, 1 and 0.25 m, i.e. 4, 2
+  // and 1/2 radii: log2 gives 2, 1, -1; divided by 4.
+  const miner::world::Box box{Eigen::Vector3d::Zero(), Eigen::Vector3d(64, 32, 8)};
+  const std::vector<float> sigma = heuristic::scale_input(box, Eigen::Vector3i(32, 32, 32), 0.5, 4.0);
+  REQUIRE(sigma.size() == 3);
+  CHECK(sigma[0] == 0.5f);
+  CHECK(sigma[1] == 0.25f);
+  CHECK(sigma[2] == -0.25f);
+  CHECK_THROWS_WITH(heuristic::scale_input(box, Eigen::Vector3i(32, 32, 32), -0.1, 4.0), Contains("radius"));
+  // A point robot, and cells of 2^12 radii, get the limit instead of infinity or 3.
+  for (double r : {0.0, 2.0 / 4096.0}) CHECK(heuristic::scale_input(box, Eigen::Vector3i(32, 32, 32), r, 4.0)[0] == 2.0f);
+  const miner::world::Box flat{Eigen::Vector3d::Zero(), Eigen::Vector3d(64, 32, 0)};
+  CHECK_THROWS_WITH(heuristic::scale_input(flat, Eigen::Vector3i(32, 32, 32), 0.5, 4.0), Contains("cells"));
+  // The shipped network takes sigma, and it changes the answer: the same E, S and noise on a
+  // 10 m and on a 200 m map give different probabilities.
+  const heuristic::Sgan g = heuristic::Sgan::builtin();
+  REQUIRE(g.architecture().scale_channels == 3);
+  const auto n = static_cast<std::size_t>(g.architecture().dims.prod());
+  std::vector<std::uint8_t> e(n, 0), s(n, 0);
+  for (std::size_t i = 0; i < n; i += 5) e[i] = 1;
+  s[40] = s[n - 40] = 1;
+  miner::Rng r1(3, 1), r2(3, 1);
+  const miner::world::Box small{Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(10.0)};
+  const miner::world::Box large{Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(200.0)};
+  CHECK(g.predict(e, s, small, 0.3, r1) != g.predict(e, s, large, 0.3, r2));
+  // A forward call with the wrong number of scale values is refused.
+  std::vector<float> env(n, 0.0f), st(n, 0.0f), noise(n, 0.0f);
+  CHECK_THROWS_WITH(g.forward(env, st, noise, {0.1f}), Contains("scale input of 3"));
 }
 
 TEST_CASE("A missing, truncated, altered or mismatched weights file is refused naming the fault", "[REQ-HEUR-006]") {

@@ -279,6 +279,23 @@ TEST_CASE("A dataset folder that contradicts itself is refused naming the file a
         edit_json(q0 + "/train-index.json", [](miner::Json& d) { d[0]["astar_cost"] = -5; });
       },
       "astar_cost: is -5, shorter than the straight line from start to goal");
+  // The map's bounds (the sGAN's scale input, REQ-HEUR-013): missing, empty, or not holding
+  // the query.
+  refused(
+      [&](const std::string& q0, const std::string&) {
+        edit_json(q0 + "/train-index.json", [](miner::Json& d) { d[0].erase("bounds"); });
+      },
+      "bounds");
+  refused(
+      [&](const std::string& q0, const std::string&) {
+        edit_json(q0 + "/train-index.json", [](miner::Json& d) { d[0]["bounds"]["max"][2] = -1.0; });
+      },
+      "min must be below max");
+  refused(
+      [&](const std::string& q0, const std::string&) {
+        edit_json(q0 + "/train-index.json", [](miner::Json& d) { d[0]["start"][0] = 1e6; });
+      },
+      "start: lies outside the sample's bounds");
 }
 
 TEST_CASE("Bad dataset options are refused naming the option", "[REQ-HEUR-003]") {

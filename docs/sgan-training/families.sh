@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# The recipe of the shipped weights (fixtures/sgan) and of the leave-one-family-out ones
+# (fixtures/sgan/lofo), session 13. Data here (2 cores: ~17 min, scan alone 8.5 min); training
+# on one H100, all eight runs at once (~6.5 min; an epoch of 10 260 samples ~20 s shared).
+#   bash docs/sgan-training/families.sh data    [miner]   -> fam-*/ (train, val, 40 test maps each)
+#   bash docs/sgan-training/families.sh train   [cuda]    -> runs/all, runs/without-F
+set -euo pipefail
+families=(sim indoor cluttered rooms forest multilevel scan)
+declare -A count=([sim]=2000 [indoor]=1200 [cluttered]=2000 [rooms]=2000 [forest]=2000 [multilevel]=1500 [scan]=700)
+case "${1:-}" in
+  data)
+    miner=${2:-build/release/miner}
+    for f in "${families[@]}"; do
+      "$miner" dataset --preset "$f" --count "${count[$f]}" --test-count 40 --seed 11 --jobs 2 --quiet --out "fam-$f"
+    done ;;
+  train)
+    device=${2:-cuda}
+    here=$(cd "$(dirname "$0")/../.." && pwd)
+    all=(); for f in "${families[@]}"; do all+=("fam-$f"); done
+    python3 "$here/src/python/sgan/train.py" --data "${all[@]}" --device "$device" --threads 1 --width 8 \
+      --epochs 18 --val-samples 280 --out runs/all > runs-all.log &
+    for held in "${families[@]}"; do
+      rest=(); for f in "${families[@]}"; do [ "$f" != "$held" ] && rest+=("fam-$f"); done
+      python3 "$here/src/python/sgan/train.py" --data "${rest[@]}" --device "$device" --threads 1 --width 8 \
+        --epochs 12 --val-samples 280 --out "runs/without-$held" > "runs-without-$held.log" &
+    done
+    wait ;;
+  *) echo "usage: $0 data [miner] | train [cuda]" >&2; exit 2 ;;
+esac

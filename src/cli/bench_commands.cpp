@@ -210,8 +210,8 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
       ->capture_default_str()->check(finite_in(1e-4, 3600.0));
   pc->add_option("--jobs", p->bench.jobs, "threads for generating the heuristic test set")->capture_default_str()
       ->check(integer_in(1, 256));
-  pc->add_option("--results", p->results, "the Markdown file to write")->capture_default_str()->check(kOutputFileNewFolder);
-  pc->add_option("--figures", p->figures, "folder for the box plots (default: <results folder>/results)")
+  pc->add_option("--out,--results", p->results, "the Markdown report to write (--results: its former name)")->capture_default_str()->check(kOutputFileNewFolder);
+  pc->add_option("--figures", p->figures, "folder for the box plots (default: <--out's folder>/results)")
       ->check(kOutputFolder);
   pc->add_flag("--json", p->json, "print every figure as JSON");
   pc->add_flag("--quiet", p->quiet, "no progress on stderr");
@@ -264,8 +264,8 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   sc->add_option("--iterations", su->bench.max_iterations, "iteration budget per run")->capture_default_str()
       ->check(kIterationsRange);
   sc->add_option("--weights", su->bench.weights, "sGAN weights (default: the shipped ones)");
-  sc->add_option("--results", su->results, "the Markdown file to write")->capture_default_str()->check(kOutputFileNewFolder);
-  sc->add_option("--figures", su->figures, "folder for the box plots (default: <results folder>/suite)")
+  sc->add_option("--out,--results", su->results, "the Markdown report to write (--results: its former name)")->capture_default_str()->check(kOutputFileNewFolder);
+  sc->add_option("--figures", su->figures, "folder for the box plots (default: <--out's folder>/suite)")
       ->check(kOutputFolder);
   sc->add_flag("--json", su->json, "print every figure as JSON");
   sc->add_flag("--quiet", su->quiet, "no progress on stderr");

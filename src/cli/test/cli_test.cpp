@@ -722,7 +722,7 @@ TEST_CASE("miner bench paper writes the four tables beside the paper's numbers, 
   const Run r = miner_cli({"bench", "paper", "--maps", src + "/fixtures/maps/sim-1.json", "--planners",
                            "rrtstar,miner-sgan,miner,ompl:RRTConnect", "--runs", "2", "--time-limit", "0.2",
                            "--heuristic-samples", "2", "--heuristic-iterations", "300", "--backend-budget", "0.005",
-                           "--tracking-maps", src + "/fixtures/maps/indoor-2.json", "--results", results, "--quiet"});
+                           "--tracking-maps", src + "/fixtures/maps/indoor-2.json", "--out", results, "--quiet"});
   INFO(r.err);
   REQUIRE(r.code == 0);
   const std::string md = read(results);

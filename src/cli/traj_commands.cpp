@@ -16,6 +16,7 @@ struct SolveOptions {
   std::string out;
   std::string allocate;
   std::optional<double> rho;
+  bool json = false;
 };
 
 void run_solve(const SolveOptions& o, std::ostream& out) {
@@ -28,6 +29,10 @@ void run_solve(const SolveOptions& o, std::ostream& out) {
     out << dump_json(answer);
   } else {
     write_file_atomic(o.out, dump_json(answer));
+    if (o.json) {
+      out << dump_json(answer);
+      return;
+    }
     out << "wrote " << o.out << ": " << answer["durations"].size() << " segments, order "
         << problem.order << ", cost " << answer["cost"].get<double>() << "\n";
   }
@@ -46,6 +51,7 @@ void add_traj_commands(CLI::App& app, std::ostream& out) {
       ->check(CLI::IsMember({"trapezoid", "optimise"}));
   s->add_option("--rho", solve->rho, "weight of the total time with --allocate optimise (default 1, or the file's)")
       ->check(finite_in(1e-9, 1e9));
+  s->add_flag("--json", solve->json, "print the answer JSON on stdout (what it prints without --out; with --out, as well)");
   s->callback([solve, &out] { run_solve(*solve, out); });
 }
 

@@ -531,6 +531,12 @@ TEST_CASE("traj solve answers the problem contract on stdout or in --out", "[REQ
   const Run w = miner_cli({"traj", "solve", "--problem", problem, "--out", out});
   REQUIRE(w.code == 0);
   CHECK(miner::read_json_file(out) == doc);
+  CHECK_THAT(w.out, Contains("wrote"));
+  // --json with --out: the file and the same JSON on stdout (every command takes --json).
+  const Run wj = miner_cli({"traj", "solve", "--problem", problem, "--out", dir() + "/answer-j.json", "--json"});
+  REQUIRE(wj.code == 0);
+  CHECK(miner::parse_json(wj.out, "stdout") == doc);
+  CHECK(miner::read_json_file(dir() + "/answer-j.json") == doc);
   const std::string bad = write("bad-problem.json", R"({"order": 3, "points": [[0,0,0],[0,0,0]],
     "head": [[0,0,0],[0,0,0],[0,0,0]], "tail": [[0,0,0],[0,0,0],[0,0,0]], "durations": [1]})");
   const Run e = miner_cli({"traj", "solve", "--problem", bad, "--out", out});

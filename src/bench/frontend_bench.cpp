@@ -155,7 +155,7 @@ FrontendBenchResult run_frontend_bench(const world::Map& map, const std::string&
           ? plan::astar_dilated_region(problem, reference, options.region_dims, options.region_dilation)
           : plan::HeuristicRegion::load(options.region_file);
   out.region_ms = elapsed_ms(region_start);
-  region.require_matches(map, "bench frontend");
+  region.require_matches(map, options.region_file.empty() ? std::string("bench frontend") : options.region_file);
   out.region_source = options.region_file.empty() ? region.source() : options.region_file;
   out.region_cells = region.cells().size();
 

@@ -80,6 +80,7 @@ void run_plan(PlanCliOptions o, std::ostream& out) {
       region = plan::astar_dilated_region(problem, need_reference(), dims, o.grid.dilation);
     } else {
       region = plan::HeuristicRegion::load(o.region);
+      region->require_matches(q.map, o.region);  // names the file (issue 20, N14)
     }
   }
   const plan::PlanResult r = plan::plan(problem, o.planner_options, region ? &*region : nullptr);

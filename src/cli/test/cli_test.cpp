@@ -617,7 +617,7 @@ TEST_CASE("plan: bad input is named, an unreachable goal exits 3", "[REQ-CLI-004
   const Run mismatch = miner_cli({"plan", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5",
                                   "--planner", "miner", "--region", region});
   CHECK(mismatch.code == 1);
-  CHECK_THAT(mismatch.err, Contains("do not match the map's bounds"));
+  CHECK_THAT(mismatch.err, Contains("bad-region.json: region bounds") && Contains("do not match the map's bounds"));
   // A closed wall: the goal is unreachable; the budget ends the run with exit 3.
   const std::string closed = write("closed.json", R"({"format": "miner-map-v1",
     "bounds": {"min": [0,0,0], "max": [10,10,3]}, "resolution": 0.5,

@@ -4,9 +4,11 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <set>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include <unistd.h>
@@ -48,33 +50,61 @@ Json parse_json(const std::string& text, const std::string& origin) {
                     std::to_string(i));
     } else if (c == ']' || c == '}') {
       --depth;
+    } else if (c == '-' || (c >= '0' && c <= '9')) {
+      // A number the JSON library would silently turn into 0 (1e-400), lose precision in
+      // (a subnormal) or into infinity (1e400) is refused here, where its text is still known
+      // (issue 20, N13: "robot_radius": 1e-400 was read as 0 before any range check).
+      std::size_t end = i;
+      bool nonzero = false, exponent = false;
+      while (end < text.size() && (std::isdigit(static_cast<unsigned char>(text[end])) || text[end] == '-' ||
+                                   text[end] == '+' || text[end] == '.' || text[end] == 'e' || text[end] == 'E')) {
+        if (text[end] == 'e' || text[end] == 'E') exponent = true;
+        if (!exponent && text[end] >= '1' && text[end] <= '9') nonzero = true;
+        ++end;
+      }
+      const std::string token = text.substr(i, end - i);
+      const double v = std::strtod(token.c_str(), nullptr);
+      if ((nonzero && std::fabs(v) < std::numeric_limits<double>::min()) || std::isinf(v))
+        throw Error(origin + ": the number " + token + " at byte " + std::to_string(i) + " is " +
+                    (std::isinf(v) ? "beyond the largest double" : "below the smallest normal double (2.2e-308)") +
+                    ": it would not be read as written");
+      i = end - 1;
     }
   }
   // An object that names a key twice is refused (issue 20: the JSON library keeps the last
   // one, so `"resolution": 0.25, "resolution": 0.5` silently read 0.5).
   std::vector<std::set<std::string>> keys;  // the keys of each open object
-  std::vector<std::string> path;            // the key each open object was reached by
+  // Each open container's name: the key it was reached by, with "[]" for an array (an element
+  // of an array is reached by no key), so a key is named by its dotted path, "obstacles[].min".
+  std::vector<std::string> containers;
   std::string last_key;
   const Json::parser_callback_t no_duplicates = [&](int, Json::parse_event_t event, Json& parsed) {
     switch (event) {
       case Json::parse_event_t::object_start:
         keys.emplace_back();
-        path.push_back(last_key);
+        containers.push_back(last_key);
         break;
       case Json::parse_event_t::key:
         last_key = parsed.get<std::string>();
         if (!keys.back().insert(last_key).second) {
           std::string where;
-          for (std::size_t i = 1; i < path.size(); ++i) where += (path[i].empty() ? "[]" : path[i]) + ".";
+          for (const std::string& c : containers)
+            if (!c.empty()) where += (where.empty() || c == "[]" ? "" : ".") + c;
+          if (!where.empty()) where += ".";
           throw Error(origin + ": " + where + last_key + ": the key appears twice in one object (which one is meant?)");
         }
         break;
-      case Json::parse_event_t::object_end:
-        keys.pop_back();
-        path.pop_back();
+      case Json::parse_event_t::array_start:
+        containers.push_back(last_key + "[]");
         last_key.clear();
         break;
-      case Json::parse_event_t::array_start:
+      case Json::parse_event_t::object_end:
+        keys.pop_back();
+        containers.pop_back();
+        last_key.clear();
+        break;
+      case Json::parse_event_t::array_end:
+        containers.pop_back();
         last_key.clear();
         break;
       default:

@@ -34,7 +34,7 @@ TEST_CASE("Malformed JSON names the file and the byte offset", "[REQ-CORE-003]")
                     Contains("x.json: malformed JSON at byte 13"));
   CHECK_THROWS_WITH(miner::parse_json("{\"a\": NaN}", "y.json"), Contains("y.json: malformed JSON"));
   CHECK_THROWS_WITH(miner::parse_json("{\"a\": 1e999}", "z.json"),
-                    Contains("z.json: invalid JSON: [json.exception.out_of_range.406] number overflow"));
+                    Contains("z.json: the number 1e999 at byte 6 is beyond the largest double"));
   CHECK_THROWS_WITH(miner::read_json_file("/nonexistent/file.json"),
                     Contains("/nonexistent/file.json: cannot open file"));
 }
@@ -44,8 +44,26 @@ TEST_CASE("A key named twice in one object is refused, naming it", "[REQ-CORE-00
                     Contains("m.json: resolution: the key appears twice"));
   CHECK_THROWS_WITH(miner::parse_json(R"({"a": {"b": 1, "c": {"d": 1, "d": 2}}})", "x.json"),
                     Contains("x.json: a.c.d: the key appears twice"));
+  // Inside an array: the array's key and [] (issue 20, N14: was "[].min").
+  CHECK_THROWS_WITH(miner::parse_json(R"({"obstacles": [{"min": 1}, {"min": 1, "min": 2}]})", "o.json"),
+                    Contains("o.json: obstacles[].min: the key appears twice"));
+  CHECK_THROWS_WITH(miner::parse_json(R"({"a": [[{"k": 1, "k": 2}]]})", "n.json"), Contains("n.json: a[][].k: the key"));
   // The same key in different objects, or in objects of an array, is fine.
   CHECK_NOTHROW(miner::parse_json(R"({"a": {"k": 1}, "b": {"k": 2}, "l": [{"k": 1}, {"k": 2}], "k": 3})", "ok.json"));
+}
+
+TEST_CASE("A number the JSON library would not read as written is refused, naming it", "[REQ-CORE-003]") {
+  // Issue 20, N13: 1e-400 was read as 0 before any range check saw it.
+  CHECK_THROWS_WITH(miner::parse_json(R"({"robot_radius": 1e-400})", "s.json"),
+                    Contains("s.json: the number 1e-400 at byte 17 is below the smallest normal double"));
+  CHECK_THROWS_WITH(miner::parse_json(R"({"v": [1, -2.5e-320]})", "s.json"), Contains("-2.5e-320"));
+  CHECK_THROWS_WITH(miner::parse_json(R"({"v": 1e400})", "s.json"), Contains("beyond the largest double"));
+  // Zeros written any way, the smallest normal double and ordinary numbers are read.
+  const miner::Json ok = miner::parse_json(R"({"a": 0, "b": -0.0, "c": 0e-500, "d": 2.3e-308, "e": -12.5e3, "k1e-400": "1e-400"})", "ok.json");
+  CHECK(ok["c"].get<double>() == 0.0);
+  CHECK(ok["d"].get<double>() == 2.3e-308);
+  CHECK(ok["e"].get<double>() == -12500.0);
+  CHECK(ok["k1e-400"] == "1e-400");  // inside strings nothing is a number
 }
 
 TEST_CASE("Field access names the dotted path and the type found", "[REQ-CORE-003]") {

@@ -12,6 +12,11 @@
 #include "miner/core/json_io.hpp"
 #include "miner/core/progress.hpp"
 #include "miner/heuristic/dataset.hpp"
+#include "miner/heuristic/grid.hpp"
+#include "miner/plan/heuristic_region.hpp"
+#include "miner/world/astar.hpp"
+#include "miner/world/map_generator.hpp"
+#include "miner/world/voxel_grid.hpp"
 
 using Catch::Matchers::Contains;
 namespace heuristic = miner::heuristic;
@@ -160,6 +165,37 @@ TEST_CASE("A sample's state marks 3x3x3 cubes at start and goal and its target i
   CHECK(seen[cell(s.goal)] == 1);
   CHECK(heuristic::solid_cells_in(s.target, s.environment) == 0);
   CHECK(s.astar_cost >= (s.goal - s.start).norm());
+}
+
+TEST_CASE("T is the A* path's cells and the free cells of their dilation, never a partial cell off the path",
+          "[REQ-HEUR-002]") {
+  std::size_t partial_dropped_all = 0;  // the rule is exercised: some tube cells are partial
+  for (const char* preset : {"indoor", "cluttered", "rooms"}) {
+    INFO(preset);
+    auto o = small_options();
+    o.preset = preset;
+    const heuristic::Sample s = heuristic::make_sample(o, 1);
+    // The same A* path again, from the sample's map and query.
+    const miner::world::GeneratorPreset p = miner::world::generator_preset(preset);
+    const miner::world::Map map = miner::world::generate_map(p, s.map_seed);
+    const miner::world::VoxelGrid grid(map, p.robot_radius);
+    const miner::world::GridPath path = miner::world::astar(map, grid, s.start, s.goal);
+    REQUIRE(path.cost == Approx(s.astar_cost));
+    const auto own = miner::plan::HeuristicRegion::from_path(map.bounds(), o.dims, path.points, 0, "own");
+    const auto tube = miner::plan::HeuristicRegion::from_path(map.bounds(), o.dims, path.points, 1, "tube");
+    std::vector<std::uint8_t> on(s.target.size(), 0), in_tube(s.target.size(), 0);
+    for (std::size_t c : own.cells()) on[c] = 1;
+    for (std::size_t c : tube.cells()) in_tube[c] = 1;
+    std::size_t partial_dropped = 0;
+    for (std::size_t c = 0; c < s.target.size(); ++c) {
+      const bool want = on[c] || (in_tube[c] && s.environment[c] == heuristic::kFree);
+      REQUIRE(static_cast<bool>(s.target[c]) == want);
+      partial_dropped += in_tube[c] && !on[c] && s.environment[c] == heuristic::kPartial;
+    }
+    CHECK(std::count(on.begin(), on.end(), 1) > 0);
+    partial_dropped_all += partial_dropped;
+  }
+  CHECK(partial_dropped_all > 0);
 }
 
 TEST_CASE("The dataset has its splits, unseen test seeds and the same bytes for a seed", "[REQ-HEUR-001]") {

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The recipe of the shipped weights (fixtures/sgan) and of the leave-one-family-out ones
 # (fixtures/sgan/lofo), session 13. Data here (2 cores: ~17 min, scan alone 8.5 min); training
-# on one H100, all eight runs at once (~6.5 min; an epoch of 10 260 samples ~20 s shared).
+# on one H100, all eight runs at once (~6 min).
 #   bash docs/sgan-training/families.sh data    [miner]   -> fam-*/ (train, val, 40 test maps each)
 #   bash docs/sgan-training/families.sh train   [cuda]    -> runs/all, runs/without-F
 set -euo pipefail
@@ -18,11 +18,11 @@ case "${1:-}" in
     here=$(cd "$(dirname "$0")/../.." && pwd)
     all=(); for f in "${families[@]}"; do all+=("fam-$f"); done
     python3 "$here/src/python/sgan/train.py" --data "${all[@]}" --device "$device" --threads 1 --width 8 \
-      --epochs 18 --val-samples 280 --out runs/all > runs-all.log &
+      --epochs 16 --val-samples 280 --out runs/all > runs-all.log &
     for held in "${families[@]}"; do
       rest=(); for f in "${families[@]}"; do [ "$f" != "$held" ] && rest+=("fam-$f"); done
       python3 "$here/src/python/sgan/train.py" --data "${rest[@]}" --device "$device" --threads 1 --width 8 \
-        --epochs 12 --val-samples 280 --out "runs/without-$held" > "runs-without-$held.log" &
+        --epochs 8 --val-samples 280 --out "runs/without-$held" > "runs-without-$held.log" &
     done
     wait ;;
   *) echo "usage: $0 data [miner] | train [cuda]" >&2; exit 2 ;;

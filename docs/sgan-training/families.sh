@@ -3,7 +3,7 @@
 # (fixtures/sgan/lofo), session 13. Data here (2 cores: ~17 min, scan alone 8.5 min); training
 # on one H100, all eight runs at once (~6 min).
 #   bash docs/sgan-training/families.sh data    [miner]   -> fam-*/ (train, val, 40 test maps each)
-#   bash docs/sgan-training/families.sh train   [cuda]    -> runs/all, runs/without-F
+#   bash docs/sgan-training/families.sh train   [cuda]    -> runs/all, runs/without-F (sgan-0.1.bin: shipped)
 set -euo pipefail
 families=(sim indoor cluttered rooms forest multilevel scan)
 declare -A count=([sim]=2000 [indoor]=1200 [cluttered]=2000 [rooms]=2000 [forest]=2000 [multilevel]=1500 [scan]=700)
@@ -24,6 +24,11 @@ case "${1:-}" in
       python3 "$here/src/python/sgan/train.py" --data "${rest[@]}" --device "$device" --threads 1 --width 8 \
         --epochs 8 --val-samples 280 --out "runs/without-$held" > "runs-without-$held.log" &
     done
-    wait ;;
+    wait
+    # The threshold, chosen on the validation split by the strict rates (docs/heuristic.md):
+    for r in runs/all runs/without-*; do
+      python3 "$here/src/python/sgan/set_threshold.py" --weights "$r/sgan.bin" --threshold 0.1 \
+        --reason "chosen on the validation split by strict connectivity + safety" --out "$r/sgan-0.1.bin"
+    done ;;
   *) echo "usage: $0 data [miner] | train [cuda]" >&2; exit 2 ;;
 esac

@@ -12,6 +12,7 @@
 #include "bench/ompl_planners.hpp"
 #include "cli/cli.hpp"
 #include "miner/core/json_io.hpp"
+#include "miner/heuristic/sgan.hpp"
 #include "miner/pipeline/scenario.hpp"
 #include "miner/plan/heuristic_region.hpp"
 
@@ -1091,6 +1092,21 @@ TEST_CASE("Training is deterministic for a seed and exports weights C++ loads an
   CHECK(miner_cli({"sgan", "check", "--weights", dir() + "/train-two/sgan.bin", "--reference",
                    dir() + "/train-two/reference.bin"})
             .code == 0);
+  // set_threshold.py: the same tensors with another threshold and the reason recorded; C++
+  // loads it, uses the new threshold and still agrees with the reference.
+  const std::string set = std::string(MINER_TORCH_PYTHON) + " " + MINER_SOURCE_DIR + "/src/python/sgan/set_threshold.py";
+  REQUIRE(std::system((set + " --weights " + dir() + "/train-two/sgan.bin --threshold 0.15 --reason 'strict rates' --out " +
+                       dir() + "/train-two/sgan-0.15.bin")
+                          .c_str()) == 0);
+  const auto retuned = miner::heuristic::Sgan::load(dir() + "/train-two/sgan-0.15.bin");
+  CHECK(retuned.architecture().threshold == 0.15);
+  CHECK(retuned.meta()["final"]["threshold_override"]["reason"] == "strict rates");
+  CHECK(miner_cli({"sgan", "check", "--weights", dir() + "/train-two/sgan-0.15.bin", "--reference",
+                   dir() + "/train-two/reference.bin"})
+            .code == 0);
+  CHECK(std::system((set + " --weights " + dir() + "/train-two/sgan.bin --threshold 1.5 --reason x --out " + dir() +
+                     "/train-two/bad.bin 2> /dev/null")
+                        .c_str()) != 0);
   // Stopped after epoch 1 and resumed: the same bytes as the run straight through.
   const std::string ckpt = " --checkpoint " + dir() + "/train-e.ckpt";
   REQUIRE(std::system((train + ckpt + " --stop-after 1 --epochs 2 --out " + dir() + "/train-e > /dev/null 2> " + dir() +

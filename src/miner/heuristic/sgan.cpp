@@ -123,13 +123,14 @@ struct Conv {
 /// A 3x3x3 convolution (padding 1) with fused ReLU from src to dst, weights in the layout
 /// oneDNN picks for the kernel it chooses.
 dnnl::convolution_forward::primitive_desc relu_conv(const dnnl::engine& engine, const memory::desc& src,
-                                                    const memory::desc& dst, int stride) {
+                                                    const memory::desc& dst, int stride, bool accumulate = false) {
   const memory::dim cin = src.dims()[1], cout = dst.dims()[1];
   const dnnl::convolution_forward::desc cd(
       dnnl::prop_kind::forward_inference, dnnl::algorithm::convolution_direct, src,
       memory::desc({cout, cin, 3, 3, 3}, Type::f32, Tag::any), memory::desc({cout}, Type::f32, Tag::a), dst,
       {stride, stride, stride}, {1, 1, 1}, {1, 1, 1});
   dnnl::post_ops po;
+  if (accumulate) po.append_sum(1.0f);  // dst = relu(conv(src) + bias + dst)
   po.append_eltwise(1.0f, dnnl::algorithm::eltwise_relu, 0.0f, 0.0f);
   dnnl::primitive_attr attr;
   attr.set_post_ops(po);
@@ -149,12 +150,84 @@ void set_conv(Conv& c, const dnnl::convolution_forward::primitive_desc& pd, cons
   std::copy(bias.values.begin(), bias.values.end(), static_cast<float*>(c.bias.get_data_handle()));
 }
 
+/// The part of a 3x3x3 convolution (padding 1) that reads an upsampled source, computed on the
+/// source's own (coarse) grid. With up2 nearest-neighbour, fine voxel f = 2i + p (per axis,
+/// parity p) reads coarse voxels i - 1, i, i (taps -1, 0, +1) when p = 0 and i, i, i + 1 when
+/// p = 1: two distinct coarse taps per axis. So conv3(up2(x))[2i + p] =
+/// sum over j in {0, 1}^3 of M_p[j] x[i + p + j - 1], M_p the 3x3x3 kernel's taps summed into
+/// 2x2x2 by parity: one 2x2x2 convolution of x with padding 1 (output n + 1 per axis) whose
+/// 8 cout output channels are the 8 parities, read back at q = i + p. 8 x 8 / 27 of the
+/// multiply-adds of the fine convolution (on d2: 4.2 M instead of 14.2 M), and no upsampled
+/// copy of x. Float sums in another order than PyTorch's: a few ulps (kReferenceTolerance).
+struct UpsampledPart {
+  dnnl::convolution_forward primitive;
+  memory weights, src, dst;
+  int cout = 0;
+  Activation parities;  // 8 cout channels (parity p = 4 pz + 2 py + px first) on the (n + 1)^3 grid
+};
+
+/// Which of the two coarse taps fine tap k (0, 1, 2 for -1, 0, +1) reads at parity p.
+constexpr int kCoarseTap[2][3] = {{0, 1, 1}, {0, 0, 1}};
+
+/// Builds u from layer weights w (cout x cin_total x 3^3, PyTorch's oidhw) for the up-sampled
+/// source x, the first x.channels input channels of the layer.
+void set_upsampled_part(UpsampledPart& u, const dnnl::engine& engine, dnnl::stream& stream, const Tensor& w,
+                        int cout, int cin_total, Activation& x) {
+  const int cu = x.channels;
+  u.cout = cout;
+  u.parities = Activation(8 * cout, x.dims + Eigen::Vector3i::Ones());
+  std::vector<float> merged(static_cast<std::size_t>(8 * cout * cu * 8), 0.0f);  // oidhw, 2x2x2
+  for (int p = 0; p < 8; ++p) {
+    const int pz = p >> 2, py = (p >> 1) & 1, px = p & 1;
+    for (int o = 0; o < cout; ++o)
+      for (int c = 0; c < cu; ++c)
+        for (int t = 0; t < 27; ++t) {
+          const int j = kCoarseTap[pz][t / 9] * 4 + kCoarseTap[py][t / 3 % 3] * 2 + kCoarseTap[px][t % 3];
+          merged[static_cast<std::size_t>(((p * cout + o) * cu + c) * 8 + j)] +=
+              w.values[static_cast<std::size_t>((o * cin_total + c) * 27 + t)];
+        }
+  }
+  const memory::desc wd({8 * cout, cu, 2, 2, 2}, Type::f32, Tag::any);
+  const dnnl::convolution_forward::primitive_desc pd(
+      dnnl::convolution_forward::desc(dnnl::prop_kind::forward_inference, dnnl::algorithm::convolution_direct,
+                                      x.desc(), wd, u.parities.desc(), {1, 1, 1}, {1, 1, 1}, {1, 1, 1}),
+      engine);
+  u.primitive = dnnl::convolution_forward(pd);
+  memory user(memory::desc({8 * cout, cu, 2, 2, 2}, Type::f32, Tag::oidhw), engine, merged.data());
+  u.weights = memory(pd.weights_desc(), engine);
+  dnnl::reorder(user, u.weights).execute(stream, user, u.weights);
+  stream.wait();
+  u.src = memory(x.desc(), engine, x.data.data());
+  u.dst = memory(u.parities.desc(), engine, u.parities.data.data());
+}
+
+/// dst (cout channels on the fine grid, planes z0 on) <- u's parities read back at each fine
+/// voxel: dst[f][o] = parities[q][p cout + o], q_a = (f_a + 1) / 2, p_a = f_a mod 2.
+void scatter_parities(Activation& dst, const UpsampledPart& u, int z0 = 0) {
+  const Eigen::Vector3i d = dst.dims, qd = u.parities.dims;
+  const auto co = static_cast<std::size_t>(u.cout), qc = static_cast<std::size_t>(u.parities.channels);
+  float* out = dst.data.data();
+  for (int z = z0; z < z0 + d.z(); ++z)
+    for (int y = 0; y < d.y(); ++y) {
+      const std::size_t row = (static_cast<std::size_t>((z + 1) / 2) * static_cast<std::size_t>(qd.y()) +
+                               static_cast<std::size_t>((y + 1) / 2)) *
+                              static_cast<std::size_t>(qd.x());
+      const std::size_t pzy = static_cast<std::size_t>((z & 1) * 4 + (y & 1) * 2);
+      for (int x = 0; x < d.x(); ++x, out += co) {
+        const float* q = u.parities.data.data() + (row + static_cast<std::size_t>((x + 1) / 2)) * qc +
+                         (pzy + static_cast<std::size_t>(x & 1)) * co;
+        std::copy(q, q + co, out);
+      }
+    }
+}
+
 constexpr std::size_t kConvs = 9;
 /// The last layer's tap products per voxel: 27, padded to 32 channels (zero filters) so each
 /// voxel's row is 128 bytes and oneDNN's 1x1 kernel takes whole vector blocks (0.28 vs 0.34 ms).
 constexpr int kTapChannels = 32;
 constexpr const char* kLayers[kConvs] = {"enc1", "enc2", "enc3", "enc4", "mid1", "mid2", "dec3", "dec2", "dec1"};
 constexpr int kStrides[kConvs] = {1, 2, 2, 2, 1, 1, 1, 1, 1};
+constexpr std::size_t kFirstDecoder = 6;  // dec3, dec2, dec1 read an up-sampled source
 
 }  // namespace
 
@@ -164,12 +237,18 @@ struct Sgan::Impl {
   SganArchitecture arch;
   dnnl::engine engine{dnnl::engine::kind::cpu, 0};
   // Buffers, in graph order (model.py's names; cat* are the concatenated conv inputs).
-  Activation x0, cond1, a1, c2, a2, cat2, c4, a3, cat3, c8, a4, sigma, cat4, m1, m2, catd3, d3, catd2, d2, catd1, out;
+  Activation x0, cond1, a1, c2, a2, cat2, c4, a3, cat3, c8, a4, sigma, cat4, m1, m2, d3, d2, catd1, out;
+  // The decoder's convolutions split in two: the up-sampled source's part on its coarse grid
+  // (UpsampledPart: m2 for dec3, d3 for dec2, d2 for dec1) and the skip inputs' part (cat3,
+  // cat2, [a1, E/2, S]) on the fine grid, which adds the first (oneDNN's sum post-op; for dec1
+  // in shift_sum_plane). Nothing up-sampled is ever copied.
+  std::array<UpsampledPart, 3> up;
   // The last layer streams plane by plane (catd1 is one plane of its input, taps a ring of three
   // planes of its tap products), so its 7.6 MB of full-grid buffers stay out of the caches.
   Activation taps;                      // 27 tap products per voxel (+5 zero channels), 3 planes
   std::vector<float> last_tap_weights;  // [kTapChannels][cin], oidhw of the 1x1x1 tap convolution
   float last_bias = 0.0f;
+  std::vector<float> plane_base;        // one plane of the logits' start: bias + d2's part (up[2])
   dnnl::eltwise_forward sigmoid;        // R = sigmoid(logits), in place on out
   memory out_memory;
   // The first layer reads a planar (ncdhw) x0 and writes a blocked a1_blocked that a reorder
@@ -276,25 +355,38 @@ void Sgan::Impl::build(const TensorFile& f, Sgan::FirstLayer first_layer) {
   cat4 = Activation(4 * w + 2 + arch.scale_channels, n8);
   m1 = Activation(4 * w, n8);
   m2 = Activation(4 * w, n8);
-  catd3 = Activation(4 * w + 4 * w + 2, n4);
   d3 = Activation(2 * w, n4);
-  catd2 = Activation(2 * w + 2 * w + 2, n2);
   d2 = Activation(2 * w, n2);
-  catd1 = Activation(2 * w + w + 2, Eigen::Vector3i(n1.x(), n1.y(), 1));
+  catd1 = Activation(w + 2, Eigen::Vector3i(n1.x(), n1.y(), 1));
   out = Activation(1, n1);
-  io = {{{&x0, &a1}, {&a1, &a2}, {&cat2, &a3}, {&cat3, &a4}, {&cat4, &m1}, {&m1, &m2}, {&catd3, &d3},
-         {&catd2, &d2}, {&catd1, &out}}};
+  io = {{{&x0, &a1}, {&a1, &a2}, {&cat2, &a3}, {&cat3, &a4}, {&cat4, &m1}, {&m1, &m2}, {&cat3, &d3},
+         {&cat2, &d2}, {&catd1, &out}}};
+  // The up-sampled source of dec3, dec2, dec1 (layers 6, 7, 8), ahead of their skip inputs.
+  const std::array<Activation*, 3> upsampled{&m2, &d3, &d2};
 
   dnnl::stream stream(engine);
   for (std::size_t l = 0; l < kConvs; ++l) {
     Activation& src = *io[l].first;
     Activation& dst = *io[l].second;
-    const int cin = src.channels, cout = dst.channels;
-    const Tensor& wt = f.at(std::string(kLayers[l]) + ".weight", {cout, cin, 3, 3, 3});
+    const int cout = dst.channels;
+    const bool decoder = l >= kFirstDecoder;
+    const int cu = decoder ? upsampled[l - kFirstDecoder]->channels : 0;  // up-sampled channels
+    const int cin = cu + src.channels;
+    const Tensor& full = f.at(std::string(kLayers[l]) + ".weight", {cout, cin, 3, 3, 3});
     const Tensor& bt = f.at(std::string(kLayers[l]) + ".bias", {cout});
-    for (const auto* t : {&wt, &bt})
+    for (const auto* t : {&full, &bt})
       for (float v : t->values)
         if (!std::isfinite(v)) throw Error(f.path + ": layer " + kLayers[l] + " has a non-finite weight");
+    Tensor skip_part;  // a decoder layer's weights of its skip inputs (channels cu on)
+    if (decoder) {
+      set_upsampled_part(up[l - kFirstDecoder], engine, stream, full, cout, cin, *upsampled[l - kFirstDecoder]);
+      skip_part.shape = {cout, src.channels, 3, 3, 3};
+      for (int o = 0; o < cout; ++o)
+        skip_part.values.insert(skip_part.values.end(),
+                                full.values.begin() + static_cast<std::ptrdiff_t>((o * cin + cu) * 27),
+                                full.values.begin() + static_cast<std::ptrdiff_t>((o + 1) * cin * 27));
+    }
+    const Tensor& wt = decoder ? skip_part : full;
     const bool last = l + 1 == kConvs;
     Conv& c = conv[l];
     if (last) {
@@ -305,19 +397,21 @@ void Sgan::Impl::build(const TensorFile& f, Sgan::FirstLayer first_layer) {
       const memory::desc taps_plane({1, kTapChannels, 1, n1.y(), n1.x()}, Type::f32, Tag::ndhwc);
       const dnnl::convolution_forward::primitive_desc pd(
           dnnl::convolution_forward::desc(dnnl::prop_kind::forward_inference, dnnl::algorithm::convolution_direct,
-                                          src.desc(), memory::desc({kTapChannels, cin, 1, 1, 1}, Type::f32, Tag::any),
+                                          src.desc(), memory::desc({kTapChannels, src.channels, 1, 1, 1}, Type::f32, Tag::any),
                                           taps_plane, {1, 1, 1}, {0, 0, 0}, {0, 0, 0}),
           engine);
       c.primitive = dnnl::convolution_forward(pd);
-      std::vector<float> tap_weights(static_cast<std::size_t>(kTapChannels * cin), 0.0f);
-      for (int ch = 0; ch < cin; ++ch)
+      const int cs = src.channels;
+      std::vector<float> tap_weights(static_cast<std::size_t>(kTapChannels * cs), 0.0f);
+      for (int ch = 0; ch < cs; ++ch)
         for (int t = 0; t < 27; ++t)
-          tap_weights[static_cast<std::size_t>(t * cin + ch)] = wt.values[static_cast<std::size_t>(ch * 27 + t)];
+          tap_weights[static_cast<std::size_t>(t * cs + ch)] = wt.values[static_cast<std::size_t>(ch * 27 + t)];
       last_tap_weights = std::move(tap_weights);
-      memory user(memory::desc({kTapChannels, cin, 1, 1, 1}, Type::f32, Tag::oidhw), engine, last_tap_weights.data());
+      memory user(memory::desc({kTapChannels, cs, 1, 1, 1}, Type::f32, Tag::oidhw), engine, last_tap_weights.data());
       c.weights = memory(pd.weights_desc(), engine);
       dnnl::reorder(user, c.weights).execute(stream, user, c.weights);
       last_bias = bt.values[0];
+      plane_base.assign(static_cast<std::size_t>(n1.x() * n1.y()), 0.0f);
       c.src = memory(src.desc(), engine, src.data.data());
       c.dst = memory(taps_plane, engine, taps.data.data());  // moved along the ring in run()
       out_memory = memory(out.desc(), engine, out.data.data());
@@ -328,7 +422,7 @@ void Sgan::Impl::build(const TensorFile& f, Sgan::FirstLayer first_layer) {
       continue;
     }
     if (l == 0 && first_layer == Sgan::FirstLayer::kFastest && build_planar_first_layer(wt, bt, stream)) continue;
-    set_conv(c, relu_conv(engine, src.desc(), dst.desc(), kStrides[l]), engine, stream, wt, bt);
+    set_conv(c, relu_conv(engine, src.desc(), dst.desc(), kStrides[l], decoder), engine, stream, wt, bt);
     c.src = memory(src.desc(), engine, src.data.data());
     c.dst = memory(dst.desc(), engine, dst.data.data());
   }
@@ -367,10 +461,24 @@ void Sgan::Impl::shift_sum_plane(int z, const std::array<const float*, 3>& plane
     if (planes[static_cast<std::size_t>(t / 9)])
       tap[static_cast<std::size_t>(t)] = planes[static_cast<std::size_t>(t / 9)] + (t / 3 % 3 - 1) * sy + (t % 3 - 1) * C + t;
   float* o = out.data.data() + static_cast<std::ptrdiff_t>(z) * d.x() * d.y();
+  // Each voxel's sum starts from the bias plus d2's up-sampled part (scatter_parities for one
+  // output channel: parity p = 4 pz + 2 py + px at q = (f + 1) / 2).
+  {
+    const UpsampledPart& u = up[2];
+    const Eigen::Vector3i qd = u.parities.dims;
+    float* b = plane_base.data();
+    for (int yy = 0; yy < d.y(); ++yy) {
+      const float* row = u.parities.data.data() +
+                         ((static_cast<std::ptrdiff_t>((z + 1) / 2) * qd.y() + (yy + 1) / 2) * qd.x()) * 8 +
+                         (z & 1) * 4 + (yy & 1) * 2;
+      for (int x = 0; x < d.x(); ++x) *b++ = last_bias + row[((x + 1) / 2) * 8 + (x & 1)];
+    }
+  }
+  const float* base = plane_base.data();
   // Border voxels: taps outside the grid are skipped; the sum runs in tap order as below.
   auto border = [&](int x, int yy) {
     const std::ptrdiff_t v = static_cast<std::ptrdiff_t>(yy) * d.x() + x;
-    float sum = last_bias;
+    float sum = base[v];
     for (int dz = -1; dz <= 1; ++dz) {
       if (!planes[static_cast<std::size_t>(dz + 1)]) continue;
       for (int dy = -1; dy <= 1; ++dy) {
@@ -395,14 +503,14 @@ void Sgan::Impl::shift_sum_plane(int z, const std::array<const float*, 3>& plane
     for (; x + kChains < d.x(); x += kChains) {
       const std::ptrdiff_t v = static_cast<std::ptrdiff_t>(yy) * d.x() + x;
       std::array<float, kChains> acc;
-      acc.fill(last_bias);
+      std::copy(base + v, base + v + kChains, acc.begin());
       for (std::size_t t = 0; t < 27; ++t)
         for (int j = 0; j < kChains; ++j) acc[static_cast<std::size_t>(j)] += tap[t][(v + j) * C];
       std::copy(acc.begin(), acc.end(), o + v);
     }
     for (; x + 1 < d.x(); ++x) {
       const std::ptrdiff_t v = static_cast<std::ptrdiff_t>(yy) * d.x() + x;
-      float sum = last_bias;
+      float sum = base[v];
       for (std::size_t t = 0; t < 27; ++t) sum += tap[t][v * C];
       o[v] = sum;
     }
@@ -496,17 +604,24 @@ std::vector<float> Sgan::Impl::run() {
   concat(g.cat4, {{&g.a4, false}, {&g.c8, false}, {&g.sigma, false}});
   run(4);  // m1
   run(5);  // m2
-  concat(g.catd3, {{&g.m2, true}, {&g.cat3, false}});
-  run(6);  // d3
-  concat(g.catd2, {{&g.d3, true}, {&g.cat2, false}});
+  auto run_up = [&](UpsampledPart& u) {
+    u.primitive.execute(stream, {{DNNL_ARG_SRC, u.src}, {DNNL_ARG_WEIGHTS, u.weights}, {DNNL_ARG_DST, u.dst}});
+    stream.wait();
+  };
+  run_up(g.up[0]);
+  scatter_parities(g.d3, g.up[0]);
+  run(6);  // d3 = relu(conv(cat3) + bias + the up-sampled part)
+  run_up(g.up[1]);
+  scatter_parities(g.d2, g.up[1]);
   run(7);  // d2
+  run_up(g.up[2]);  // d2's part of the logits, added in shift_sum_plane
   // The last layer, plane by plane: the tap products of plane p go to ring slot p % 3, and
   // plane p - 1 of the logits is finished once planes p - 2, p - 1 and p are there.
   const int nz = g.out.dims.z();
   const std::size_t plane = g.taps.voxels() / 3 * static_cast<std::size_t>(kTapChannels);
   const auto slot = [&](int p) -> float* { return g.taps.data.data() + static_cast<std::size_t>(p % 3) * plane; };
   for (int p = 0; p < nz; ++p) {
-    concat(g.catd1, {{&g.d2, true}, {&g.a1, false}, {&g.cond1, false}}, p);
+    concat(g.catd1, {{&g.a1, false}, {&g.cond1, false}}, p);
     g.conv[8].dst.set_data_handle(slot(p));
     run(8);  // tap products of plane p
     if (p >= 1) g.shift_sum_plane(p - 1, {p >= 2 ? slot(p - 2) : nullptr, slot(p - 1), slot(p)});

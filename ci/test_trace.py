@@ -72,6 +72,7 @@ class TraceCheckerTest(unittest.TestCase):
                 "#!/bin/sh\n"
                 'if [ "$1" = "--list-tags" ]; then\n'
                 '  printf "All available tags:\\n   1  [REQ-WORLD-001]\\n   1  [REQ-CORE-001]\\n   1  [unit]\\n3 tags\\n"\n'
+                'elif [ "$#" = "1" ]; then printf "Map loads\\nRNG repeats\\n"\n'
                 'elif [ "$2" = "[REQ-WORLD-001]" ]; then echo "Map loads"\n'
                 'elif [ "$2" = "[REQ-CORE-001]" ]; then echo "RNG repeats"\n'
                 "fi\n")
@@ -85,6 +86,91 @@ class TraceCheckerTest(unittest.TestCase):
             (spec / "world.md").write_text("### REQ-WORLD-001: Map format\n")
             r = subprocess.run(cmd, capture_output=True, text=True)
             self.assertEqual(r.returncode, 0, r.stderr)
+
+    # Evidence mode (issue 19 item 4): only tests that ran and passed in this run count.
+    CTEST = {"tests": [
+        {"name": "world_test: Map loads", "command": ["/b/world_test", "Map loads"],
+         "properties": [{"name": "LABELS", "value": ["unit"]}]},
+        {"name": "world_test: Map saves", "command": ["/b/world_test", "Map saves"],
+         "properties": [{"name": "LABELS", "value": ["property"]}]},
+        {"name": "slow_test: Sweep", "command": ["/b/slow_test", "Sweep"],
+         "properties": [{"name": "LABELS", "value": ["long"]}]},
+        {"name": "pytests", "command": ["/usr/bin/python3", "-m", "pytest", "/src/python/tests"],
+         "properties": [{"name": "LABELS", "value": ["unit"]}]},
+    ]}
+
+    def junit(self, cases):
+        body = "".join(f'<testcase name="{n}" status="{s}">' + ("<failure message='x'/>" if s == "fail" else "")
+                       + "</testcase>" for n, s in cases.items())
+        return f'<?xml version="1.0"?><testsuite tests="{len(cases)}">{body}</testsuite>'
+
+    def test_evidence_counts_only_tests_that_ran_and_passed(self):
+        import json
+        ctest = trace.read_ctest_json(json.dumps(self.CTEST))
+        junit = trace.read_junit(self.junit({"world_test: Map loads": "run", "world_test: Map saves": "fail",
+                                             "slow_test: Sweep": "run"}))
+        self.assertEqual(junit["world_test: Map saves"], "failed")
+        cites = {"REQ-A-001": ["world_test: Map loads", "world_test: Map saves"],
+                 "REQ-A-002": ["world_test: Map saves"],          # only a failing test
+                 "REQ-A-003": ["slow_test: Sweep"],               # only a long test
+                 "REQ-A-004": ["pytests"],                        # registered, not run
+                 "REQ-A-005": ["hidden_test: never registered"]}
+        kept, dropped = trace.evidence(cites, ctest, junit)
+        self.assertEqual(kept["REQ-A-001"], ["world_test: Map loads"])
+        for rid in ("REQ-A-002", "REQ-A-003", "REQ-A-004", "REQ-A-005"):
+            self.assertNotIn(rid, kept)
+        self.assertIn("failed", dropped["world_test: Map saves"])
+        self.assertIn("long", dropped["slow_test: Sweep"])
+        self.assertIn("not run", dropped["pytests"])
+        self.assertIn("not registered", dropped["hidden_test: never registered"])
+
+    def test_evidence_matrix_gives_kinds_and_flags_single_tests(self):
+        import json
+        ctest = trace.read_ctest_json(json.dumps(self.CTEST))
+        reqs = {"REQ-A-001": ("a.md", "One"), "REQ-A-002": ("a.md", "Two")}
+        text = trace.render_evidence(reqs, {"REQ-A-001": ["world_test: Map loads", "world_test: Map saves"],
+                                            "REQ-A-002": ["world_test: Map loads"]}, ctest)
+        self.assertIn("| REQ-A-001 | a.md | One | property, unit | 2 |", text)
+        self.assertIn("1 rest on a single test: REQ-A-002", text)
+
+    def test_scripts_count_through_the_tests_that_run_them(self):
+        import json
+        ctest = trace.read_ctest_json(json.dumps(self.CTEST))
+        self.assertEqual(trace.script_runners(ctest, "/src/python/tests/test_miner.py"), ["pytests"])
+        self.assertEqual(trace.script_runners(ctest, "/src/other/check.py"), [])
+
+    def test_end_to_end_evidence_mode_fails_when_the_only_citing_test_failed(self):
+        import json
+        with tempfile.TemporaryDirectory() as d:
+            spec = pathlib.Path(d, "spec")
+            spec.mkdir()
+            (spec / "world.md").write_text("### REQ-WORLD-001: Map format\n### REQ-WORLD-002: Hidden\n")
+            fake = pathlib.Path(d, "world_test")
+            # Like Catch2 v2: a hidden test appears under its tag but not in the plain list.
+            fake.write_text(
+                "#!/bin/sh\n"
+                'if [ "$1" = "--list-tags" ]; then printf "   1  [REQ-WORLD-001]\\n   1  [REQ-WORLD-002]\\n"\n'
+                'elif [ "$#" = "1" ]; then echo "Map loads"\n'
+                'elif [ "$2" = "[REQ-WORLD-001]" ]; then echo "Map loads"\n'
+                'elif [ "$2" = "[REQ-WORLD-002]" ]; then echo "Hidden check"\n'
+                "fi\n")
+            fake.chmod(fake.stat().st_mode | stat.S_IEXEC)
+            cj, ju, out = (pathlib.Path(d, n) for n in ("ctest.json", "junit.xml", "m.md"))
+            cj.write_text(json.dumps(self.CTEST))
+            cmd = [sys.executable, trace.__file__, "--spec", str(spec), "--out", str(out),
+                   "--ctest-json", str(cj), "--junit", str(ju), str(fake)]
+            ju.write_text(self.junit({"world_test: Map loads": "run"}))
+            r = subprocess.run(cmd, capture_output=True, text=True)
+            self.assertEqual(r.returncode, 1, r.stderr)  # REQ-WORLD-002 rests on a hidden test only
+            self.assertIn("requirement without evidence: REQ-WORLD-002", r.stderr)
+            self.assertNotIn("REQ-WORLD-001 (", r.stderr)
+            (spec / "world.md").write_text("### REQ-WORLD-001: Map format\n")
+            r = subprocess.run(cmd, capture_output=True, text=True)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            ju.write_text(self.junit({"world_test: Map loads": "fail"}))
+            r = subprocess.run(cmd, capture_output=True, text=True)
+            self.assertEqual(r.returncode, 1, r.stderr)
+            self.assertIn("world_test: Map loads: failed in this run", r.stderr)
 
     def test_script_citations_are_read(self):
         found = trace.script_citations(__file__)

@@ -13,7 +13,7 @@ namespace miner::testing {
 
 namespace {
 
-void compare_into(const nlohmann::json& e, const nlohmann::json& a, const Tolerance& tol,
+void compare_into(const nlohmann::json& e, const nlohmann::json& a, const Tolerances& rules, const Tolerance& tol,
                   const std::string& path, std::size_t limit, std::vector<std::string>& out) {
   if (out.size() >= limit) return;
   const auto where = path.empty() ? std::string("value") : path;
@@ -41,7 +41,7 @@ void compare_into(const nlohmann::json& e, const nlohmann::json& a, const Tolera
       return;
     }
     for (std::size_t i = 0; i < e.size(); ++i) {
-      compare_into(e[i], a[i], tol, where + "[" + std::to_string(i) + "]", limit, out);
+      compare_into(e[i], a[i], rules, tol, where + "[" + std::to_string(i) + "]", limit, out);
     }
     return;
   }
@@ -50,7 +50,9 @@ void compare_into(const nlohmann::json& e, const nlohmann::json& a, const Tolera
       if (!a.contains(it.key())) {
         out.push_back(where + "." + it.key() + ": missing in the result");
       } else {
-        compare_into(it.value(), a[it.key()], tol, where + "." + it.key(), limit, out);
+        const auto own = rules.by_key.find(it.key());
+        compare_into(it.value(), a[it.key()], rules, own != rules.by_key.end() ? own->second : tol,
+                     where + "." + it.key(), limit, out);
       }
     }
     for (auto it = a.begin(); it != a.end(); ++it) {
@@ -66,16 +68,22 @@ bool env_is_set(const char* name) {
   return v != nullptr && *v != '\0' && std::string(v) != "0" && std::string(v) != "false";
 }
 
-nlohmann::json golden_document(const nlohmann::json& value, const Tolerance& tol) {
-  return {{"tolerance", {{"abs", tol.abs}, {"rel", tol.rel}}}, {"value", value}};
+nlohmann::json golden_document(const nlohmann::json& value, const Tolerances& tol) {
+  return {{"tolerance", tol.to_json()}, {"value", value}};
 }
 
 }  // namespace
 
+nlohmann::json Tolerances::to_json() const {
+  nlohmann::json j = {{"abs", fallback.abs}, {"rel", fallback.rel}};
+  for (const auto& [key, t] : by_key) j["by_key"][key] = {{"abs", t.abs}, {"rel", t.rel}};
+  return j;
+}
+
 std::vector<std::string> compare_json(const nlohmann::json& expected, const nlohmann::json& actual,
-                                      const Tolerance& tol, std::size_t limit) {
+                                      const Tolerances& tol, std::size_t limit) {
   std::vector<std::string> out;
-  compare_into(expected, actual, tol, "", limit, out);
+  compare_into(expected, actual, tol, tol.fallback, "", limit, out);
   return out;
 }
 
@@ -88,20 +96,26 @@ GoldenMode golden_mode_from_environment() {
   return GoldenMode::kUpdate;
 }
 
-GoldenOutcome check_golden_file(const std::string& path, const nlohmann::json& actual,
-                                const Tolerance& default_tol, GoldenMode mode) {
+GoldenOutcome check_golden_file(const std::string& path, const nlohmann::json& actual, const Tolerances& tol,
+                                GoldenMode mode) {
   namespace fs = std::filesystem;
   const std::string received = path + ".received";
-  Tolerance tol = default_tol;
   nlohmann::json expected;
   bool have_golden = false;
   std::string problem;
   if (fs::exists(path)) {
     try {
       const nlohmann::json doc = read_json_file(path);
-      tol = {doc.at("tolerance").at("abs").get<double>(), doc.at("tolerance").at("rel").get<double>()};
       expected = doc.at("value");
-      have_golden = true;
+      // The tolerance is the test's; the file's copy is a record, and a different one (looser
+      // or not) means the file was blessed under another test.
+      if (doc.at("tolerance") != tol.to_json()) {
+        problem = "golden file " + path + " records the tolerance " + doc.at("tolerance").dump() +
+                  " but the test fixes " + tol.to_json().dump() +
+                  ": tolerances live in the test code and a golden file cannot change them";
+      } else {
+        have_golden = true;
+      }
     } catch (const std::exception& e) {
       problem = "unreadable golden file " + path + ": " + e.what();
     }
@@ -132,12 +146,10 @@ GoldenOutcome check_golden_file(const std::string& path, const nlohmann::json& a
   return {false, os.str()};
 }
 
-GoldenOutcome check_golden(const std::string& relative_path, const nlohmann::json& actual,
-                           const Tolerance& default_tol) {
+GoldenOutcome check_golden(const std::string& relative_path, const nlohmann::json& actual, const Tolerances& tol) {
   const char* env_dir = std::getenv("MINER_SOURCE_DIR");
   const std::string root = env_dir && *env_dir ? env_dir : MINER_SOURCE_DIR;
-  return check_golden_file(root + "/golden/" + relative_path, actual, default_tol,
-                           golden_mode_from_environment());
+  return check_golden_file(root + "/golden/" + relative_path, actual, tol, golden_mode_from_environment());
 }
 
 }  // namespace miner::testing

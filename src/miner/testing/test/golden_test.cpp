@@ -57,16 +57,17 @@ TEST_CASE("A mismatch fails, names the difference and writes a .received file", 
   const std::string dir = fresh_dir("mismatch");
   const std::string path = dir + "/g.json";
   miner::write_file_atomic(path, miner::dump_json({{"tolerance", {{"abs", 0.0}, {"rel", 1e-9}}}, {"value", {{"x", 1.0}}}}));
-  const auto bad = check_golden_file(path, json{{"x", 1.5}}, Tolerance{}, GoldenMode::kCheck);
+  const Tolerance tol{0.0, 1e-9};  // the test's, recorded in the file
+  const auto bad = check_golden_file(path, json{{"x", 1.5}}, tol, GoldenMode::kCheck);
   CHECK_FALSE(bad.ok);
   CHECK_THAT(bad.message, Contains("value.x: expected 1, got 1.5"));
   CHECK_THAT(bad.message, Contains("UPDATE_GOLDEN=1 ctest -L golden"));
   REQUIRE(std::filesystem::exists(path + ".received"));
   const json received = miner::read_json_file(path + ".received");
   CHECK(received["value"]["x"] == 1.5);
-  CHECK(received["tolerance"]["rel"] == 1e-9);  // the golden's own tolerance is kept
+  CHECK(received["tolerance"]["rel"] == 1e-9);  // the test's tolerance is recorded
   // The golden itself is untouched; a later match removes the stale .received.
-  const auto good = check_golden_file(path, json{{"x", 1.0 + 1e-12}}, Tolerance{}, GoldenMode::kCheck);
+  const auto good = check_golden_file(path, json{{"x", 1.0 + 1e-12}}, tol, GoldenMode::kCheck);
   CHECK(good.ok);
   CHECK_FALSE(std::filesystem::exists(path + ".received"));
 }
@@ -83,15 +84,16 @@ TEST_CASE("A missing or unreadable golden fails with a .received to accept", "[R
   CHECK_THAT(broken.message, Contains("unreadable golden file"));
 }
 
-TEST_CASE("Update mode rewrites the golden with its tolerance and CI refuses update mode", "[REQ-HARNESS-002]") {
+TEST_CASE("Update mode rewrites the golden with the test's tolerance and CI refuses update mode", "[REQ-HARNESS-002]") {
   const std::string dir = fresh_dir("update");
   const std::string path = dir + "/sub/g.json";
-  const auto first = check_golden_file(path, json{{"x", 2.0}}, Tolerance{1e-3, 0.0}, GoldenMode::kUpdate);
+  const Tolerance tol{1e-3, 0.0};
+  const auto first = check_golden_file(path, json{{"x", 2.0}}, tol, GoldenMode::kUpdate);
   CHECK(first.ok);
   CHECK(miner::read_json_file(path)["tolerance"]["abs"] == 1e-3);
-  CHECK(check_golden_file(path, json{{"x", 2.0005}}, Tolerance{}, GoldenMode::kCheck).ok);
-  CHECK_FALSE(check_golden_file(path, json{{"x", 2.1}}, Tolerance{}, GoldenMode::kCheck).ok);
-  CHECK(check_golden_file(path, json{{"x", 2.1}}, Tolerance{}, GoldenMode::kUpdate).ok);
+  CHECK(check_golden_file(path, json{{"x", 2.0005}}, tol, GoldenMode::kCheck).ok);
+  CHECK_FALSE(check_golden_file(path, json{{"x", 2.1}}, tol, GoldenMode::kCheck).ok);
+  CHECK(check_golden_file(path, json{{"x", 2.1}}, tol, GoldenMode::kUpdate).ok);
   CHECK(miner::read_json_file(path)["value"]["x"] == 2.1);
 
   {
@@ -108,4 +110,41 @@ TEST_CASE("Update mode rewrites the golden with its tolerance and CI refuses upd
     ScopedEnv update("UPDATE_GOLDEN", nullptr);
     CHECK(golden_mode_from_environment() == GoldenMode::kCheck);
   }
+}
+
+TEST_CASE("A golden file cannot loosen the test's tolerance: the test fixes it", "[REQ-HARNESS-002]") {
+  const std::string dir = fresh_dir("strict");
+  const std::string path = dir + "/g.json";
+  const Tolerance strict{1e-9, 0.0};
+  REQUIRE(check_golden_file(path, json{{"x", 2.0}}, strict, GoldenMode::kUpdate).ok);
+  // A re-blessed (or hand-edited) file that records a looser tolerance fails, though the value
+  // would match under the file's tolerance.
+  json doc = miner::read_json_file(path);
+  doc["tolerance"]["abs"] = 1.0;
+  miner::write_file_atomic(path, miner::dump_json(doc));
+  const auto loose = check_golden_file(path, json{{"x", 2.5}}, strict, GoldenMode::kCheck);
+  CHECK_FALSE(loose.ok);
+  CHECK_THAT(loose.message, Contains("tolerances live in the test code"));
+  // So does a file blessed under a test that has since tightened its tolerance, even when the
+  // value is unchanged: the file must record what is checked.
+  REQUIRE(check_golden_file(path, json{{"x", 2.0}}, Tolerance{1e-3, 0.0}, GoldenMode::kUpdate).ok);
+  CHECK_FALSE(check_golden_file(path, json{{"x", 2.0}}, strict, GoldenMode::kCheck).ok);
+  CHECK(check_golden_file(path, json{{"x", 2.0}}, Tolerance{1e-3, 0.0}, GoldenMode::kCheck).ok);
+}
+
+TEST_CASE("A key's own tolerance applies to the numbers under it, the fallback elsewhere", "[REQ-HARNESS-002]") {
+  // Rotor speeds (~800 rad/s) to 1e-6 rad/s, positions (m) to 1e-9 m, the rest exact.
+  const Tolerances tol(Tolerance{0.0, 0.0}, {{"rotor", {1e-6, 0.0}}, {"position", {1e-9, 0.0}}});
+  const json golden = {{"rotor", {800.0, 801.0}}, {"position", {{"x", 1.0}}}, {"count", 3}};
+  CHECK(compare_json(golden, json{{"rotor", {800.0000005, 801.0}}, {"position", {{"x", 1.0 + 5e-10}}}, {"count", 3}},
+                     tol).empty());
+  // +1e-3 on a rotor speed (1.25e-6 relative) is caught; a relative fallback of 1e-4 would not.
+  const auto rotor = compare_json(golden, json{{"rotor", {800.001, 801.0}}, {"position", {{"x", 1.0}}}, {"count", 3}}, tol);
+  REQUIRE(rotor.size() == 1);
+  CHECK_THAT(rotor[0], Contains("value.rotor[0]"));
+  CHECK(compare_json(golden, json{{"rotor", {800.001, 801.0}}, {"position", {{"x", 1.0}}}, {"count", 3}},
+                     Tolerance{0.0, 1e-4}).empty());
+  CHECK(compare_json(golden, json{{"rotor", {800.0, 801.0}}, {"position", {{"x", 1.0 + 2e-9}}}, {"count", 3}}, tol).size() == 1);
+  CHECK(compare_json(golden, json{{"rotor", {800.0, 801.0}}, {"position", {{"x", 1.0}}}, {"count", 3.0000001}}, tol).size() == 1);
+  CHECK(tol.to_json()["by_key"]["rotor"]["abs"] == 1e-6);
 }

@@ -12,6 +12,7 @@
 #include "miner/core/error.hpp"
 #include "miner/core/rng.hpp"
 #include "miner/heuristic/grid.hpp"
+#include "miner/heuristic/sgan_kernels.hpp"
 #include "miner/heuristic/tensor_file.hpp"
 
 namespace miner::heuristic {
@@ -123,12 +124,13 @@ struct Conv {
 /// A 3x3x3 convolution (padding 1) with fused ReLU from src to dst, weights in the layout
 /// oneDNN picks for the kernel it chooses.
 dnnl::convolution_forward::primitive_desc relu_conv(const dnnl::engine& engine, const memory::desc& src,
-                                                    const memory::desc& dst, int stride, bool accumulate = false) {
+                                                    const memory::desc& dst, int stride, bool accumulate = false,
+                                                    int padding = 1) {
   const memory::dim cin = src.dims()[1], cout = dst.dims()[1];
   const dnnl::convolution_forward::desc cd(
       dnnl::prop_kind::forward_inference, dnnl::algorithm::convolution_direct, src,
       memory::desc({cout, cin, 3, 3, 3}, Type::f32, Tag::any), memory::desc({cout}, Type::f32, Tag::a), dst,
-      {stride, stride, stride}, {1, 1, 1}, {1, 1, 1});
+      {stride, stride, stride}, {padding, padding, padding}, {padding, padding, padding});
   dnnl::post_ops po;
   if (accumulate) po.append_sum(1.0f);  // dst = relu(conv(src) + bias + dst)
   po.append_eltwise(1.0f, dnnl::algorithm::eltwise_relu, 0.0f, 0.0f);
@@ -251,29 +253,51 @@ struct Sgan::Impl {
   std::vector<float> plane_base;        // one plane of the logits' start: bias + d2's part (up[2])
   dnnl::eltwise_forward sigmoid;        // R = sigmoid(logits), in place on out
   memory out_memory;
-  // The first layer reads a planar (ncdhw) x0 and writes a blocked a1_blocked that a reorder
-  // turns into channels-last a1, when this CPU has an optimised kernel for that pair.
-  bool planar_input = false;
-  memory a1_blocked, a1_memory;
-  dnnl::reorder a1_reorder;
+  // MINER's own kernels for enc1 and dec1's skip part (sgan_kernels.hpp; width 8 and
+  // Sgan::Kernels::kFastest): N, E/2 and S on a padded grid, the nonzero voxels of E/2 and S, and a1
+  // channels-last on the padded grid, which enc2 (oneDNN) reads with padding 0.
+  bool own_kernels = false;
+  std::vector<float> noise_padded, environment_padded, state_padded, a1_padded;
+  std::vector<kernels::SparseInput> sparse;
+  std::vector<float> first_weights, first_bias, skip_weights;
   std::array<Conv, kConvs> conv;
   std::array<std::pair<Activation*, Activation*>, kConvs> io;
 
-  /// Voxel v of the input: x0 = (E, S, Z) in its layout, cond1 = (E, S).
-  void set_input(std::size_t v, float e, float s, float z) {
-    if (planar_input) {
-      const std::size_t n = x0.voxels();
-      x0.data[v] = e;
-      x0.data[n + v] = s;
-      x0.data[2 * n + v] = z;
+  /// Starts a query's input (the sparse list is rebuilt by set_input).
+  void begin_input() { sparse.clear(); }
+
+  /// Voxel (x, y, z), index v, of the input: E/2 = e, S = s, N = noise; cond1 = (E/2, S) and,
+  /// with the own kernels, N on the padded grid and (e, s) in the sparse list when nonzero;
+  /// else x0 = (E/2, S, N) channels-last.
+  void set_input(int x, int y, int z, std::size_t v, float e, float s, float noise) {
+    if (own_kernels) {
+      const Eigen::Vector3i d = cond1.dims;
+      const int padded = ((z + 1) * (d.y() + 2) + y + 1) * (d.x() + 2) + x + 1;
+      noise_padded[static_cast<std::size_t>(padded)] = noise;
+      environment_padded[static_cast<std::size_t>(padded)] = e;
+      state_padded[static_cast<std::size_t>(padded)] = s;
+      if (e != 0.0f || s != 0.0f) sparse.push_back({padded, e, s});
     } else {
       x0.data[3 * v] = e;
       x0.data[3 * v + 1] = s;
-      x0.data[3 * v + 2] = z;
+      x0.data[3 * v + 2] = noise;
     }
     cond1.data[2 * v] = e;
     cond1.data[2 * v + 1] = s;
   }
+
+  /// Calls f(x, y, z, v) for every voxel in index order (x fastest).
+  template <class F>
+  void for_voxels(F&& f) const {
+    const Eigen::Vector3i d = cond1.dims;
+    std::size_t v = 0;
+    for (int z = 0; z < d.z(); ++z)
+      for (int y = 0; y < d.y(); ++y)
+        for (int x = 0; x < d.x(); ++x, ++v) f(x, y, z, v);
+  }
+
+  /// One plane of the logits' start: bias + d2's up-sampled part (up[2]).
+  void logit_base_plane(int z, float* dst) const;
 
   /// sigma, constant over the bottleneck's grid (nothing when the network has no scale input).
   void set_scale(const std::vector<float>& scale) {
@@ -294,14 +318,10 @@ struct Sgan::Impl {
   /// last layer, finished.
   void shift_sum_plane(int z, const std::array<const float*, 3>& planes);
 
-  /// enc1 (3 input channels) as described at planar_input; false if oneDNN has no optimised
-  /// kernel for it here, and then nothing is changed.
-  bool build_planar_first_layer(const Tensor& weights, const Tensor& bias, dnnl::stream& stream);
-
-  void build(const TensorFile& f, Sgan::FirstLayer first_layer);
+  void build(const TensorFile& f, Sgan::Kernels kernels);
 };
 
-void Sgan::Impl::build(const TensorFile& f, Sgan::FirstLayer first_layer) {
+void Sgan::Impl::build(const TensorFile& f, Sgan::Kernels which) {
   const JsonField a(f.meta, "meta", f.path);
   a.only_keys({"architecture", "final", "training"});
   const JsonField ar = a.at("architecture");
@@ -340,7 +360,15 @@ void Sgan::Impl::build(const TensorFile& f, Sgan::FirstLayer first_layer) {
 
   const int w = arch.width;
   const Eigen::Vector3i n1 = arch.dims, n2 = n1 / 2, n4 = n1 / 4, n8 = n1 / 8;
-  x0 = Activation(3, n1);
+  own_kernels = which == Sgan::Kernels::kFastest && w == kernels::kWidth;
+  const Eigen::Vector3i padded = n1 + Eigen::Vector3i::Constant(2);
+  if (own_kernels) {
+    noise_padded.assign(static_cast<std::size_t>(padded.prod()), 0.0f);
+    a1_padded.assign(static_cast<std::size_t>(padded.prod()) * kernels::kWidth, 0.0f);
+    environment_padded.assign(static_cast<std::size_t>(padded.prod()), 0.0f);
+    state_padded.assign(static_cast<std::size_t>(padded.prod()), 0.0f);
+  }
+  x0 = Activation(3, own_kernels ? Eigen::Vector3i(0, 0, 0) : n1);  // oneDNN's enc1 input only
   cond1 = Activation(2, n1);
   a1 = Activation(w, n1);
   c2 = Activation(2, n2);
@@ -389,6 +417,28 @@ void Sgan::Impl::build(const TensorFile& f, Sgan::FirstLayer first_layer) {
     const Tensor& wt = decoder ? skip_part : full;
     const bool last = l + 1 == kConvs;
     Conv& c = conv[l];
+    if (own_kernels && (l == 0 || last)) {  // sgan_kernels.cpp
+      if (l == 0) {
+        first_weights = wt.values;
+        first_bias = bt.values;
+      } else {
+        skip_weights = wt.values;
+        last_bias = bt.values[0];
+        out_memory = memory(out.desc(), engine, out.data.data());
+        sigmoid = dnnl::eltwise_forward(dnnl::eltwise_forward::primitive_desc(
+            dnnl::eltwise_forward::desc(dnnl::prop_kind::forward_inference, dnnl::algorithm::eltwise_logistic,
+                                        out.desc(), 0.0f, 0.0f),
+            engine));
+      }
+      continue;
+    }
+    if (own_kernels && l == 1) {  // enc2 reads a1 on the padded grid: padding 0
+      const memory::desc src_padded({1, kernels::kWidth, padded.z(), padded.y(), padded.x()}, Type::f32, Tag::ndhwc);
+      set_conv(c, relu_conv(engine, src_padded, dst.desc(), kStrides[l], false, 0), engine, stream, wt, bt);
+      c.src = memory(src_padded, engine, a1_padded.data());
+      c.dst = memory(dst.desc(), engine, dst.data.data());
+      continue;
+    }
     if (last) {
       // A single output channel keeps oneDNN's kernels ~5 % busy; instead a 1x1x1
       // convolution computes, per voxel u, the 27 tap products Y[u][t] = sum_c W[0][c][t]
@@ -421,7 +471,6 @@ void Sgan::Impl::build(const TensorFile& f, Sgan::FirstLayer first_layer) {
           engine));
       continue;
     }
-    if (l == 0 && first_layer == Sgan::FirstLayer::kFastest && build_planar_first_layer(wt, bt, stream)) continue;
     set_conv(c, relu_conv(engine, src.desc(), dst.desc(), kStrides[l], decoder), engine, stream, wt, bt);
     c.src = memory(src.desc(), engine, src.data.data());
     c.dst = memory(dst.desc(), engine, dst.data.data());
@@ -434,21 +483,17 @@ void Sgan::Impl::build(const TensorFile& f, Sgan::FirstLayer first_layer) {
                 std::to_string(2 * kConvs));
 }
 
-bool Sgan::Impl::build_planar_first_layer(const Tensor& weights, const Tensor& bias, dnnl::stream& stream) {
-  const Eigen::Vector3i n = x0.dims;
-  const memory::desc src({1, x0.channels, n.z(), n.y(), n.x()}, Type::f32, Tag::ncdhw);
-  const memory::desc dst({1, a1.channels, n.z(), n.y(), n.x()}, Type::f32, Tag::any);
-  const dnnl::convolution_forward::primitive_desc pd = relu_conv(engine, src, dst, 1);
-  if (std::string(pd.impl_info_str()).rfind("ref", 0) == 0) return false;  // reference kernel: far slower
-  Conv& c = conv[0];
-  set_conv(c, pd, engine, stream, weights, bias);
-  c.src = memory(src, engine, x0.data.data());
-  a1_blocked = memory(pd.dst_desc(), engine);
-  a1_memory = memory(a1.desc(), engine, a1.data.data());
-  a1_reorder = dnnl::reorder(a1_blocked, a1_memory);
-  c.dst = a1_blocked;
-  planar_input = true;
-  return true;
+void Sgan::Impl::logit_base_plane(int z, float* dst) const {
+  // scatter_parities for one output channel: parity p = 4 pz + 2 py + px at q = (f + 1) / 2.
+  const Eigen::Vector3i d = out.dims;
+  const UpsampledPart& u = up[2];
+  const Eigen::Vector3i qd = u.parities.dims;
+  for (int yy = 0; yy < d.y(); ++yy) {
+    const float* row = u.parities.data.data() +
+                       ((static_cast<std::ptrdiff_t>((z + 1) / 2) * qd.y() + (yy + 1) / 2) * qd.x()) * 8 +
+                       (z & 1) * 4 + (yy & 1) * 2;
+    for (int x = 0; x < d.x(); ++x) *dst++ = last_bias + row[((x + 1) / 2) * 8 + (x & 1)];
+  }
 }
 
 void Sgan::Impl::shift_sum_plane(int z, const std::array<const float*, 3>& planes) {
@@ -461,19 +506,7 @@ void Sgan::Impl::shift_sum_plane(int z, const std::array<const float*, 3>& plane
     if (planes[static_cast<std::size_t>(t / 9)])
       tap[static_cast<std::size_t>(t)] = planes[static_cast<std::size_t>(t / 9)] + (t / 3 % 3 - 1) * sy + (t % 3 - 1) * C + t;
   float* o = out.data.data() + static_cast<std::ptrdiff_t>(z) * d.x() * d.y();
-  // Each voxel's sum starts from the bias plus d2's up-sampled part (scatter_parities for one
-  // output channel: parity p = 4 pz + 2 py + px at q = (f + 1) / 2).
-  {
-    const UpsampledPart& u = up[2];
-    const Eigen::Vector3i qd = u.parities.dims;
-    float* b = plane_base.data();
-    for (int yy = 0; yy < d.y(); ++yy) {
-      const float* row = u.parities.data.data() +
-                         ((static_cast<std::ptrdiff_t>((z + 1) / 2) * qd.y() + (yy + 1) / 2) * qd.x()) * 8 +
-                         (z & 1) * 4 + (yy & 1) * 2;
-      for (int x = 0; x < d.x(); ++x) *b++ = last_bias + row[((x + 1) / 2) * 8 + (x & 1)];
-    }
-  }
+  logit_base_plane(z, plane_base.data());
   const float* base = plane_base.data();
   // Border voxels: taps outside the grid are skipped; the sum runs in tap order as below.
   auto border = [&](int x, int yy) {
@@ -523,14 +556,14 @@ Sgan::~Sgan() = default;
 Sgan::Sgan(Sgan&&) noexcept = default;
 Sgan& Sgan::operator=(Sgan&&) noexcept = default;
 
-Sgan Sgan::from_bytes(const std::string& blob, const std::string& origin, FirstLayer first_layer) {
+Sgan Sgan::from_bytes(const std::string& blob, const std::string& origin, Kernels kernels) {
   const TensorFile f = parse_tensor_file(blob, origin, "sgan-weights");
   auto impl = std::make_unique<Impl>();
   impl->path = origin;
   impl->meta = f.meta;
   try {
     const OneOpenMpThread one_thread;  // the primitives keep the thread count they are made with
-    impl->build(f, first_layer);
+    impl->build(f, kernels);
   } catch (const dnnl::error& e) {
     throw Error(origin + ": oneDNN refused the network (" + e.what() + ")");
   }
@@ -549,16 +582,17 @@ Sgan Sgan::builtin() {
 const SganArchitecture& Sgan::architecture() const { return impl_->arch; }
 const Json& Sgan::meta() const { return impl_->meta; }
 const std::string& Sgan::path() const { return impl_->path; }
-bool Sgan::planar_first_layer() const { return impl_->planar_input; }
+bool Sgan::own_kernels() const { return impl_->own_kernels; }
 
 std::vector<float> Sgan::forward(const std::vector<float>& env, const std::vector<float>& state,
                                  const std::vector<float>& noise, const std::vector<float>& scale) const {
   Impl& g = *impl_;
-  const std::size_t n = g.x0.voxels();
+  const std::size_t n = g.cond1.voxels();
   if (env.size() != n || state.size() != n || noise.size() != n)
     throw Error("sgan: inputs must have " + std::to_string(n) + " cells each (the weights' grid)");
   g.set_scale(scale);
-  for (std::size_t v = 0; v < n; ++v) g.set_input(v, env[v], state[v], noise[v]);
+  g.begin_input();
+  g.for_voxels([&](int x, int y, int z, std::size_t v) { g.set_input(x, y, z, v, env[v], state[v], noise[v]); });
   return g.run();
 }
 
@@ -588,11 +622,13 @@ std::vector<float> Sgan::Impl::run() {
                                          {DNNL_ARG_DST, g.conv[l].dst}});
     stream.wait();
   };
-  run(0);  // a1
-  if (g.planar_input) {
-    g.a1_reorder.execute(stream, g.a1_blocked, g.a1_memory);
-    stream.wait();
-  }
+  const Eigen::Vector3i n1 = g.out.dims;
+  const int dims[3] = {n1.x(), n1.y(), n1.z()};
+  if (g.own_kernels)
+    kernels::first_layer(dims, g.noise_padded.data(), g.sparse, g.first_weights.data(), g.first_bias.data(),
+                         g.a1_padded.data());
+  else
+    run(0);  // a1
   run(1);  // a2
   max_pool2(g.c2, g.cond1);
   max_pool2(g.c4, g.c2);
@@ -614,7 +650,16 @@ std::vector<float> Sgan::Impl::run() {
   run_up(g.up[1]);
   scatter_parities(g.d2, g.up[1]);
   run(7);  // d2
-  run_up(g.up[2]);  // d2's part of the logits, added in shift_sum_plane
+  run_up(g.up[2]);  // d2's part of the logits
+  if (g.own_kernels) {
+    const std::size_t plane = static_cast<std::size_t>(n1.x() * n1.y());
+    for (int z = 0; z < n1.z(); ++z) g.logit_base_plane(z, g.out.data.data() + static_cast<std::size_t>(z) * plane);
+    kernels::last_layer_skip(dims, g.a1_padded.data(), g.environment_padded.data(), g.state_padded.data(),
+                             g.skip_weights.data(), g.out.data.data());
+    g.sigmoid.execute(stream, {{DNNL_ARG_SRC, g.out_memory}, {DNNL_ARG_DST, g.out_memory}});
+    stream.wait();  // R
+    return g.out.data;
+  }
   // The last layer, plane by plane: the tap products of plane p go to ring slot p % 3, and
   // plane p - 1 of the logits is finished once planes p - 2, p - 1 and p are there.
   const int nz = g.out.dims.z();
@@ -635,14 +680,16 @@ std::vector<float> Sgan::Impl::run() {
 std::vector<float> Sgan::predict(const std::vector<std::uint8_t>& environment, const std::vector<std::uint8_t>& state,
                                  const world::Box& bounds, double robot_radius, Rng& rng) const {
   Impl& g = *impl_;
-  const std::size_t n = g.x0.voxels();
+  const std::size_t n = g.cond1.voxels();
   if (environment.size() != n || state.size() != n)
     throw Error("sgan: E and S must have " + std::to_string(n) + " cells each (the weights' grid)");
   if (g.arch.scale_channels != 0) g.set_scale(scale_input(bounds, g.arch.dims, robot_radius, g.arch.scale_divisor));
   const auto scale = static_cast<float>(g.arch.environment_scale);
-  for (std::size_t v = 0; v < n; ++v)
-    g.set_input(v, scale * static_cast<float>(environment[v]), static_cast<float>(state[v]),
+  g.begin_input();
+  g.for_voxels([&](int x, int y, int z, std::size_t v) {
+    g.set_input(x, y, z, v, scale * static_cast<float>(environment[v]), static_cast<float>(state[v]),
                 static_cast<float>(rng.normal_ziggurat()));
+  });
   return g.run();
 }
 

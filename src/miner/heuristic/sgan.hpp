@@ -12,7 +12,9 @@
 ///     d2 = relu(conv3([up2(d3), a2, c2]))    2w x (n/2)^3
 ///     R  = sigmoid(conv3([up2(d2), a1, E/2, S]))
 /// The convolutions run in oneDNN (channels-last activations, weights reordered once to the
-/// kernel's preferred layout); pooling, upsampling and concatenation are copies done here.
+/// kernel's preferred layout), except enc1 and dec1's skip part at width 8 (sgan_kernels.hpp);
+/// a decoder layer's up-sampled input is convolved on its own coarse grid (parity kernels);
+/// pooling and concatenation are copies done here.
 /// Weights come from a `miner-tensors-v1` file of kind "sgan-weights" (tensor_file.hpp);
 /// a missing, truncated, altered or mismatched file is refused naming the fault (REQ-HEUR-006).
 
@@ -47,17 +49,17 @@ struct SganArchitecture {
 
 class Sgan {
  public:
-  /// How the first layer (3 input channels) runs: kFastest takes a planar input and oneDNN's
-  /// blocked-output kernel where this CPU has an optimised one (else channels-last, as every
-  /// other layer); kChannelsLast always the latter (what a CPU without the planar kernel runs;
-  /// the tests compare the two).
-  enum class FirstLayer { kFastest, kChannelsLast };
+  /// Which kernels run the two full-resolution layers (enc1 with its 3 input channels, dec1
+  /// with its one output channel): kFastest uses MINER's own (sgan_kernels.hpp: the sparse
+  /// inputs E/2 and S scattered, the dense ones gathered) for a width-8 network, oneDNN's
+  /// otherwise; kOneDnn always oneDNN's (the tests compare the two).
+  enum class Kernels { kFastest, kOneDnn };
 
   /// Loads and checks the weights file; builds the oneDNN primitives for one query.
   static Sgan load(const std::string& path);
   /// The same from the file's bytes (`origin` names them in messages).
   static Sgan from_bytes(const std::string& blob, const std::string& origin,
-                         FirstLayer first_layer = FirstLayer::kFastest);
+                         Kernels kernels = Kernels::kFastest);
   /// The weights shipped in fixtures/sgan/sgan.bin, compiled into the library (nothing is
   /// read or downloaded at run time).
   static Sgan builtin();
@@ -71,8 +73,8 @@ class Sgan {
   /// The file's "meta" object (architecture, training command, seeds, metrics).
   const Json& meta() const;
   const std::string& path() const;
-  /// Whether the first layer runs on the planar input (see FirstLayer).
-  bool planar_first_layer() const;
+  /// Whether MINER's own kernels run enc1 and dec1 (see Kernels).
+  bool own_kernels() const;
 
   /// R = G(N | E, S) on the grid: three inputs of dims.prod() floats (x fastest) — the
   /// One query at a time per object (the buffers are reused). Inputs: the

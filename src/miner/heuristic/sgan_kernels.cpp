@@ -1,0 +1,152 @@
+#include "miner/heuristic/sgan_kernels.hpp"
+
+#include <algorithm>
+#include <cstring>
+
+namespace miner::heuristic::kernels {
+
+namespace {
+
+// Eight floats (one voxel's 8 channels, or 8 voxels' sums): GCC's vector extension, lowered to
+// one AVX register in the x86-64-v3/v4 clones and to two SSE registers in the baseline one.
+// Never passed by value between functions (the baseline ABI has no 32-byte registers).
+using v8 = float __attribute__((vector_size(32)));
+using v8i = int __attribute__((vector_size(32)));
+
+/// r <- p[0..7] (unaligned); by reference, as no v8 crosses a function boundary by value.
+inline void load8(v8& r, const float* p) { std::memcpy(&r, p, sizeof r); }
+
+/// Zeroes the border of a padded grid of c floats per voxel (its six faces).
+void clear_border(const int n[3], int c, float* padded) {
+  const std::ptrdiff_t px = n[0] + 2, py = n[1] + 2, pz = n[2] + 2;
+  for (std::ptrdiff_t z = 0; z < pz; ++z)
+    for (std::ptrdiff_t y = 0; y < py; ++y) {
+      float* row = padded + (z * py + y) * px * c;
+      if (z == 0 || z == pz - 1 || y == 0 || y == py - 1) {
+        std::fill(row, row + px * c, 0.0f);
+      } else {
+        std::fill(row, row + c, 0.0f);
+        std::fill(row + (px - 1) * c, row + px * c, 0.0f);
+      }
+    }
+}
+
+}  // namespace
+
+// Tap t = (dz + 1) 9 + (dy + 1) 3 + (dx + 1), as PyTorch's [kd][kh][kw] flattened. A voxel v
+// reads input v + (dx, dy, dz) at tap t, so an input u reaches the outputs u - (dx, dy, dz).
+
+__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+void first_layer(const int n[3], const float* noise_padded, const std::vector<SparseInput>& sparse,
+                 const float* weights, const float* bias, float* a1_padded) {
+  const int nx = n[0], ny = n[1], nz = n[2];
+  const std::ptrdiff_t px = nx + 2, pxy = px * (ny + 2);
+  std::fill(a1_padded, a1_padded + pxy * (nz + 2) * kWidth, 0.0f);
+  v8 wn[27], we[27], ws[27];
+  for (int t = 0; t < 27; ++t)
+    for (int o = 0; o < kWidth; ++o) {
+      we[t][o] = weights[(o * 3 + 0) * 27 + t];
+      ws[t][o] = weights[(o * 3 + 1) * 27 + t];
+      wn[t][o] = weights[(o * 3 + 2) * 27 + t];
+    }
+  // E/2 and S, scattered from their nonzero voxels to the 27 voxels that read each, border
+  // voxels included (cleared below).
+  std::ptrdiff_t off[27];
+  for (int t = 0; t < 27; ++t) off[t] = (t / 9 - 1) * pxy + (t / 3 % 3 - 1) * px + (t % 3 - 1);
+  for (const SparseInput& s : sparse)
+    for (int t = 0; t < 27; ++t) {
+      float* dst = a1_padded + (s.padded - off[t]) * kWidth;
+      v8 cur;
+      load8(cur, dst);
+      cur += s.environment * we[t] + s.state * ws[t];
+      std::memcpy(dst, &cur, sizeof cur);
+    }
+  clear_border(n, kWidth, a1_padded);
+  // N gathered for 8 voxels along x at a time (independent sums), the bias, ReLU.
+  v8 b;
+  load8(b, bias);
+  const v8 zero = {};
+  for (int z = 0; z < nz; ++z)
+    for (int y = 0; y < ny; ++y) {
+      const std::ptrdiff_t row = (z + 1) * pxy + (y + 1) * px + 1;  // padded index of (0, y, z)
+      const float* nrow = noise_padded + row;
+      float* arow = a1_padded + row * kWidth;
+      for (int x = 0; x + 8 <= nx; x += 8) {
+        v8 acc[8];
+        for (int j = 0; j < 8; ++j) {
+          load8(acc[j], arow + (x + j) * kWidth);
+          acc[j] += b;
+        }
+        for (int t = 0; t < 27; ++t) {
+          const v8 w = wn[t];
+          const float* p = nrow + x + off[t];
+          for (int j = 0; j < 8; ++j) acc[j] += p[j] * w;
+        }
+        for (int j = 0; j < 8; ++j) {
+          const v8 r = acc[j] > zero ? acc[j] : zero;
+          std::memcpy(arow + (x + j) * kWidth, &r, sizeof r);
+        }
+      }
+    }
+}
+
+__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+void last_layer_skip(const int n[3], const float* a1_padded, const float* environment_padded,
+                     const float* state_padded, const float* skip_weights, float* logits) {
+  const int nx = n[0], ny = n[1], nz = n[2];
+  const std::ptrdiff_t px = nx + 2, pxy = px * (ny + 2);
+  v8 wa[27];
+  float we[27], ws[27];
+  for (int t = 0; t < 27; ++t) {
+    for (int c = 0; c < kWidth; ++c) wa[t][c] = skip_weights[c * 27 + t];
+    we[t] = skip_weights[kWidth * 27 + t];
+    ws[t] = skip_weights[(kWidth + 1) * 27 + t];
+  }
+  std::ptrdiff_t tap[27];
+  for (int t = 0; t < 27; ++t) tap[t] = (t / 9 - 1) * pxy + (t / 3 % 3 - 1) * px + (t % 3 - 1);
+  std::ptrdiff_t off[27];
+  for (int t = 0; t < 27; ++t) off[t] = ((t / 9 - 1) * pxy + (t / 3 % 3 - 1) * px + (t % 3 - 1)) * kWidth;
+  // Pairwise sums of 8 accumulators into one vector of 8 totals (an 8 x 8 transpose-add).
+  const v8i even = {0, 8, 2, 10, 4, 12, 6, 14}, odd = {1, 9, 3, 11, 5, 13, 7, 15};
+  const v8i lo2 = {0, 1, 8, 9, 4, 5, 12, 13}, hi2 = {2, 3, 10, 11, 6, 7, 14, 15};
+  const v8i lo4 = {0, 1, 2, 3, 8, 9, 10, 11}, hi4 = {4, 5, 6, 7, 12, 13, 14, 15};
+  for (int z = 0; z < nz; ++z)
+    for (int y = 0; y < ny; ++y) {
+      const std::ptrdiff_t row = (z + 1) * pxy + (y + 1) * px + 1;  // padded index of (0, y, z)
+      const float* arow = a1_padded + row * kWidth;
+      const float* erow = environment_padded + row;
+      const float* strow = state_padded + row;
+      float* out = logits + (static_cast<std::ptrdiff_t>(z) * ny + y) * nx;
+      for (int x = 0; x + 8 <= nx; x += 8) {
+        v8 acc[8] = {};
+        v8 sparse_part = {};  // E/2 and S: the 8 voxels in the lanes
+        for (int t = 0; t < 27; ++t) {
+          v8 e, st;
+          load8(e, erow + x + tap[t]);
+          load8(st, strow + x + tap[t]);
+          sparse_part += e * we[t] + st * ws[t];
+        }
+        for (int t = 0; t < 27; ++t) {
+          const v8 w = wa[t];
+          const float* p = arow + x * kWidth + off[t];
+          for (int j = 0; j < 8; ++j) {
+            v8 a;
+            load8(a, p + j * kWidth);
+            acc[j] += a * w;
+          }
+        }
+        v8 p[4], q[2];
+        for (int j = 0; j < 4; ++j)
+          p[j] = __builtin_shuffle(acc[2 * j], acc[2 * j + 1], even) + __builtin_shuffle(acc[2 * j], acc[2 * j + 1], odd);
+        for (int j = 0; j < 2; ++j)
+          q[j] = __builtin_shuffle(p[2 * j], p[2 * j + 1], lo2) + __builtin_shuffle(p[2 * j], p[2 * j + 1], hi2);
+        v8 r;
+        load8(r, out + x);
+        r += sparse_part;
+        r += __builtin_shuffle(q[0], q[1], lo4) + __builtin_shuffle(q[0], q[1], hi4);
+        std::memcpy(out + x, &r, sizeof r);
+      }
+    }
+}
+
+}  // namespace miner::heuristic::kernels

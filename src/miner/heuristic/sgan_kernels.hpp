@@ -1,0 +1,48 @@
+#pragma once
+/// \file
+/// MINER's own kernels for the sGAN generator's two full-resolution layers at width 8 (the
+/// shipped network), where oneDNN's are least efficient (3 input channels into enc1; one
+/// output channel out of dec1). Both read zero-padded grids, so every voxel takes the same
+/// path (zero padding is the convolutions' padding 1), and both skip the work that the
+/// inputs E/2 and S make zero: those two channels are constant over most of the grid and zero
+/// on 70-80 % of it, so their taps are scattered from the nonzero voxels only, while the
+/// dense channels (the noise N into enc1, a1 into dec1) are gathered. Compiled for
+/// x86-64-v4 (AVX-512), x86-64-v3 (AVX2 + FMA) and the baseline, picked at load time by the
+/// CPU (GCC target_clones): bytes are the same for the same machine, as oneDNN's are.
+///
+/// Grids: n = (nx, ny, nz) voxels, x fastest; a padded grid has (nx + 2)(ny + 2)(nz + 2)
+/// voxels, voxel (x, y, z) of the grid at padded (x + 1, y + 1, z + 1), the border zero.
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace miner::heuristic::kernels {
+
+/// The width of the network the kernels are for (a1 has 8 channels).
+inline constexpr int kWidth = 8;
+
+/// A nonzero voxel of the sparse inputs: its index in the padded grid and its E/2 and S.
+struct SparseInput {
+  std::int32_t padded;
+  float environment, state;
+};
+
+/// a1 = relu(conv3([E/2, S, N]) + bias), written channels-last into the interior of the padded
+/// a1_padded ((nx + 2)(ny + 2)(nz + 2) x 8 floats; the border is left zero: the sparse taps are
+/// scattered without bounds tests, onto the border too, which is cleared afterwards).
+///   noise_padded: N on the padded grid (planar, border zero);
+///   sparse: the voxels where E/2 or S is nonzero;
+///   weights: PyTorch's oidhw [8][3][27] (input channels E/2, S, N); bias[8].
+void first_layer(const int n[3], const float* noise_padded, const std::vector<SparseInput>& sparse,
+                 const float* weights, const float* bias, float* a1_padded);
+
+/// The logits' skip part of dec1 added to `logits` (nx ny nz floats, holding the bias and the
+/// up-sampled part): logits[v] += sum over taps t of a1[v + t] . W_a[t] + E/2[v + t] W_e[t] +
+/// S[v + t] W_s[t], with a1 from first_layer (padded, channels-last), E/2 and S on the padded
+/// grid (planar; one output channel, so these two are gathered 8 voxels to a vector, cheaper
+/// than a scatter here) and skip_weights PyTorch's [1][10][27] (input channels a1 0..7, E/2, S).
+void last_layer_skip(const int n[3], const float* a1_padded, const float* environment_padded,
+                     const float* state_padded, const float* skip_weights, float* logits);
+
+}  // namespace miner::heuristic::kernels

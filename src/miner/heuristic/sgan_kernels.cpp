@@ -13,6 +13,15 @@ namespace {
 using v8 = float __attribute__((vector_size(32)));
 using v8i = int __attribute__((vector_size(32)));
 
+// Lanes i0..i7 of the 16 of (a, b): GCC's and Clang's spellings (ci/fuzz.sh builds with Clang).
+#if defined(__clang__)
+#define MINER_SHUFFLE8(a, b, i0, i1, i2, i3, i4, i5, i6, i7) __builtin_shufflevector(a, b, i0, i1, i2, i3, i4, i5, i6, i7)
+#define MINER_KERNEL_CLONES
+#else
+#define MINER_SHUFFLE8(a, b, i0, i1, i2, i3, i4, i5, i6, i7) __builtin_shuffle(a, b, v8i{i0, i1, i2, i3, i4, i5, i6, i7})
+#define MINER_KERNEL_CLONES __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+#endif
+
 /// r <- p[0..7] (unaligned); by reference, as no v8 crosses a function boundary by value.
 inline void load8(v8& r, const float* p) { std::memcpy(&r, p, sizeof r); }
 
@@ -36,7 +45,7 @@ void clear_border(const int n[3], int c, float* padded) {
 // Tap t = (dz + 1) 9 + (dy + 1) 3 + (dx + 1), as PyTorch's [kd][kh][kw] flattened. A voxel v
 // reads input v + (dx, dy, dz) at tap t, so an input u reaches the outputs u - (dx, dy, dz).
 
-__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+MINER_KERNEL_CLONES
 void first_layer(const int n[3], const float* noise_padded, const std::vector<SparseInput>& sparse,
                  const float* weights, const float* bias, float* a1_padded) {
   const int nx = n[0], ny = n[1], nz = n[2];
@@ -83,14 +92,14 @@ void first_layer(const int n[3], const float* noise_padded, const std::vector<Sp
           for (int j = 0; j < 8; ++j) acc[j] += p[j] * w;
         }
         for (int j = 0; j < 8; ++j) {
-          const v8 r = acc[j] > zero ? acc[j] : zero;
+          const v8 r = (v8)((v8i)acc[j] & (acc[j] > zero));  // ReLU: the lanes above zero, else +0
           std::memcpy(arow + (x + j) * kWidth, &r, sizeof r);
         }
       }
     }
 }
 
-__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+MINER_KERNEL_CLONES
 void last_layer_skip(const int n[3], const float* a1_padded, const float* environment_padded,
                      const float* state_padded, const float* skip_weights, float* logits) {
   const int nx = n[0], ny = n[1], nz = n[2];
@@ -107,9 +116,6 @@ void last_layer_skip(const int n[3], const float* a1_padded, const float* enviro
   std::ptrdiff_t off[27];
   for (int t = 0; t < 27; ++t) off[t] = ((t / 9 - 1) * pxy + (t / 3 % 3 - 1) * px + (t % 3 - 1)) * kWidth;
   // Pairwise sums of 8 accumulators into one vector of 8 totals (an 8 x 8 transpose-add).
-  const v8i even = {0, 8, 2, 10, 4, 12, 6, 14}, odd = {1, 9, 3, 11, 5, 13, 7, 15};
-  const v8i lo2 = {0, 1, 8, 9, 4, 5, 12, 13}, hi2 = {2, 3, 10, 11, 6, 7, 14, 15};
-  const v8i lo4 = {0, 1, 2, 3, 8, 9, 10, 11}, hi4 = {4, 5, 6, 7, 12, 13, 14, 15};
   for (int z = 0; z < nz; ++z)
     for (int y = 0; y < ny; ++y) {
       const std::ptrdiff_t row = (z + 1) * pxy + (y + 1) * px + 1;  // padded index of (0, y, z)
@@ -137,13 +143,15 @@ void last_layer_skip(const int n[3], const float* a1_padded, const float* enviro
         }
         v8 p[4], q[2];
         for (int j = 0; j < 4; ++j)
-          p[j] = __builtin_shuffle(acc[2 * j], acc[2 * j + 1], even) + __builtin_shuffle(acc[2 * j], acc[2 * j + 1], odd);
+          p[j] = MINER_SHUFFLE8(acc[2 * j], acc[2 * j + 1], 0, 8, 2, 10, 4, 12, 6, 14) +
+                 MINER_SHUFFLE8(acc[2 * j], acc[2 * j + 1], 1, 9, 3, 11, 5, 13, 7, 15);
         for (int j = 0; j < 2; ++j)
-          q[j] = __builtin_shuffle(p[2 * j], p[2 * j + 1], lo2) + __builtin_shuffle(p[2 * j], p[2 * j + 1], hi2);
+          q[j] = MINER_SHUFFLE8(p[2 * j], p[2 * j + 1], 0, 1, 8, 9, 4, 5, 12, 13) +
+                 MINER_SHUFFLE8(p[2 * j], p[2 * j + 1], 2, 3, 10, 11, 6, 7, 14, 15);
         v8 r;
         load8(r, out + x);
         r += sparse_part;
-        r += __builtin_shuffle(q[0], q[1], lo4) + __builtin_shuffle(q[0], q[1], hi4);
+        r += MINER_SHUFFLE8(q[0], q[1], 0, 1, 2, 3, 8, 9, 10, 11) + MINER_SHUFFLE8(q[0], q[1], 4, 5, 6, 7, 12, 13, 14, 15);
         std::memcpy(out + x, &r, sizeof r);
       }
     }

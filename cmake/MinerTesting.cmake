@@ -5,8 +5,8 @@
 #   registers every TEST_CASE as its own CTest test carrying <label>, and records
 #   the binary for the traceability check (cmake/Traceability.cmake).
 #
-# Labels: unit, property, golden, statistical, bench-smoke, long, cluster, fuzz (CI skips long,
-# cluster and fuzz: the test presets exclude the label regex `long|cluster|fuzz`).
+# Labels: unit, property, golden, statistical, bench-smoke, long, cluster, fuzz, mutation (CI skips long,
+# cluster, fuzz and mutation: the test presets exclude the label regex `long|cluster|fuzz|mutation`).
 function(miner_add_catch_test target)
   cmake_parse_arguments(ARG "" "LABEL" "SOURCES;LIBS" ${ARGN})
   if(NOT ARG_LABEL)

@@ -123,6 +123,28 @@ TEST_CASE("The SE(3) controller turns a feed-forward acceleration into attitude 
   CHECK(sat.command.x < 0.0);  // roll negative tilts thrust toward +y
 }
 
+TEST_CASE("On a moving reference the controller feeds the vehicle's drag forward", "[REQ-FLIGHT-006]") {
+  // On the reference, level, moving with it: no error, so a_cmd = ref.a + R D R^T v / m, the
+  // acceleration that cancels the linear drag; the thrust tilts into the motion by
+  // atan(a_drag / g). Dropped or of the wrong sign, the vehicle would lag at speed.
+  const flight::VehicleParams v;
+  for (const Eigen::Vector3d& vel : {Eigen::Vector3d(2.0, 0.0, 0.0), Eigen::Vector3d(0.0, -1.5, 0.0)}) {
+    flight::Se3Controller c(v, flight::ControllerParams{});
+    flight::Reference ref;
+    ref.v = vel;
+    ref.a = Eigen::Vector3d::Zero();
+    flight::NavState on_ref;
+    on_ref.v = vel;
+    const auto out = c.update(ref, on_ref, 0.01);
+    const Eigen::Vector3d a_drag = v.linear_drag.cwiseProduct(vel) / v.mass;
+    INFO("reference velocity " << vel.transpose());
+    CHECK((out.a_cmd - a_drag).norm() < 1e-12);
+    const Eigen::Vector3d z = flight::rotation_zyx({out.command.x, out.command.y, 0.0}).col(2);
+    const Eigen::Vector3d thrust_dir = (a_drag + Eigen::Vector3d(0, 0, flight::kGravity)).normalized();
+    CHECK((z - thrust_dir).norm() < 1e-9);  // tilted into the motion
+  }
+}
+
 TEST_CASE("The position integrator does not wind up", "[REQ-FLIGHT-006]") {
   const flight::VehicleParams v;
   flight::ControllerParams p;

@@ -97,6 +97,27 @@ TEST_CASE("Free fall follows p = p0 - g t^2 / 2 and rotors follow their first-or
   CHECK(d.rotor[0] == Approx(expected_down).epsilon(1e-8));
 }
 
+TEST_CASE("Linear drag decays the velocity as v0 exp(-d t / m) per axis, against the motion", "[REQ-FLIGHT-002]") {
+  // Level, rotors held at the hover speed: thrust = weight and no torque, so each world axis is
+  // m dv/dt = -d v (body = world axes when level): v = v0 e^{-kt}, p = p0 + v0 (1 - e^{-kt}) / k,
+  // k = d / m. A drag of the wrong sign (or none) makes |v| grow (or stay).
+  const flight::VehicleParams v;  // drag (0.10, 0.10, 0.15) N/(m/s), 1.5 kg
+  flight::Integrator integrator(v, {1e-10, 20000});
+  const Eigen::Vector3d p0(0, 0, 5), v0(2.0, -1.0, 0.5);
+  flight::QuadState s = flight::hover_state(v, p0);
+  s.v = v0;
+  const Eigen::Vector4d u = s.rotor;
+  const double t = 2.0;
+  integrator.advance(s, 0.0, t, u);
+  for (int a = 0; a < 3; ++a) {
+    const double k = v.linear_drag[a] / v.mass;
+    INFO("axis " << a);
+    CHECK(s.v[a] == Approx(v0[a] * std::exp(-k * t)).epsilon(1e-7));
+    CHECK(s.p[a] == Approx(p0[a] + v0[a] * (1.0 - std::exp(-k * t)) / k).epsilon(1e-7));
+    CHECK(std::abs(s.v[a]) < std::abs(v0[a]));
+  }
+}
+
 TEST_CASE("A torque-free spin conserves angular momentum and energy and keeps q unit", "[REQ-FLIGHT-002]") {
   const flight::VehicleParams v;
   flight::Integrator integrator(v, {1e-9, 50000});

@@ -299,6 +299,16 @@ struct Sgan::Impl {
   /// One plane of the logits' start: bias + d2's up-sampled part (up[2]).
   void logit_base_plane(int z, float* dst) const;
 
+  /// The last layer's bias and R = sigmoid(logits), in place on out.
+  void set_output(float bias) {
+    last_bias = bias;
+    out_memory = memory(out.desc(), engine, out.data.data());
+    sigmoid = dnnl::eltwise_forward(dnnl::eltwise_forward::primitive_desc(
+        dnnl::eltwise_forward::desc(dnnl::prop_kind::forward_inference, dnnl::algorithm::eltwise_logistic, out.desc(),
+                                    0.0f, 0.0f),
+        engine));
+  }
+
   /// sigma, constant over the bottleneck's grid (nothing when the network has no scale input).
   void set_scale(const std::vector<float>& scale) {
     if (sigma.channels == 0) return;
@@ -423,12 +433,7 @@ void Sgan::Impl::build(const TensorFile& f, Sgan::Kernels which) {
         first_bias = bt.values;
       } else {
         skip_weights = wt.values;
-        last_bias = bt.values[0];
-        out_memory = memory(out.desc(), engine, out.data.data());
-        sigmoid = dnnl::eltwise_forward(dnnl::eltwise_forward::primitive_desc(
-            dnnl::eltwise_forward::desc(dnnl::prop_kind::forward_inference, dnnl::algorithm::eltwise_logistic,
-                                        out.desc(), 0.0f, 0.0f),
-            engine));
+        set_output(bt.values[0]);
       }
       continue;
     }
@@ -460,15 +465,10 @@ void Sgan::Impl::build(const TensorFile& f, Sgan::Kernels which) {
       memory user(memory::desc({kTapChannels, cs, 1, 1, 1}, Type::f32, Tag::oidhw), engine, last_tap_weights.data());
       c.weights = memory(pd.weights_desc(), engine);
       dnnl::reorder(user, c.weights).execute(stream, user, c.weights);
-      last_bias = bt.values[0];
+      set_output(bt.values[0]);
       plane_base.assign(static_cast<std::size_t>(n1.x() * n1.y()), 0.0f);
       c.src = memory(src.desc(), engine, src.data.data());
       c.dst = memory(taps_plane, engine, taps.data.data());  // moved along the ring in run()
-      out_memory = memory(out.desc(), engine, out.data.data());
-      sigmoid = dnnl::eltwise_forward(dnnl::eltwise_forward::primitive_desc(
-          dnnl::eltwise_forward::desc(dnnl::prop_kind::forward_inference, dnnl::algorithm::eltwise_logistic,
-                                      out.desc(), 0.0f, 0.0f),
-          engine));
       continue;
     }
     set_conv(c, relu_conv(engine, src.desc(), dst.desc(), kStrides[l], decoder), engine, stream, wt, bt);

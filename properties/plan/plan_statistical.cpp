@@ -106,6 +106,51 @@ TEST_CASE("Lemma 1: miner with a region that holds no path still solves within K
   CHECK(solved >= k);
 }
 
+TEST_CASE("MINER samples H with probability mu_2 before the first solution and mu_1 after it", "[REQ-PLAN-004]") {
+  // Alg. 1 with the paper's fixed mu (safeguard off): each iteration samples x_goal with
+  // probability goal_bias, else H with probability mu_2 before the first solution and mu_1
+  // after it, so the counts of H samples are Binomial(iterations, (1 - goal_bias) mu). The
+  // adversarial region keeps the first solution ~1000 iterations away; common random numbers
+  // (same seed and stream) make the run to K extend the run to the first solution. Each count
+  // must lie inside its two-sided binomial interval (false fail <= 1e-6 each); swapping mu_1
+  // and mu_2 moves both rates by 0.38, hundreds of standard deviations at these counts.
+  const auto map = wall_with_door_map();
+  const auto problem = PlanningProblem::make(map, kStart, kGoal, 0.0);
+  const HeuristicRegion region = adversarial_door_region(map);
+  PlannerOptions base;
+  base.planner = PlannerKind::kMiner;
+  base.safeguard = false;
+  base.seed = seed_for_set(4242, seed_set());
+  const std::size_t after_first = 3000;
+  long before_iterations = 0, before_h = 0, after_iterations = 0, after_h = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    PlannerOptions o = base;
+    o.stream = static_cast<std::uint64_t>(trial);
+    o.stop_at_first = true;
+    const PlanResult a = miner::plan::plan(problem, o, &region);
+    REQUIRE(a.first);
+    o.stop_at_first = false;
+    o.max_iterations = a.iterations + after_first;
+    const PlanResult b = miner::plan::plan(problem, o, &region);
+    REQUIRE(b.first);
+    REQUIRE(b.first->iteration == a.first->iteration);  // the same run up to the first solution
+    before_iterations += static_cast<long>(a.iterations);
+    before_h += static_cast<long>(a.region_samples);
+    after_iterations += static_cast<long>(b.iterations - a.iterations);
+    after_h += static_cast<long>(b.region_samples - a.region_samples);
+  }
+  const double q = 1.0 - base.goal_bias;
+  const auto before = miner::testing::binomial_interval(static_cast<int>(before_iterations), q * base.mu_2);
+  const auto after = miner::testing::binomial_interval(static_cast<int>(after_iterations), q * base.mu_1);
+  INFO("before the first solution: " << before_h << " of " << before_iterations << " in [" << before.lo << ", "
+                                     << before.hi << "]; after: " << after_h << " of " << after_iterations << " in ["
+                                     << after.lo << ", " << after.hi << "]");
+  CHECK(before_h >= before.lo);
+  CHECK(before_h <= before.hi);
+  CHECK(after_h >= after.lo);
+  CHECK(after_h <= after.hi);
+}
+
 TEST_CASE("Under common random numbers, solved after K1 iterations implies solved after K2", "[REQ-PLAN-013]") {
   const auto map = wall_with_door_map();
   const auto problem = PlanningProblem::make(map, kStart, kGoal, 0.0);

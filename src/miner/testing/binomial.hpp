@@ -76,6 +76,31 @@ inline BinomialTest size_binomial_test(double p0, double p1, double alpha = kFal
   throw std::domain_error("size_binomial_test: no n <= n_max separates p0 from p1 at these error rates");
 }
 
+/// [lo, hi] with P(X < lo) <= alpha / 2 and P(X > hi) <= alpha / 2 for X ~ Binomial(n, p): a
+/// count outside it rejects "the rate is p" with a false-fail rate <= alpha (bisection on
+/// the exact CDF).
+struct CountInterval {
+  long lo = 0, hi = 0;
+};
+inline CountInterval binomial_interval(int n, double p, double alpha = kFalseFailRate) {
+  if (n < 0 || !(p >= 0.0 && p <= 1.0) || !(alpha > 0.0 && alpha < 1.0))
+    throw std::invalid_argument("binomial_interval: need n >= 0, p in [0, 1], alpha in (0, 1)");
+  // lo: the largest k with P(X <= k - 1) <= alpha / 2; hi: the smallest k with P(X > k) <= alpha / 2.
+  int a = 0, b = n;  // P(X <= a - 1) = 0 <= alpha/2 always holds at a = 0
+  while (a < b) {
+    const int m = a + (b - a + 1) / 2;
+    if (binomial_cdf(m - 1, n, p) <= alpha / 2) a = m; else b = m - 1;
+  }
+  const int lo = a;
+  a = 0;
+  b = n;
+  while (a < b) {
+    const int m = a + (b - a) / 2;
+    if (1.0 - binomial_cdf(m, n, p) <= alpha / 2) b = m; else a = m + 1;
+  }
+  return {lo, a};
+}
+
 /// The seed set of a statistical test: 0 in CI's run; the `long` label runs the same tests
 /// with MINER_SEED_SET = 1, 2, 3 (each test mixes it into its master seed), so each test is
 /// not one fixed draw.

@@ -87,3 +87,18 @@ TEST_CASE("Seed sets: 0 is CI's seed, others mix it, MINER_SEED_SET chooses", "[
   ::unsetenv("MINER_SEED_SET");
   CHECK(miner::testing::seed_set() == 0);
 }
+
+TEST_CASE("binomial_interval bounds a count on both sides at the stated rate", "[REQ-HARNESS-005]") {
+  using miner::testing::binomial_cdf;
+  const auto iv = miner::testing::binomial_interval(1000, 0.3, 1e-6);
+  CHECK(binomial_cdf(static_cast<int>(iv.lo) - 1, 1000, 0.3) <= 5e-7);
+  CHECK(binomial_cdf(static_cast<int>(iv.lo), 1000, 0.3) > 5e-7);      // as tight as allowed
+  CHECK(1.0 - binomial_cdf(static_cast<int>(iv.hi), 1000, 0.3) <= 5e-7);
+  CHECK(1.0 - binomial_cdf(static_cast<int>(iv.hi) - 1, 1000, 0.3) > 5e-7);
+  CHECK(iv.lo < 300);
+  CHECK(iv.hi > 300);
+  const auto edge = miner::testing::binomial_interval(10, 1.0);
+  CHECK(edge.lo == 10);
+  CHECK(edge.hi == 10);
+  CHECK_THROWS_AS(miner::testing::binomial_interval(10, 1.5), std::invalid_argument);
+}

@@ -172,6 +172,19 @@ class TraceCheckerTest(unittest.TestCase):
             self.assertEqual(r.returncode, 1, r.stderr)
             self.assertIn("world_test: Map loads: failed in this run", r.stderr)
 
+    def test_list_tests_output_is_parsed_with_wrapped_names_and_tags(self):
+        text = ("All available test cases:\n"
+                "  Short test\n      [REQ-A-001][unit]\n"
+                "  A long name that Catch2 wraps at eighty columns when it lists the tests of\n"
+                "    a binary\n      [REQ-A-002][REQ-A-001]\n      [REQ-B-003]\n"
+                "3 test cases\n")
+        exact = {"Short test", "A long name that Catch2 wraps at eighty columns when it lists the tests of a binary"}
+        got = trace.parse_list_tests(text, exact)
+        self.assertEqual(sorted(got["REQ-A-001"]), sorted(exact))
+        self.assertEqual(got["REQ-B-003"], [sorted(exact)[0]])
+        # A wrapped name that matches no exact name (a split word): no guess, fall back.
+        self.assertIsNone(trace.parse_list_tests(text, {"Short test", "something else"}))
+
     def test_script_citations_are_read(self):
         found = trace.script_citations(__file__)
         self.assertIn("REQ-HARNESS-001", found)

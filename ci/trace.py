@@ -187,13 +187,52 @@ def run(args: list[str]) -> str:
     return result.stdout
 
 
-def catch_citations(binary: str) -> dict[str, list[str]]:
-    """Asks a Catch2 v2 binary for its REQ tags, then for the tests under each tag; a hidden
-    test (one a plain run skips: absent from the unfiltered list) does not count."""
+def parse_list_tests(text: str, exact_names: set[str]) -> dict[str, list[str]] | None:
+    """Catch2 v2's `--list-tests` (names at indent 2, wrapped on lines at indent 4, tags at
+    indent 6) -> {REQ id: [exact test name]}; None when a wrapped name cannot be matched to
+    one of exact_names (whitespace aside), so the caller falls back to a query per tag."""
+    if "test case" not in text:  # not Catch2's listing
+        return None
+    by_words = {" ".join(n.split()): n for n in exact_names}
+    entries: list[list[str]] = []  # [name parts, tag text]
+    for line in text.splitlines():
+        indent = len(line) - len(line.lstrip(" "))
+        body = line.strip()
+        if not body or indent == 0:
+            continue
+        if indent >= 6 and body.startswith("[") and entries:
+            entries[-1][1] += body
+        elif indent >= 4 and entries and not entries[-1][1]:
+            entries[-1][0] += " " + body
+        elif indent == 2:
+            entries.append([body, ""])
+        else:
+            return None
+    if len(entries) != len(exact_names):
+        return None
     found: dict[str, list[str]] = defaultdict(list)
-    tags = sorted(set(TAG.findall(run([binary, "--list-tags"]))))
+    for name, tags in entries:
+        exact = by_words.get(" ".join(name.split()))
+        if exact is None:
+            return None
+        for rid in sorted(set(TAG.findall(tags))):
+            found[rid].append(exact)
+    return found
+
+
+def catch_citations(binary: str) -> dict[str, list[str]]:
+    """Asks a Catch2 v2 binary for its tests and their REQ tags (one `--list-tests`, checked
+    against `--list-test-names-only`; else a query per tag); a hidden test (one a plain run
+    skips: absent from the unfiltered list) does not count."""
+    found: dict[str, list[str]] = defaultdict(list)
     short = pathlib.Path(binary).name
     visible = {n.strip() for n in run([binary, "--list-test-names-only"]).splitlines() if n.strip()}
+    listed = parse_list_tests(run([binary, "--list-tests"]), visible)
+    if listed is not None:
+        for rid, names in listed.items():
+            found[rid].extend(f"{short}: {n}" for n in names)
+        return found
+    tags = sorted(set(TAG.findall(run([binary, "--list-tags"]))))
     for rid in tags:
         out = run([binary, "--list-test-names-only", f"[{rid}]"])
         for name in out.splitlines():

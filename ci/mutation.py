@@ -226,7 +226,13 @@ def main(argv: list[str]) -> int:
     b.discover()
 
     results: list[dict] = []
+    # Every selection's baseline on the unmutated build, before any mutant: a restored file is
+    # rebuilt only with the next mutant, so a baseline run later would test the last mutant.
     baseline: dict[str, tuple[bool, str]] = {}
+    for m in mutants:
+        sel = b.selection(m["requirements"])
+        if sel and not m.get("excluded") and json.dumps(sel) not in baseline:
+            baseline[json.dumps(sel)] = b.run(sel, a.timeout)
     for m in mutants:
         r = {k: m[k] for k in ("id", "capability", "operator", "why")}
         if m.get("excluded"):
@@ -239,8 +245,6 @@ def main(argv: list[str]) -> int:
             r.update(status="unusable", by="no non-golden test cites " + ", ".join(m["requirements"]))
             results.append(r)
             continue
-        if key not in baseline:
-            baseline[key] = b.run(sel, a.timeout)
         if not baseline[key][0]:
             r.update(status="unusable", by="fails unmutated: " + baseline[key][1])
             results.append(r)

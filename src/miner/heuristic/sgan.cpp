@@ -54,13 +54,12 @@ struct Activation {
   std::size_t voxels() const { return static_cast<std::size_t>(dims.prod()); }
 };
 
-/// Copies one source into channels [offset, offset + src.channels) of dst, at dst's resolution
-/// or, with `up`, from half of it (nearest-neighbour upsampling by 2, as
-/// torch.nn.functional.interpolate(scale_factor=2, mode="nearest")). kChannels = src.channels
-/// when known at compile time (a fixed-size copy the compiler turns into vector moves), else 0.
-/// dst may be a slab of planes of the full grid, starting at plane z0.
+/// Copies one source (at dst's resolution) into channels [offset, offset + src.channels) of
+/// dst. kChannels = src.channels when known at compile time (a fixed-size copy the compiler
+/// turns into vector moves), else 0. dst may be a slab of planes of the full grid, starting at
+/// plane z0. (Nothing is up-sampled: the decoder convolves on the coarse grid, UpsampledPart.)
 template <std::size_t kChannels>
-void copy_into(Activation& dst, const Activation& src, bool up, std::size_t offset, int z0) {
+void copy_into(Activation& dst, const Activation& src, std::size_t offset, int z0) {
   const std::size_t sc = kChannels ? kChannels : static_cast<std::size_t>(src.channels);
   const Eigen::Vector3i d = dst.dims;
   const auto dc = static_cast<std::size_t>(dst.channels);
@@ -69,26 +68,25 @@ void copy_into(Activation& dst, const Activation& src, bool up, std::size_t offs
   const float* in = src.data.data();
   for (int z = z0; z < z0 + d.z(); ++z)
     for (int y = 0; y < d.y(); ++y) {
-      const std::size_t row = up ? (static_cast<std::size_t>(z / 2) * sy + static_cast<std::size_t>(y / 2)) * sx
-                                 : (static_cast<std::size_t>(z) * sy + static_cast<std::size_t>(y)) * sx;
+      const std::size_t row = (static_cast<std::size_t>(z) * sy + static_cast<std::size_t>(y)) * sx;
       for (int x = 0; x < d.x(); ++x, out += dc) {
-        const float* v = in + (row + static_cast<std::size_t>(up ? x / 2 : x)) * sc;
+        const float* v = in + (row + static_cast<std::size_t>(x)) * sc;
         for (std::size_t ch = 0; ch < sc; ++ch) out[ch] = v[ch];
       }
     }
 }
 
-/// dst <- [srcs...] along channels; every source is at dst's resolution or, with `upsample`
-/// set for it, at half of it (see copy_into); dst holds the planes from z0 on.
-void concat(Activation& dst, const std::vector<std::pair<const Activation*, bool>>& srcs, int z0 = 0) {
+/// dst <- [srcs...] along channels, every source at dst's resolution; dst holds the planes
+/// from z0 on.
+void concat(Activation& dst, const std::vector<const Activation*>& srcs, int z0 = 0) {
   std::size_t offset = 0;  // channel offset of the current source in dst
-  for (const auto& [src, up] : srcs) {
+  for (const Activation* src : srcs) {
     switch (src->channels) {  // the widths of the shipped width-8 network
-      case 2: copy_into<2>(dst, *src, up, offset, z0); break;
-      case 8: copy_into<8>(dst, *src, up, offset, z0); break;
-      case 16: copy_into<16>(dst, *src, up, offset, z0); break;
-      case 32: copy_into<32>(dst, *src, up, offset, z0); break;
-      default: copy_into<0>(dst, *src, up, offset, z0);
+      case 2: copy_into<2>(dst, *src, offset, z0); break;
+      case 8: copy_into<8>(dst, *src, offset, z0); break;
+      case 16: copy_into<16>(dst, *src, offset, z0); break;
+      case 32: copy_into<32>(dst, *src, offset, z0); break;
+      default: copy_into<0>(dst, *src, offset, z0);
     }
     offset += static_cast<std::size_t>(src->channels);
   }
@@ -203,13 +201,13 @@ void set_upsampled_part(UpsampledPart& u, const dnnl::engine& engine, dnnl::stre
   u.dst = memory(u.parities.desc(), engine, u.parities.data.data());
 }
 
-/// dst (cout channels on the fine grid, planes z0 on) <- u's parities read back at each fine
+/// dst (cout channels on the fine grid) <- u's parities read back at each fine
 /// voxel: dst[f][o] = parities[q][p cout + o], q_a = (f_a + 1) / 2, p_a = f_a mod 2.
-void scatter_parities(Activation& dst, const UpsampledPart& u, int z0 = 0) {
+void scatter_parities(Activation& dst, const UpsampledPart& u) {
   const Eigen::Vector3i d = dst.dims, qd = u.parities.dims;
   const auto co = static_cast<std::size_t>(u.cout), qc = static_cast<std::size_t>(u.parities.channels);
   float* out = dst.data.data();
-  for (int z = z0; z < z0 + d.z(); ++z)
+  for (int z = 0; z < d.z(); ++z)
     for (int y = 0; y < d.y(); ++y) {
       const std::size_t row = (static_cast<std::size_t>((z + 1) / 2) * static_cast<std::size_t>(qd.y()) +
                                static_cast<std::size_t>((y + 1) / 2)) *
@@ -633,11 +631,11 @@ std::vector<float> Sgan::Impl::run() {
   max_pool2(g.c2, g.cond1);
   max_pool2(g.c4, g.c2);
   max_pool2(g.c8, g.c4);
-  concat(g.cat2, {{&g.a2, false}, {&g.c2, false}});
+  concat(g.cat2, {&g.a2, &g.c2});
   run(2);  // a3
-  concat(g.cat3, {{&g.a3, false}, {&g.c4, false}});
+  concat(g.cat3, {&g.a3, &g.c4});
   run(3);  // a4
-  concat(g.cat4, {{&g.a4, false}, {&g.c8, false}, {&g.sigma, false}});
+  concat(g.cat4, {&g.a4, &g.c8, &g.sigma});
   run(4);  // m1
   run(5);  // m2
   auto run_up = [&](UpsampledPart& u) {
@@ -666,7 +664,7 @@ std::vector<float> Sgan::Impl::run() {
   const std::size_t plane = g.taps.voxels() / 3 * static_cast<std::size_t>(kTapChannels);
   const auto slot = [&](int p) -> float* { return g.taps.data.data() + static_cast<std::size_t>(p % 3) * plane; };
   for (int p = 0; p < nz; ++p) {
-    concat(g.catd1, {{&g.a1, false}, {&g.cond1, false}}, p);
+    concat(g.catd1, {&g.a1, &g.cond1}, p);
     g.conv[8].dst.set_data_handle(slot(p));
     run(8);  // tap products of plane p
     if (p >= 1) g.shift_sum_plane(p - 1, {p >= 2 ? slot(p - 2) : nullptr, slot(p - 1), slot(p)});

@@ -53,7 +53,7 @@ Eigen::MatrixX3d random_points() {
 TEST_CASE("Tracking error stays under the derived bound on random feasible trajectories", "[REQ-FLIGHT-008]") {
   // Each case is a closed-loop flight of ~10 s (5000 CVODE ticks, ~1.3 s under the
   // sanitizers); the `long` label runs 1000.
-  const miner::testing::Cases cases{40, "one closed-loop flight per case"};
+  const miner::testing::Cases cases{25, "one closed-loop flight per case"};
   property("random legs, v <= 2 m/s, a <= 2 m/s^2 reached exactly, sensor noise on", cases, [] {
     const Eigen::MatrixX3d points = random_points();
     const double v_max = *rc::gen::inRange(5, 21) / 10.0;
@@ -108,9 +108,11 @@ TEST_CASE("At the paper's speeds the tracking MSE is at or below the paper's rea
 
 TEST_CASE("Planned with the tracking margin, fixture-map flights never touch the inflated map", "[REQ-FLIGHT-007]") {
   // Without the margin (planning at the bare vehicle radius) 3 of 20 seeds of the default
-  // scenario grazed the inflated map by a few centimetres of tracking error.
+  // scenario grazed the inflated map by a few centimetres of tracking error. Three seeds per
+  // map here (each a whole sGAN -> RRT* -> MINCO -> flight run, ~3 s under the sanitizers);
+  // docs/flight.md's 30-seed sweep is the wider check.
   for (const char* map : {"indoor-1", "indoor-2"}) {
-    for (std::uint64_t seed = 1; seed <= 8; ++seed) {
+    for (std::uint64_t seed = 1; seed <= 3; ++seed) {
       miner::Json doc = miner::read_json_file(std::string(MINER_SOURCE_DIR) + "/fixtures/scenarios/default.json");
       doc["map"] = std::string("../maps/") + map + ".json";
       doc["seed"] = seed;
@@ -123,4 +125,104 @@ TEST_CASE("Planned with the tracking margin, fixture-map flights never touch the
       CHECK(r.goal_reached);
     }
   }
+}
+
+namespace {
+
+/// ||h||_1 of the position loop's error response per axis, h the impulse response of
+/// 1 / (s^2 + K_v s + K_p): the largest steady-or-transient error a unit disturbance
+/// acceleration bounded in magnitude can cause (|e|_inf <= ||h||_1 |d|_inf).
+double impulse_l1(double kp, double kv) {
+  double x = 0.0, v = 1.0, l1 = 0.0;  // h(0) = 0, h'(0) = 1
+  constexpr double dt = 1e-4;
+  for (int k = 0; k < 400000; ++k) {  // 40 s: e^{-40 min(kv/2, ...)} of the tail left
+    const double a = -kv * v - kp * x;
+    v += a * dt;
+    x += v * dt;
+    l1 += std::abs(x) * dt;
+  }
+  return l1;
+}
+
+/// Observed safety factor over the linear bound: the attitude loop's lag, the N3 latency and
+/// the EKF's delay make the loop respond later than the ideal PD does; 1.5 covers them on
+/// the ideal-vehicle property above (whose jerk term is the same lag).
+constexpr double kDisturbanceGain = 1.5;
+
+}  // namespace
+
+TEST_CASE("Tracking error stays under the disturbance-aware bound in wind and with model mismatch", "[REQ-FLIGHT-018]") {
+  // Random feasible trajectories (as above) flown by a vehicle with rotor and quadratic drag
+  // in a random mean wind, Dryden turbulence and a gust, whose mass, thrust coefficient and
+  // drag differ from the controller's model. The bound adds to REQ-FLIGHT-008's
+  //   G ||h||_1 d_max,   d_max = (D_w W + c_q W (W + 2 v_max)) / m'      (wind W = peak |w|)
+  //                              + |1 - c_T / c_m| (g + a_max)             (thrust / mass)
+  //                              + |c_d - 1| (D_w v_max + c_q v_max^2) / m'  (drag model)
+  // per the worst axis (||h||_1 of the slowest loop, x/y), m' the plant's mass.
+  const flight::ControllerParams gains;
+  const double h1 = std::max(impulse_l1(gains.kp.x(), gains.kv.x()), impulse_l1(gains.kp.z(), gains.kv.z()));
+  const miner::testing::Cases cases{15, "one closed-loop flight in wind per case"};
+  property("random legs and limits, random wind, turbulence, gust and mismatch", cases, [h1] {
+    const Eigen::MatrixX3d points = random_points();
+    // Inside the open room with the vehicle's radius and the planning margin to spare.
+    RC_PRE(points.col(2).maxCoeff() < 9.0 && points.col(2).minCoeff() > 1.0);
+    const double v_max = *rc::gen::inRange(5, 16) / 10.0;
+    const double a_max = *rc::gen::inRange(5, 16) / 10.0;
+    const auto seed = static_cast<std::uint64_t>(*rc::gen::inRange(1, 1000000));
+    pipeline::Scenario s = open_room_scenario(points, v_max, a_max, seed);
+    s.hover_after_s = 2.0;
+    s.vehicle.rotor_drag = 1e-4;
+    s.vehicle.quadratic_drag = 0.03;
+    s.wind.enabled = true;
+    const double heading = *rc::gen::inRange(0, 360) * miner::kPi / 180.0;
+    const double mean = *rc::gen::inRange(0, 16) / 10.0;
+    s.wind.mean = Eigen::Vector3d(mean * std::cos(heading), mean * std::sin(heading), 0.0);
+    s.wind.sigma_horizontal = *rc::gen::inRange(0, 11) / 10.0;
+    s.wind.sigma_vertical = *rc::gen::inRange(0, 6) / 10.0;
+    s.wind.gusts.push_back({*rc::gen::inRange(0, 60) / 10.0, 1.0 + *rc::gen::inRange(0, 20) / 10.0,
+                            Eigen::Vector3d(*rc::gen::inRange(-10, 11) / 10.0, *rc::gen::inRange(-10, 11) / 10.0, 0.0)});
+    s.mismatch.mass = *rc::gen::inRange(90, 111) / 100.0;
+    s.mismatch.thrust_coefficient = *rc::gen::inRange(95, 106) / 100.0;
+    s.mismatch.drag = *rc::gen::inRange(70, 151) / 100.0;
+    pipeline::ReferencePlan ref = pipeline::build_reference(s);
+    const double k = std::max(ref.max_speed / v_max, std::sqrt(ref.max_acceleration / a_max));
+    miner::traj::scale_time(ref.trajectory, k);
+    flight::FlyOptions options;
+    options.record_log = false;
+    const flight::FlightResult r = pipeline::fly(s, ref, options);
+    const flight::VehicleParams plant = flight::plant_vehicle(s.vehicle, s.mismatch);
+    const double sum_w = 4.0 * plant.hover_rotor_speed() * 1.2;  // rotors up to 20 % above hover
+    const double d_w = plant.linear_drag.maxCoeff() + plant.rotor_drag * sum_w;
+    const double w = r.wind_max;
+    const double d_max = (d_w * w + plant.quadratic_drag * w * (w + 2 * v_max)) / plant.mass +
+                         std::abs(1.0 - s.mismatch.thrust_coefficient / s.mismatch.mass) * (flight::kGravity + a_max) +
+                         std::abs(s.mismatch.drag - 1.0) *
+                             (d_w * v_max + plant.quadratic_drag * v_max * v_max) / s.mismatch.drag / plant.mass;
+    const double j = max_jerk(ref.trajectory);
+    const double bound = kMaxErrorFloor + kErrorPerJerk * j + kDisturbanceGain * h1 * d_max;
+    RC_LOG() << "v_max " << v_max << " a_max " << a_max << " jerk " << j << " wind max " << w << " d_max " << d_max
+             << " max error " << r.max_position_error << " bound " << bound << "\n";
+    RC_ASSERT(r.max_position_error <= bound);
+    RC_ASSERT(r.collisions == 0);
+  });
+}
+
+TEST_CASE("The realistic preset's tracking lands in the paper's real-flight range", "[REQ-FLIGHT-019]") {
+  // fixtures/scenarios/realistic.json: indoor-1 at the paper's speed with wind, gusts, rotor
+  // drag, model mismatch, battery sag and a drifting, jittering, dropping VIO pose. The paper's
+  // real flights: position MSE x / y 0.0513-0.1108 m^2; the issue's band is 0.01-0.2 m^2.
+  const pipeline::Scenario s = pipeline::load_scenario(std::string(MINER_SOURCE_DIR) + "/fixtures/scenarios/realistic.json");
+  const flight::FlightResult r = pipeline::fly(s, pipeline::build_reference(s));
+  INFO(flight::tracking_table(s.name, r) << r.summary.dump(1));
+  CHECK(r.goal_reached);
+  CHECK(r.collisions == 0);
+  for (int a = 0; a < 2; ++a) {
+    CHECK(r.position_mse[a] >= 0.01);
+    CHECK(r.position_mse[a] <= 0.2);
+  }
+  // Every model acted: wind, the VIO's losses and drift, the battery's sag.
+  CHECK(r.wind_max > 1.0);
+  CHECK(r.pose_losses > 0);
+  CHECK(r.pose_drift.norm() > 0.0);
+  CHECK(r.battery_min_voltage < s.battery.full_voltage);
 }

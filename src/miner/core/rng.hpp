@@ -35,6 +35,8 @@ namespace streams {
 inline constexpr std::uint64_t kImuNoise = 1;          ///< flight: IMU noise and bias walks
 inline constexpr std::uint64_t kPoseNoise = 2;         ///< flight: pose noise and outliers
 inline constexpr std::uint64_t kInitialEstimate = 3;   ///< flight: the EKF's initial error
+inline constexpr std::uint64_t kWind = 4;              ///< flight: Dryden turbulence
+inline constexpr std::uint64_t kPoseVio = 5;           ///< flight: VIO drift, tracking losses, delay jitter
 inline constexpr std::uint64_t kSganNoise = 0x5347414e;  ///< heuristic: the generator's noise ("SGAN")
 /// heuristic: a dataset sample's query, on its map seed (a stream the map generator never uses)
 inline constexpr std::uint64_t kDatasetQuery = 0x9e3779b97f4a7c15ULL;

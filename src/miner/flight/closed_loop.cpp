@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstdio>
 #include <deque>
+#include <iterator>
+#include <tuple>
 #include <sstream>
 
 #include <Eigen/Cholesky>
@@ -41,9 +43,43 @@ const std::vector<std::string>& flight_log_columns() {
     for (const char* n : {"rotor_0", "rotor_1", "rotor_2", "rotor_3"}) c.emplace_back(n);
     c.emplace_back("failsafe");
     c.emplace_back("collision");
+    // Issue 23: the reference's yaw, the yaw-rate command, the EKF's position sigma, the
+    // wind, the battery, saturation and the pose stream's losses.
+    c.emplace_back("ref_yaw");
+    c.emplace_back("cmd_yaw_rate");
+    add3("est_sigma_", "x", "y", "z");
+    add3("wind_", "x", "y", "z");
+    c.emplace_back("battery_v");
+    c.emplace_back("saturated");
+    c.emplace_back("pose_lost");
     return c;
   }();
   return columns;
+}
+
+const std::vector<std::string>& flight_log_units() {
+  static const std::vector<std::string> units = [] {
+    std::vector<std::string> u;
+    for (const auto& name : flight_log_columns()) {
+      const auto starts = [&](const char* prefix) { return name.rfind(prefix, 0) == 0; };
+      const auto is_v = name.find("_v") != std::string::npos && name != "battery_v";
+      std::string unit;
+      if (name == "t") unit = "s";
+      else if (starts("est_ba_") || starts("true_ba_")) unit = "m/s^2";
+      else if (starts("est_bg_") || starts("true_bg_") || name == "cmd_yaw_rate") unit = "rad/s";
+      else if (starts("rotor_")) unit = "rad/s";
+      else if (name.find("roll") != std::string::npos || name.find("pitch") != std::string::npos ||
+               name.find("yaw") != std::string::npos) unit = "rad";
+      else if (name == "cmd_thrust_pct") unit = "%";
+      else if (starts("wind_") || is_v) unit = "m/s";
+      else if (name == "battery_v") unit = "V";
+      else if (name == "failsafe" || name == "collision" || name == "saturated" || name == "pose_lost") unit = "0/1";
+      else unit = "m";
+      u.push_back(unit);
+    }
+    return u;
+  }();
+  return units;
 }
 
 namespace {
@@ -63,7 +99,8 @@ FlightResult fly(const FlightSetup& s, const ReferenceTrajectory& reference, con
   const double dt = 1.0 / s.n3.rate_hz;
   const int control_every = static_cast<int>(std::lround(s.n3.rate_hz / s.controller.rate_hz));
   const int pose_every = static_cast<int>(std::lround(s.n3.rate_hz / s.pose.rate_hz));
-  const int delay_ticks = static_cast<int>(std::lround(s.pose.delay_s / dt));
+  // The EKF's horizon waits for the latest a measurement can arrive (delay + jitter).
+  const int delay_ticks = static_cast<int>(std::lround((s.pose.delay_s + s.pose.delay_jitter_s) / dt));
   const double control_dt = control_every * dt;
   const auto& trajectory = reference.trajectory;
   const double t_traj = trajectory.total_duration();
@@ -71,7 +108,10 @@ FlightResult fly(const FlightSetup& s, const ReferenceTrajectory& reference, con
 
   Rng imu_rng(s.seed, streams::kImuNoise), pose_rng(s.seed, streams::kPoseNoise),
       init_rng(s.seed, streams::kInitialEstimate);
-  QuadState truth = hover_state(s.vehicle, s.start, 0.0);
+  // The plant: the nominal vehicle with the scenario's mismatch (the controller, N3 and EKF
+  // keep the nominal one).
+  const VehicleParams plant = s.mismatch.any() ? plant_vehicle(s.vehicle, s.mismatch) : s.vehicle;
+  QuadState truth = hover_state(plant, s.start, 0.0);
   ImuModel imu(s.imu, dt, imu_rng);
   NavState estimate0;
   estimate0.p = truth.p + normal3(init_rng, s.ekf.initial_position_sigma);
@@ -81,8 +121,18 @@ FlightResult fly(const FlightSetup& s, const ReferenceTrajectory& reference, con
   n3::FlightController fc(s.vehicle, s.n3);
   fc.obtain_control(0.0);
   Se3Controller controller(s.vehicle, s.controller);
-  Integrator integrator(s.vehicle, options.integrator);
-  const Mixer mixer(s.vehicle);
+  Integrator integrator(plant, options.integrator);
+  const Mixer mixer(plant);
+  Rng wind_rng(s.seed, streams::kWind), vio_rng(s.seed, streams::kPoseVio);
+  WindModel wind_model(s.wind, dt, wind_rng);
+  Battery battery(s.battery);
+  PoseSource pose_source(s.pose, pose_every * dt, s.start, pose_rng, vio_rng);
+  YawReference yaw_reference(s.yaw, 0.0);
+  Eigen::Vector3d wind = Eigen::Vector3d::Zero();
+  double wind_sq = 0.0;
+  bool battery_limited = false, control_saturated = false, speed_limited = false;
+  double yaw_rate_command = 0.0;
+  out.battery_min_voltage = s.battery.enabled ? battery.voltage() : 0.0;
 
   std::deque<std::pair<long, PoseMeasurement>> in_transit;
   std::deque<std::pair<long, NavState>> truth_history;  // for NEES at the horizon
@@ -94,7 +144,12 @@ FlightResult fly(const FlightSetup& s, const ReferenceTrajectory& reference, con
 
   for (long k = 0; k < total_ticks; ++k) {
     const double t = static_cast<double>(k) * dt;
-    const Eigen::Vector3d accel = acceleration(s.vehicle, mixer, truth);
+    if (s.wind.enabled) {
+      wind = wind_model.step(t, truth.v);
+      wind_sq += wind.squaredNorm();
+      out.wind_max = std::max(out.wind_max, wind.norm());
+    }
+    const Eigen::Vector3d accel = acceleration(plant, mixer, truth, Eigen::Vector3d::Zero(), wind);
     NavState truth_nav{truth.p, truth.v, truth.q, imu.accel_bias(), imu.gyro_bias()};
     if (options.record_consistency) {
       truth_history.emplace_back(k, truth_nav);
@@ -102,9 +157,14 @@ FlightResult fly(const FlightSetup& s, const ReferenceTrajectory& reference, con
     }
     ekf.push_imu(k, imu.sample(truth.q, truth.omega, accel));
     if (k % pose_every == 0) {
-      PoseMeasurement m = measure_pose(s.pose, t, truth.p, truth.q, pose_rng);
-      out.outliers_injected += m.outlier ? 1 : 0;
-      in_transit.emplace_back(k + delay_ticks, m);
+      if (auto d = pose_source.measure(t, truth.p, truth.q)) {
+        out.outliers_injected += d->measurement.outlier ? 1 : 0;
+        const long arrival = k + std::lround(d->delay / dt);
+        // In order of arrival (jitter may let a later stamp overtake an earlier one).
+        auto at = in_transit.end();
+        while (at != in_transit.begin() && std::prev(at)->first > arrival) --at;
+        in_transit.insert(at, {arrival, d->measurement});
+      }
     }
     while (!in_transit.empty() && in_transit.front().first <= k) {
       const FuseResult r = ekf.push_pose(in_transit.front().second);
@@ -119,13 +179,22 @@ FlightResult fly(const FlightSetup& s, const ReferenceTrajectory& reference, con
       ref.p = trajectory.evaluate(t);
       ref.v = trajectory.evaluate(t, 1);
       ref.a = trajectory.evaluate(t, 2);
+      std::tie(ref.yaw, ref.yaw_rate) = yaw_reference.step(ref.v, control_dt);
       const ControlOutput control = controller.update(ref, flown_on, control_dt);
+      control_saturated = control.saturated;
+      speed_limited = control.speed_limited;
+      yaw_rate_command = (control.command.flag & n3::kYawRate) ? control.command.yaw : 0.0;
+      const bool saturated_now = control_saturated || battery_limited;
+      if (saturated_now) out.saturation_time_s += control_dt;
+      if (speed_limited) out.speed_limited_time_s += control_dt;
+      if (pose_source.lost()) out.pose_lost_time_s += control_dt;
       const bool silent = s.command_dropout && t >= s.command_dropout->first && t < s.command_dropout->second;
       if (!silent) {
         if (!fc.has_authority()) fc.obtain_control(t);
         fc.submit(control.command, t);
         last_command = control.command;
       }
+      if (fc.in_failsafe()) out.failsafe_time_s += control_dt;  // as the log's failsafe column
       if (t <= t_traj) {
         const Eigen::Vector3d ep = truth.p - ref.p, ev = truth.v - ref.v;
         sum_p2 += ep.cwiseAbs2();
@@ -166,11 +235,28 @@ FlightResult fly(const FlightSetup& s, const ReferenceTrajectory& reference, con
         row.insert(row.end(), {truth.rotor[0], truth.rotor[1], truth.rotor[2], truth.rotor[3]});
         row.push_back(fc.in_failsafe() ? 1.0 : 0.0);
         row.push_back(colliding ? 1.0 : 0.0);
+        row.push_back(ref.yaw);
+        row.push_back(yaw_rate_command);
+        append(row, ekf.covariance().diagonal().head<3>().cwiseSqrt());
+        append(row, wind);
+        row.push_back(s.battery.enabled ? battery.voltage() : 0.0);
+        row.push_back(saturated_now ? 1.0 : 0.0);
+        row.push_back(pose_source.lost() ? 1.0 : 0.0);
         out.log.push_back(std::move(row));
       }
     }
-    const Eigen::Vector4d rotor_command = fc.step(t, truth);
-    integrator.advance(truth, t, t + dt, rotor_command);
+    Eigen::Vector4d rotor_command = fc.step(t, truth);
+    if (s.battery.enabled) {
+      // The sagging pack caps what the motors reach (the N3 does not know it).
+      const double limit = battery.rotor_speed_limit(plant);
+      battery_limited = rotor_command.maxCoeff() > limit;
+      rotor_command = rotor_command.cwiseMin(limit);
+    }
+    integrator.advance(truth, t, t + dt, rotor_command, Eigen::Vector3d::Zero(), wind);
+    if (s.battery.enabled) {
+      battery.step(plant, truth.rotor, dt);
+      out.battery_min_voltage = std::min(out.battery_min_voltage, battery.voltage());
+    }
   }
 
   out.ticks = total_ticks;
@@ -197,6 +283,10 @@ FlightResult fly(const FlightSetup& s, const ReferenceTrajectory& reference, con
   out.n3_timeouts = fc.timeouts();
   out.n3_rejected_commands = fc.rejected();
   out.rhs_evaluations = integrator.rhs_evaluations();
+  out.pose_losses = pose_source.losses();
+  out.pose_drift = pose_source.drift();
+  out.wind_rms = total_ticks > 0 ? std::sqrt(wind_sq / static_cast<double>(total_ticks)) : 0.0;
+  out.battery_used_wh = battery.energy_used_wh();
 
   double length = 0.0;
   for (Eigen::Index i = 1; i < reference.path.rows(); ++i) length += (reference.path.row(i) - reference.path.row(i - 1)).norm();
@@ -230,14 +320,28 @@ FlightResult fly(const FlightSetup& s, const ReferenceTrajectory& reference, con
                       {"pose_stale", out.stale},
                       {"outliers_injected", out.outliers_injected},
                       {"outliers_rejected", out.outliers_rejected}}},
-      {"n3", {{"timeouts", out.n3_timeouts}, {"rejected_commands", out.n3_rejected_commands}}}};
+      {"n3", {{"timeouts", out.n3_timeouts}, {"rejected_commands", out.n3_rejected_commands}}},
+      {"events", {{"saturation_time_s", out.saturation_time_s},
+                  {"speed_limited_time_s", out.speed_limited_time_s},
+                  {"failsafe_time_s", out.failsafe_time_s},
+                  {"pose_lost_time_s", out.pose_lost_time_s},
+                  {"pose_losses", out.pose_losses}}}};
+  // What the flight met, when modelled (issue 23).
+  Json met = Json::object();
+  if (s.wind.enabled) met["wind"] = {{"rms_m_s", out.wind_rms}, {"max_m_s", out.wind_max}};
+  if (s.mismatch.any()) met["mismatch"] = to_json(s.mismatch);
+  if (s.battery.enabled)
+    met["battery"] = {{"min_voltage_v", out.battery_min_voltage}, {"used_wh", out.battery_used_wh}};
+  if (s.pose.vio()) met["pose_drift_m"] = vec_json(out.pose_drift);
+  if (!met.empty()) out.summary["disturbances"] = met;
   return out;
 }
 
 std::string flight_log_csv(const FlightResult& r) {
   std::string text;
   const auto& columns = flight_log_columns();
-  for (std::size_t i = 0; i < columns.size(); ++i) text += (i ? "," : "") + columns[i];
+  const auto& units = flight_log_units();
+  for (std::size_t i = 0; i < columns.size(); ++i) text += (i ? "," : "") + columns[i] + "[" + units[i] + "]";
   text += "\n";
   char buf[32];
   for (const auto& row : r.log) {

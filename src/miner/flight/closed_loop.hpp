@@ -19,6 +19,7 @@
 
 #include "miner/core/json_io.hpp"
 #include "miner/flight/controller.hpp"
+#include "miner/flight/disturbances.hpp"
 #include "miner/flight/dynamics.hpp"
 #include "miner/flight/ekf.hpp"
 #include "miner/flight/n3.hpp"
@@ -47,6 +48,13 @@ struct FlightSetup {
   n3::Config n3;
   ControllerParams controller;
   EkfParams ekf;  ///< imu and pose are copies of the above
+  /// The world and vehicle a real flight meets (issue 23; each off unless given): wind and
+  /// gusts, the plant's mismatch against `vehicle` (which the controller, N3 and EKF
+  /// assume), the battery's sag, and the reference's yaw.
+  WindParams wind;
+  MismatchParams mismatch;
+  BatteryParams battery;
+  YawParams yaw;
   /// The companion computer stays silent in [t0, t1) s (the N3's stream-timeout failsafe).
   std::optional<std::pair<double, double>> command_dropout;
   /// Whether the vehicle at a position touches an obstacle (counted as a collision); empty:
@@ -70,8 +78,9 @@ struct FlyOptions {
   IntegratorOptions integrator;
 };
 
-/// Column names of the flight log (one row per controller tick).
+/// Column names of the flight log (one row per controller tick) and their units.
 const std::vector<std::string>& flight_log_columns();
+const std::vector<std::string>& flight_log_units();
 
 struct FlightResult {
   std::vector<std::vector<double>> log;
@@ -90,6 +99,15 @@ struct FlightResult {
   long fused = 0, rejected = 0, stale = 0;
   long outliers_injected = 0, outliers_rejected = 0;
   int n3_timeouts = 0;
+  // Time (s, counted per control tick) with the thrust or tilt saturated (the controller's
+  // or the battery's limit), the speed limit binding, the pose stream lost, the N3 in its
+  // failsafe.
+  double saturation_time_s = 0.0, speed_limited_time_s = 0.0, pose_lost_time_s = 0.0, failsafe_time_s = 0.0;
+  long pose_losses = 0;
+  double wind_rms = 0.0, wind_max = 0.0;     ///< m/s, |w| over the flight
+  double battery_min_voltage = 0.0;          ///< V (0 without a battery model)
+  double battery_used_wh = 0.0;
+  Eigen::Vector3d pose_drift = Eigen::Vector3d::Zero();  ///< the VIO frame's drift at the end (m)
   long n3_rejected_commands = 0;
   long rhs_evaluations = 0;
   std::vector<double> nees;       ///< with record_consistency
@@ -103,8 +121,8 @@ struct FlightResult {
 /// setup (seed included) gives the same bytes.
 FlightResult fly(const FlightSetup& setup, const ReferenceTrajectory& reference, const FlyOptions& options = {});
 
-/// The log as CSV with a header row, numbers printed with 9 significant digits (the same
-/// bytes for the same flight).
+/// The log as CSV with a header row naming each column with its unit, "t[s],ref_x[m],...",
+/// numbers printed with 9 significant digits (the same bytes for the same flight).
 std::string flight_log_csv(const FlightResult& result);
 
 /// The tracking MSE as the paper's table (Env., Pos. Err. x/y/z, Vel. Err. x/y/z).

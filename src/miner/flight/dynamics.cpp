@@ -36,13 +36,25 @@ QuadState unpack(const StateVector& x) {
   return s;
 }
 
+Eigen::Vector3d aerodynamic_drag(const VehicleParams& vehicle, const Eigen::Matrix3d& r,
+                                 const Eigen::Vector3d& v_air, double rotor_speed_sum) {
+  // Each extra term only when modelled, so a vehicle without them keeps its bytes.
+  Eigen::Vector3d d = vehicle.linear_drag;
+  if (vehicle.rotor_drag != 0.0) d.head<2>().array() += vehicle.rotor_drag * rotor_speed_sum;
+  Eigen::Vector3d drag = r * (d.asDiagonal() * (r.transpose() * v_air));
+  if (vehicle.quadratic_drag != 0.0) drag += vehicle.quadratic_drag * v_air.norm() * v_air;
+  return drag;
+}
+
 namespace {
 
-/// Shared by derivative() and acceleration(): v' given the rotation and rotor speeds.
+/// Shared by derivative() and acceleration(): v' given the rotation, thrust, velocity, wind
+/// and rotor speeds.
 Eigen::Vector3d linear_acceleration(const VehicleParams& vehicle, const Eigen::Matrix3d& r,
                                     double thrust, const Eigen::Vector3d& v,
-                                    const Eigen::Vector3d& disturbance) {
-  const Eigen::Vector3d drag = r * (vehicle.linear_drag.asDiagonal() * (r.transpose() * v));
+                                    const Eigen::Vector3d& disturbance, const Eigen::Vector3d& wind,
+                                    const Eigen::Vector4d& rotor) {
+  const Eigen::Vector3d drag = aerodynamic_drag(vehicle, r, v - wind, rotor.sum());
   return Eigen::Vector3d(0.0, 0.0, -kGravity) + (thrust * r.col(2) - drag + disturbance) / vehicle.mass;
 }
 
@@ -53,7 +65,8 @@ Eigen::Vector4d rotor_thrusts(const VehicleParams& vehicle, const Eigen::Vector4
 }  // namespace
 
 StateVector derivative(const VehicleParams& vehicle, const Mixer& mixer, const StateVector& x,
-                       const Eigen::Vector4d& rotor_command, const Eigen::Vector3d& disturbance) {
+                       const Eigen::Vector4d& rotor_command, const Eigen::Vector3d& disturbance,
+                       const Eigen::Vector3d& wind) {
   const Eigen::Quaterniond q = Eigen::Quaterniond(x[6], x[7], x[8], x[9]).normalized();
   const Eigen::Matrix3d r = q.toRotationMatrix();
   const Eigen::Vector3d omega = x.segment<3>(10);
@@ -62,7 +75,7 @@ StateVector derivative(const VehicleParams& vehicle, const Mixer& mixer, const S
 
   StateVector dx;
   dx.segment<3>(0) = x.segment<3>(3);
-  dx.segment<3>(3) = linear_acceleration(vehicle, r, wrench[0], x.segment<3>(3), disturbance);
+  dx.segment<3>(3) = linear_acceleration(vehicle, r, wrench[0], x.segment<3>(3), disturbance, wind, w);
   // q' = 1/2 q (x) (0, omega), on the stored (unnormalised) q.
   const double qw = x[6], qx = x[7], qy = x[8], qz = x[9];
   dx[6] = 0.5 * (-qx * omega.x() - qy * omega.y() - qz * omega.z());
@@ -79,10 +92,10 @@ StateVector derivative(const VehicleParams& vehicle, const Mixer& mixer, const S
 }
 
 Eigen::Vector3d acceleration(const VehicleParams& vehicle, const Mixer& mixer, const QuadState& s,
-                             const Eigen::Vector3d& disturbance) {
+                             const Eigen::Vector3d& disturbance, const Eigen::Vector3d& wind) {
   const Eigen::Matrix3d r = s.q.normalized().toRotationMatrix();
   const double thrust = mixer.wrench(rotor_thrusts(vehicle, s.rotor))[0];
-  return linear_acceleration(vehicle, r, thrust, s.v, disturbance);
+  return linear_acceleration(vehicle, r, thrust, s.v, disturbance, wind, s.rotor);
 }
 
 struct Integrator::Impl {
@@ -98,6 +111,7 @@ struct Integrator::Impl {
   long rhs_count = 0;
   Eigen::Vector4d command = Eigen::Vector4d::Zero();
   Eigen::Vector3d disturbance = Eigen::Vector3d::Zero();
+  Eigen::Vector3d wind = Eigen::Vector3d::Zero();
 
   Impl(const VehicleParams& v, IntegratorOptions o) : vehicle(v), mixer(v), options(o) {}
   ~Impl() {
@@ -113,7 +127,7 @@ struct Integrator::Impl {
     ++self->rhs_count;
     const Eigen::Map<const StateVector> x(N_VGetArrayPointer(y_vec));
     Eigen::Map<StateVector> dx(N_VGetArrayPointer(ydot));
-    dx = derivative(self->vehicle, self->mixer, x, self->command, self->disturbance);
+    dx = derivative(self->vehicle, self->mixer, x, self->command, self->disturbance, self->wind);
     return 0;
   }
 
@@ -150,13 +164,14 @@ Integrator::Integrator(const VehicleParams& vehicle, IntegratorOptions options)
 Integrator::~Integrator() = default;
 
 void Integrator::advance(QuadState& state, double t0, double t1, const Eigen::Vector4d& rotor_command,
-                         const Eigen::Vector3d& disturbance) {
+                         const Eigen::Vector3d& disturbance, const Eigen::Vector3d& wind) {
   auto& m = *impl_;
   if (!(t1 > t0)) throw Error("integrator: advance needs t1 > t0");
-  if (!rotor_command.allFinite() || !disturbance.allFinite())
-    throw Error("integrator: rotor command or disturbance is not finite");
+  if (!rotor_command.allFinite() || !disturbance.allFinite() || !wind.allFinite())
+    throw Error("integrator: rotor command, disturbance or wind is not finite");
   m.command = rotor_command;
   m.disturbance = disturbance;
+  m.wind = wind;
   Eigen::Map<StateVector>(N_VGetArrayPointer(m.y)) = pack(state);
   // A new input starts a new smooth piece: re-initialise, and stop exactly at the tick.
   m.check(CVodeReInit(m.cvode, t0, m.y), "CVodeReInit");

@@ -7,7 +7,8 @@
 /// speeds w. With R = R(q), rotor thrusts f_i = k_f w_i^2 and (T, tau) = A f (Mixer):
 ///
 ///   p' = v
-///   v' = -g e3 + (T / m) R e3 - R D R^T v / m
+///   v' = -g e3 + (T / m) R e3 - F_drag(v - w) / m,   F_drag(v_a) = R D_w R^T v_a + c_q |v_a| v_a
+///        D_w = D + k_r (sum_i w_i) diag(1, 1, 0)      (w the wind, aerodynamic_drag())
 ///   q' = 1/2 q (x) (0, omega)
 ///   omega' = J^{-1} (tau - omega x J omega)
 ///   w_i' = (u_i - w_i) / tau_m,   tau_m = tau_up if u_i > w_i else tau_down
@@ -42,14 +43,23 @@ using StateVector = Eigen::Matrix<double, 17, 1>;
 StateVector pack(const QuadState& s);
 QuadState unpack(const StateVector& x);
 
-/// x' = f(x, u) above; `disturbance` is an extra world force (N).
+/// The aerodynamic drag force (world, N) at air-relative velocity v_air = v - wind with
+/// rotor speeds summing to `rotor_speed_sum`: linear body drag, rotor drag in the rotor
+/// plane and quadratic body drag (REQ-FLIGHT-012).
+Eigen::Vector3d aerodynamic_drag(const VehicleParams& vehicle, const Eigen::Matrix3d& r,
+                                 const Eigen::Vector3d& v_air, double rotor_speed_sum);
+
+/// x' = f(x, u) above; `disturbance` is an extra world force (N), `wind` the air's
+/// velocity (m/s, world).
 StateVector derivative(const VehicleParams& vehicle, const Mixer& mixer, const StateVector& x,
                        const Eigen::Vector4d& rotor_command,
-                       const Eigen::Vector3d& disturbance = Eigen::Vector3d::Zero());
+                       const Eigen::Vector3d& disturbance = Eigen::Vector3d::Zero(),
+                       const Eigen::Vector3d& wind = Eigen::Vector3d::Zero());
 
 /// Linear acceleration p'' of state s (the accelerometer's input), m/s^2.
 Eigen::Vector3d acceleration(const VehicleParams& vehicle, const Mixer& mixer, const QuadState& s,
-                             const Eigen::Vector3d& disturbance = Eigen::Vector3d::Zero());
+                             const Eigen::Vector3d& disturbance = Eigen::Vector3d::Zero(),
+                             const Eigen::Vector3d& wind = Eigen::Vector3d::Zero());
 
 struct IntegratorOptions {
   /// CVODE relative tolerance. Absolute tolerances are rtol times the scale of each
@@ -66,11 +76,12 @@ class Integrator {
   Integrator(const Integrator&) = delete;
   Integrator& operator=(const Integrator&) = delete;
 
-  /// Integrates `state` from t0 to t1 > t0 with `rotor_command` and `disturbance` held
-  /// constant; throws miner::Error if CVODE fails (naming its flag) or the state stops
+  /// Integrates `state` from t0 to t1 > t0 with `rotor_command`, `disturbance` and `wind`
+  /// held constant; throws miner::Error if CVODE fails (naming its flag) or the state stops
   /// being finite.
   void advance(QuadState& state, double t0, double t1, const Eigen::Vector4d& rotor_command,
-               const Eigen::Vector3d& disturbance = Eigen::Vector3d::Zero());
+               const Eigen::Vector3d& disturbance = Eigen::Vector3d::Zero(),
+               const Eigen::Vector3d& wind = Eigen::Vector3d::Zero());
 
   /// Right-hand-side evaluations since construction (for benchmarks).
   long rhs_evaluations() const;

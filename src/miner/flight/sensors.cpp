@@ -57,6 +57,37 @@ PoseMeasurement measure_pose(const PoseParams& params, double stamp, const Eigen
   return m;
 }
 
+PoseSource::PoseSource(const PoseParams& params, double period, const Eigen::Vector3d& start, Rng& noise_rng,
+                       Rng& vio_rng)
+    : params_(params), period_(period), start_(start), noise_rng_(&noise_rng), vio_rng_(&vio_rng) {}
+
+std::optional<PoseSource::Delivery> PoseSource::measure(double stamp, const Eigen::Vector3d& p,
+                                                        const Eigen::Quaterniond& q) {
+  Delivery d;
+  d.delay = params_.delay_s;
+  if (!params_.vio()) {
+    d.measurement = measure_pose(params_, stamp, p, q, *noise_rng_);
+    return d;
+  }
+  if (params_.drift_random_walk > 0.0) drift_ += normal3(*vio_rng_, params_.drift_random_walk * std::sqrt(period_));
+  if (params_.yaw_drift_random_walk > 0.0) yaw_drift_ += params_.yaw_drift_random_walk * std::sqrt(period_) * vio_rng_->normal();
+  if (params_.dropout_rate_hz > 0.0) {
+    const double u = vio_rng_->uniform01();
+    if (!lost_ && u < -std::expm1(-params_.dropout_rate_hz * period_)) {
+      lost_ = true;
+      ++losses_;
+    } else if (lost_ && (params_.dropout_mean_s <= 0.0 || u < -std::expm1(-period_ / params_.dropout_mean_s))) {
+      lost_ = false;
+    }
+  }
+  const Eigen::Quaterniond frame(Eigen::AngleAxisd(yaw_drift_, Eigen::Vector3d::UnitZ()));
+  const Eigen::Vector3d p_vio = start_ + frame * (p - start_) + drift_;
+  d.measurement = measure_pose(params_, stamp, p_vio, frame * q, *noise_rng_);
+  if (params_.delay_jitter_s > 0.0) d.delay += params_.delay_jitter_s * vio_rng_->uniform01();
+  if (lost_) return std::nullopt;
+  return d;
+}
+
 namespace {
 /// An optional value in [0, hi] `unit` (issue 20: an accelerometer noise of 1e300 and a pose
 /// delay of 1e6 s were accepted and flown).
@@ -80,7 +111,8 @@ ImuParams imu_params_from_json(const JsonField& f) {
 }
 
 PoseParams pose_params_from_json(const JsonField& f) {
-  f.only_keys({"rate_hz", "delay_s", "position_sigma", "attitude_sigma", "outlier_probability", "outlier_magnitude"});
+  f.only_keys({"rate_hz", "delay_s", "position_sigma", "attitude_sigma", "outlier_probability", "outlier_magnitude",
+               "drift_random_walk", "yaw_drift_random_walk", "delay_jitter_s", "dropout_rate_hz", "dropout_mean_s"});
   PoseParams p;
   if (f.has("rate_hz")) {
     p.rate_hz = f.at("rate_hz").number_in(0.0, 10000.0, "Hz");
@@ -92,6 +124,14 @@ PoseParams pose_params_from_json(const JsonField& f) {
   p.outlier_probability = optional_non_negative(f, "outlier_probability", p.outlier_probability, 1.0, "");
   p.outlier_magnitude = optional_non_negative(f, "outlier_magnitude", p.outlier_magnitude, 100.0, "m");
   if (p.outlier_probability > 1.0) f.at("outlier_probability").fail("must be in [0, 1]");
+  p.drift_random_walk = optional_non_negative(f, "drift_random_walk", 0.0, 10.0, "m/sqrt(s)");
+  p.yaw_drift_random_walk = optional_non_negative(f, "yaw_drift_random_walk", 0.0, 1.0, "rad/sqrt(s)");
+  p.delay_jitter_s = optional_non_negative(f, "delay_jitter_s", 0.0, 1.0, "s");
+  p.dropout_rate_hz = optional_non_negative(f, "dropout_rate_hz", 0.0, 100.0, "Hz");
+  p.dropout_mean_s = optional_non_negative(f, "dropout_mean_s", 0.0, 100.0, "s");
+  if (p.dropout_rate_hz > 0.0 && !(p.dropout_mean_s > 0.0))
+    f.at("dropout_rate_hz").fail("needs a positive dropout_mean_s (how long a loss lasts)");
+  if (p.delay_s + p.delay_jitter_s > 1.0) f.at("delay_jitter_s").fail("delay_s + delay_jitter_s must be at most 1 s");
   if (!(p.position_sigma > 0.0) || !(p.attitude_sigma > 0.0))
     f.fail("position_sigma and attitude_sigma must be positive (the EKF divides by them)");
   return p;
@@ -107,12 +147,20 @@ Json to_json(const ImuParams& p) {
 }
 
 Json to_json(const PoseParams& p) {
-  return Json{{"rate_hz", p.rate_hz},
+  Json doc{{"rate_hz", p.rate_hz},
               {"delay_s", p.delay_s},
               {"position_sigma", p.position_sigma},
               {"attitude_sigma", p.attitude_sigma},
               {"outlier_probability", p.outlier_probability},
               {"outlier_magnitude", p.outlier_magnitude}};
+  if (p.vio()) {
+    doc["drift_random_walk"] = p.drift_random_walk;
+    doc["yaw_drift_random_walk"] = p.yaw_drift_random_walk;
+    doc["delay_jitter_s"] = p.delay_jitter_s;
+    doc["dropout_rate_hz"] = p.dropout_rate_hz;
+    doc["dropout_mean_s"] = p.dropout_mean_s;
+  }
+  return doc;
 }
 
 }  // namespace miner::flight

@@ -16,6 +16,7 @@
 /// direction (a VIO jump or a mocap marker swap).
 
 #include <cstdint>
+#include <optional>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -66,6 +67,15 @@ struct PoseParams {
   double attitude_sigma = 0.01;         ///< rad
   double outlier_probability = 0.01;
   double outlier_magnitude = 1.0;       ///< m
+  // A visual-inertial odometry front end's imperfections (REQ-FLIGHT-015); 0: absent.
+  double drift_random_walk = 0.0;       ///< m/sqrt(s): the VIO frame's position drift per axis
+  double yaw_drift_random_walk = 0.0;   ///< rad/sqrt(s): its yaw drift (about the start)
+  double delay_jitter_s = 0.0;          ///< extra delay, uniform on [0, jitter]
+  double dropout_rate_hz = 0.0;         ///< rate at which tracking is lost
+  double dropout_mean_s = 0.0;          ///< mean length of a loss (exponential)
+  bool vio() const {
+    return drift_random_walk > 0.0 || yaw_drift_random_walk > 0.0 || delay_jitter_s > 0.0 || dropout_rate_hz > 0.0;
+  }
 };
 
 struct PoseMeasurement {
@@ -78,6 +88,42 @@ struct PoseMeasurement {
 /// A pose measurement of the true (p, q) taken at `stamp`.
 PoseMeasurement measure_pose(const PoseParams& params, double stamp, const Eigen::Vector3d& p,
                              const Eigen::Quaterniond& q, Rng& rng);
+
+/// A pose stream as a VIO front end delivers it (REQ-FLIGHT-015). Its frame drifts: position
+/// by a random walk b_p (b_p += N(0, s_d^2 Dt) per measurement period Dt) and yaw by a
+/// random walk psi (s_psi), rotating the measured pose about the start, so
+///   p_m = start + Rz(psi) (p - start) + b_p + n_p,   q_m = Rz(psi) q (x) Exp(n_theta).
+/// Tracking is lost as a two-state Markov chain per period: lost with probability
+/// 1 - exp(-rate Dt), regained with 1 - exp(-Dt / mean); nothing is delivered while lost.
+/// Each delivered measurement arrives delay_s + U(0, delay_jitter_s) after its stamp.
+/// Noise and outliers come from `noise_rng` exactly as measure_pose() draws them (every
+/// period, lost or not); drift, losses and jitter from `vio_rng`, only when modelled.
+class PoseSource {
+ public:
+  PoseSource(const PoseParams& params, double period, const Eigen::Vector3d& start, Rng& noise_rng, Rng& vio_rng);
+  struct Delivery {
+    PoseMeasurement measurement;
+    double delay = 0.0;  ///< s after the stamp
+  };
+  /// The measurement of the true (p, q) at `stamp`, or nothing while tracking is lost.
+  /// Called once per period, in order.
+  std::optional<Delivery> measure(double stamp, const Eigen::Vector3d& p, const Eigen::Quaterniond& q);
+  bool lost() const { return lost_; }
+  const Eigen::Vector3d& drift() const { return drift_; }
+  double yaw_drift() const { return yaw_drift_; }
+  long losses() const { return losses_; }
+
+ private:
+  PoseParams params_;
+  double period_;
+  Eigen::Vector3d start_;
+  Rng* noise_rng_;
+  Rng* vio_rng_;
+  Eigen::Vector3d drift_ = Eigen::Vector3d::Zero();
+  double yaw_drift_ = 0.0;
+  bool lost_ = false;
+  long losses_ = 0;
+};
 
 /// Exp: rotation vector -> unit quaternion; Log: the inverse (angle in [0, pi]).
 Eigen::Quaterniond quat_exp(const Eigen::Vector3d& theta);

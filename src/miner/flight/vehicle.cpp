@@ -56,6 +56,11 @@ void validate(const VehicleParams& v, const std::string& origin) {
                                        std::to_string(j) + " > " + std::to_string(a) + " + " +
                                        std::to_string(b) + "): no rigid body has them");
   }
+  // At w_max on all four rotors, 0.01 N/(m/s)/(rad/s) is ~50 N per m/s: far above any multirotor.
+  if (!std::isfinite(v.rotor_drag) || v.rotor_drag < 0.0 || v.rotor_drag > 0.01)
+    bad(origin, "rotor_drag_N_s_per_m_rad", "must be finite and in [0, 0.01]");
+  if (!std::isfinite(v.quadratic_drag) || v.quadratic_drag < 0.0 || v.quadratic_drag > 100.0)
+    bad(origin, "quadratic_drag_N_s2_per_m2", "must be finite and in [0, 100]");
   if (!std::isfinite(v.rotor_speed_min) || v.rotor_speed_min < 0.0 ||
       v.rotor_speed_min >= v.rotor_speed_max)
     bad(origin, "rotor_speed_min_rad_s", "must satisfy 0 <= min < rotor_speed_max_rad_s");
@@ -74,7 +79,8 @@ VehicleParams vehicle_from_json(const Json& doc, const std::string& origin) {
   root.require_format(kVehicleFormat);
   root.only_keys({"format", "name", "mass_kg", "inertia_kg_m2", "arm_length_m", "thrust_coefficient_N_per_rad_s2",
                   "torque_to_thrust_ratio_m", "rotor_speed_min_rad_s", "rotor_speed_max_rad_s",
-                  "motor_time_constant_up_s", "motor_time_constant_down_s", "linear_drag_N_s_per_m", "radius_m"});
+                  "motor_time_constant_up_s", "motor_time_constant_down_s", "linear_drag_N_s_per_m", "radius_m",
+                  "rotor_drag_N_s_per_m_rad", "quadratic_drag_N_s2_per_m2"});
   VehicleParams v;
   if (root.has("name")) v.name = root.at("name").string();
   v.mass = root.at("mass_kg").number();
@@ -88,6 +94,9 @@ VehicleParams vehicle_from_json(const Json& doc, const std::string& origin) {
   v.motor_time_constant_down = root.at("motor_time_constant_down_s").number();
   v.linear_drag = root.at("linear_drag_N_s_per_m").vec3();
   v.radius = root.at("radius_m").number();
+  // The aerodynamic extras are optional: a vehicle file without them models linear drag only.
+  if (root.has("rotor_drag_N_s_per_m_rad")) v.rotor_drag = root.at("rotor_drag_N_s_per_m_rad").number();
+  if (root.has("quadratic_drag_N_s2_per_m2")) v.quadratic_drag = root.at("quadratic_drag_N_s2_per_m2").number();
   validate(v, origin);
   return v;
 }
@@ -95,7 +104,7 @@ VehicleParams vehicle_from_json(const Json& doc, const std::string& origin) {
 VehicleParams load_vehicle(const std::string& path) { return vehicle_from_json(read_json_file(path), path); }
 
 Json to_json(const VehicleParams& v) {
-  return Json{{"format", kVehicleFormat},
+  Json doc{{"format", kVehicleFormat},
               {"name", v.name},
               {"mass_kg", v.mass},
               {"inertia_kg_m2", vec3_json(v.inertia)},
@@ -108,6 +117,9 @@ Json to_json(const VehicleParams& v) {
               {"motor_time_constant_down_s", v.motor_time_constant_down},
               {"linear_drag_N_s_per_m", vec3_json(v.linear_drag)},
               {"radius_m", v.radius}};
+  if (v.rotor_drag != 0.0) doc["rotor_drag_N_s_per_m_rad"] = v.rotor_drag;
+  if (v.quadratic_drag != 0.0) doc["quadratic_drag_N_s2_per_m2"] = v.quadratic_drag;
+  return doc;
 }
 
 Mixer::Mixer(const VehicleParams& v)

@@ -37,6 +37,12 @@ struct VehicleParams {
   double motor_time_constant_up = 0.0125;                   ///< s, spinning up
   double motor_time_constant_down = 0.025;                  ///< s, spinning down
   Eigen::Vector3d linear_drag{0.10, 0.10, 0.15};            ///< N/(m/s), body axes
+  /// Rotor drag (blade flapping and induced drag; Faessler et al. 2018): a force in the
+  /// rotor plane against the body-horizontal airspeed, proportional to the sum of the rotor
+  /// speeds, N/(m/s)/(rad/s). Optional in the file (0: not modelled).
+  double rotor_drag = 0.0;
+  /// Quadratic body (parasitic) drag 1/2 rho C_d A, N/(m/s)^2. Optional (0: not modelled).
+  double quadratic_drag = 0.0;
   double radius = 0.3;                                      ///< m, collision sphere
 
   double weight() const { return mass * kGravity; }

@@ -46,7 +46,7 @@ Scenario scenario_from_json(const Json& doc, const std::string& origin, const st
   root.require_format(kScenarioFormat);
   root.only_keys({"format", "name", "map", "vehicle", "start", "goal", "waypoints", "trajectory", "planner", "seed",
                   "hover_after_s", "goal_tolerance_m", "planning_margin_m", "imu", "pose", "n3", "controller", "ekf",
-                  "command_dropout_s"});
+                  "command_dropout_s", "wind", "mismatch", "battery", "yaw"});
   Scenario s;
   s.origin = origin;
   if (root.has("name")) {
@@ -192,6 +192,23 @@ Scenario scenario_from_json(const Json& doc, const std::string& origin, const st
   }
   s.ekf.imu = s.imu;
   s.ekf.pose = s.pose;
+  if (root.has("wind")) s.wind = wind_params_from_json(root.at("wind"));
+  if (root.has("mismatch")) {
+    s.mismatch = mismatch_params_from_json(root.at("mismatch"));
+    try {
+      plant_vehicle(s.vehicle, s.mismatch);
+    } catch (const Error& e) {
+      root.at("mismatch").fail(e.what());
+    }
+  }
+  if (root.has("battery")) s.battery = battery_params_from_json(root.at("battery"));
+  if (root.has("yaw")) s.yaw = yaw_params_from_json(root.at("yaw"));
+  // The scenario's speed limit reaches the controller (the velocity its feedback may ask
+  // for, REQ-FLIGHT-016) and the N3's VELOCITY mode (its failsafe brake), with headroom.
+  const double speed_limit = kSpeedLimitHeadroom * s.limits.v_max;
+  if (!(root.has("controller") && root.at("controller").has("max_speed_m_s"))) s.controller.max_speed = speed_limit;
+  s.n3.max_horizontal_speed = std::min(s.n3.max_horizontal_speed, speed_limit);
+  s.n3.max_vertical_speed = std::min(s.n3.max_vertical_speed, speed_limit);
   if (s.controller.max_tilt_deg > s.n3.max_tilt_deg)
     root.fail("controller.max_tilt_deg exceeds the N3's max_tilt_deg");
   ticks_per(root.has("controller") ? root.at("controller") : root, s.n3.rate_hz, s.controller.rate_hz, "controller rate");

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -169,9 +170,13 @@ TEST_CASE("A command dropout in flight: failsafe hover, control regained, goal r
   const auto r = pipeline::fly(s, pipeline::build_reference(s));
   CHECK(r.n3_timeouts == 1);
   CHECK(r.goal_reached);
+  const auto& columns = flight::flight_log_columns();
+  const auto failsafe = static_cast<std::size_t>(std::find(columns.begin(), columns.end(), "failsafe") - columns.begin());
+  REQUIRE(failsafe < columns.size());
   double failsafe_time = 0.0;
-  for (const auto& row : r.log) failsafe_time += row[row.size() - 2] * 0.01;
+  for (const auto& row : r.log) failsafe_time += row[failsafe] * 0.01;
   CHECK(failsafe_time == Approx(1.0 - 0.1 - 0.02).margin(0.03));  // silent 1 s, minus timeout and latency
+  CHECK(r.failsafe_time_s == Approx(failsafe_time).margin(1e-9));  // the summary's event time agrees
 }
 
 TEST_CASE("IMU samples at rest have the stated bias, noise density and gravity", "[REQ-FLIGHT-004]") {

@@ -106,10 +106,11 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   fc->add_option("--time-limit", f->bench.time_limit_s, "wall-clock cap per run in s")
       ->check(finite_in(1e-3, 86400.0))
       ->capture_default_str();
+  // The same ranges as plan's (issue 20: 1e308 was accepted and printed with all its digits).
   fc->add_option("--step", f->bench.planner_options.steer_step, "steering step eta in m (default 0.1 x diagonal)")
-      ->check(kPositive);
+      ->check(finite_in(1e-6, 1e6));
   fc->add_option("--goal-radius", f->bench.planner_options.goal_radius, "goal radius in m (default 2 x resolution)")
-      ->check(kPositive);
+      ->check(finite_in(1e-6, 1e6));
   fc->add_flag("!--no-safeguard", f->bench.planner_options.safeguard,
                "miner, miner-sgan: the paper's fixed mu, without the safeguard (REQ-PLAN-020)");
   fc->add_option("--region", f->bench.region_file, "miner's region file (default: the A*-dilated region)");

@@ -149,14 +149,17 @@ def read_log(path):
 PLOTS = ["plot-events", "plot-position-x", "plot-position-y", "plot-position-z", "plot-velocity-x",
          "plot-velocity-y", "plot-velocity-z", "plot-attitude-roll", "plot-attitude-pitch", "plot-attitude-yaw",
          "plot-ekf-x", "plot-ekf-y", "plot-ekf-z", "plot-rotors", "plot-thrust", "plot-error", "plot-speed"]
+LAYERS = ["grid and axes", "map", "trajectory", "planned path", "repaired path", "flown", "start / goal", "vehicle"]
 MIN_COLOURED = 150     # coloured pixels of a plot's data lines (its frame, grid and text are grey)
 PAGE_HEIGHT = 3600     # the window of the second run: tall enough for every plot
 
 
-def check_view(name, st, png, failures, want_view, t, log):
+def check_view(name, dom, st, png, failures, want_view, t, log):
     if st is None:
         failures.append(f"{name}: no #miner-status in the dumped DOM (did the page load?)")
         return
+    if "Grid: <b>" not in dom:
+        failures.append(f"{name}: the view does not say the grid's spacing")
     state, pixels = st.get("state", "?"), int(st.get("pixels", "0") or 0)
     print(f"{name}: viewer state {state}, view {st.get('view')}, {pixels} drawn pixels of {VIEW_W * VIEW_H}, "
           f"t = {st.get('t')} s, marker ({st.get('marker')}) at log time {st.get('marker-t')}, "
@@ -170,6 +173,14 @@ def check_view(name, st, png, failures, want_view, t, log):
         failures.append(f"{name}: only {pixels} pixels drawn")
     if int(st.get("flown-colours", "0")) < 2:
         failures.append(f"{name}: the flown path is not coloured by tracking error")
+    layers = st.get("layers", "").split(",")
+    for layer in LAYERS:
+        if layer not in layers:
+            failures.append(f"{name}: no '{layer}' layer toggle")
+    if st.get("not-depth-tested") != "0":
+        failures.append(f"{name}: {st.get('not-depth-tested')} objects are drawn without the depth test")
+    if not float(st.get("grid-step", "0")) > 0:
+        failures.append(f"{name}: no ground grid")
     # The playback marker: at the slider's time, where the log has the vehicle.
     if abs(float(st.get("t", "nan")) - t) > 1e-6:
         failures.append(f"{name}: the playback time is {st.get('t')}, not {t:.2f}")
@@ -223,7 +234,7 @@ def main():
             failures.append("no screenshot with WebGL: " + run_3d.stderr[-2000:])
         else:
             box = [int(v) for v in (st or {}).get("view-rect", "0,0,0,0").split(",")]
-            check_view("3D view", st, decode_png(open(png_3d, "rb").read(), box[1] + box[3]), failures, "3d", t, log)
+            check_view("3D view", run_3d.stdout, st, decode_png(open(png_3d, "rb").read(), box[1] + box[3]), failures, "3d", t, log)
         # 2. No WebGL: the top view, and every plot (the same in both runs) on a tall page.
         png_top = os.path.join(work, "report-top.png")
         run_top = chromium(["--disable-webgl", "--disable-3d-apis", f"--window-size=1280,{PAGE_HEIGHT}", "--dump-dom",
@@ -245,7 +256,7 @@ def main():
             if bottom > PAGE_HEIGHT:
                 failures.append(f"the plots reach {bottom} px, below the {PAGE_HEIGHT} px screenshot")
             png = decode_png(open(png_top, "rb").read(), min(bottom, PAGE_HEIGHT))
-            check_view("top view (no WebGL)", st, png, failures, "top", t, log)
+            check_view("top view (no WebGL)", run_top.stdout, st, png, failures, "top", t, log)
             for name in PLOTS:
                 if name not in plots:
                     failures.append(f"the report has no plot {name}")

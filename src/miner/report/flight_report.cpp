@@ -1,5 +1,6 @@
 #include "miner/report/flight_report.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -144,7 +145,9 @@ constexpr EventKind kEvents[] = {{"failsafe", "failsafe", "#d62728"},
 std::string plots(const flight::FlightResult& f) {
   const std::size_t ref = column("ref_x"), ref_v = column("ref_vx"), truth = column("true_x"),
                     truth_v = column("true_vx"), est = column("est_x");
-  const Log log{f, thin_log(f, kPlotStep)};
+  // 600 points at most per line (a plot is ~330 px wide): a long flight keeps the file small.
+  const double duration = f.log.empty() ? 0.0 : f.log.back()[0];
+  const Log log{f, thin_log(f, std::max(kPlotStep, duration / kMaxPlotPoints))};
   const auto t = log.get("t");
   std::string h;
   auto section = [&](const std::string& title, const std::string& body) {
@@ -161,7 +164,9 @@ std::string plots(const flight::FlightResult& f) {
       Series tr{"flown (truth)", kTrueColor, t, log.get("true_" + name)};
       Series e{"EKF estimate", kEstColor, t, log.get("est_" + name)};
       std::vector<Series> ss;
-      for (auto* s : {&r, &tr, &e})
+      // The estimate first, the reference (dashed) last: where they agree to a pixel the
+      // dashes still show the truth between them.
+      for (auto* s : {&e, &tr, &r})
         if (!s->y.empty()) ss.push_back(*s);
       if (ss.empty()) continue;
       body += svg_line_plot(small("plot-" + kind + "-" + axis[a], std::string(pos ? "Position " : "Velocity ") + axis[a],
@@ -176,8 +181,8 @@ std::string plots(const flight::FlightResult& f) {
     for (int a = 0; a < 3; ++a) {
       const std::string n = att[a];
       std::vector<Series> ss;
-      if (log.has("true_" + n)) ss.push_back({"truth", kTrueColor, t, unwrap_break(log.get("true_" + n, kDeg))});
       if (log.has("est_" + n)) ss.push_back({"EKF estimate", kEstColor, t, unwrap_break(log.get("est_" + n, kDeg))});
+      if (log.has("true_" + n)) ss.push_back({"truth", kTrueColor, t, unwrap_break(log.get("true_" + n, kDeg))});
       if (log.has("cmd_" + n)) ss.push_back({"command", kCmdColor, t, unwrap_break(log.get("cmd_" + n, kDeg)), "4 2"});
       if (a == 2 && log.has("ref_yaw")) ss.push_back({"reference", kRefColor, t, unwrap_break(log.get("ref_yaw", kDeg)), "5 3"});
       if (!ss.empty()) body += svg_line_plot(small("plot-attitude-" + n, "Attitude: " + n, n + " (deg)"), ss);

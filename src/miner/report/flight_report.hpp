@@ -47,8 +47,10 @@ std::string render_flight_report(const FlightReportInput& in);
 /// centimetres, coarse enough that a minute of flight stays a few hundred kilobytes.
 inline constexpr double kTrajectoryStep = 0.05;  // s
 inline constexpr double kFlownStep = 0.05;       // s
-/// Sampling of the SVG plots over time.
+/// Sampling of the SVG plots over time: every kPlotStep s, coarser where a line would
+/// have more than kMaxPlotPoints points.
 inline constexpr double kPlotStep = 0.05;        // s
+inline constexpr double kMaxPlotPoints = 600;
 
 /// The three.js build and orbit controls embedded in every report (Debian libjs-three).
 std::string three_js_source();

@@ -8,6 +8,8 @@
 //   data-pixels  pixels of the view that differ from its background
 //   data-t       the playback time (s, 2 decimals); data-marker: the vehicle marker's x,y,z (m)
 //   data-layers  the layer names; data-flown-colours: distinct colours of the flown path
+//   data-grid-step the ground grid's spacing (m); data-not-depth-tested: objects drawn over
+//                everything (the playback marker aside), 0 by design
 //   data-view-rect, data-plots: where the view and every plot lie on the page (x,y,w,h px)
 // The URL's fragment may set the playback time: report.html#t=4.5.
 (function () {
@@ -16,7 +18,7 @@
   function report(state, attributes) {
     status.setAttribute('data-state', state);
     Object.keys(attributes || {}).forEach(function (k) { status.setAttribute('data-' + k, String(attributes[k])); });
-    if (state !== 'drawn') status.textContent = state;
+    status.textContent = state === 'drawn' ? '' : state;
   }
   window.addEventListener('error', function (e) { report('error: ' + e.message); });
 
@@ -193,6 +195,7 @@
       view: view.kind, pixels: drawn, t: current.toFixed(2),
       marker: markerAt ? markerAt.map(function (v) { return v.toFixed(3); }).join(',') : '',
       'marker-t': markerT === null ? '' : markerT.toFixed(3),
+      'grid-step': gridStep, 'not-depth-tested': view.undepthed,
       layers: view.layerNames.join(','), 'flown-colours': Object.keys(flownColours).length,
       'error-max': errorMax.toFixed(4), 'view-rect': rect(view.canvas), plots: plots});
   } catch (e) {
@@ -215,9 +218,11 @@
     scene.add(sun);
     var vmin = new THREE.Vector3().fromArray(bmin), vmax = new THREE.Vector3().fromArray(bmax);
     var centre = vmin.clone().add(vmax).multiplyScalar(0.5);
-    var camera = new THREE.PerspectiveCamera(45, width / height, diag / 1000, diag * 10);
+    centre.z = vmin.z + 0.25 * ext[2];
+    var camera = new THREE.PerspectiveCamera(40, width / height, diag / 1000, diag * 10);
     camera.up.set(0, 0, 1);  // ENU: z is up
-    camera.position.copy(centre).add(new THREE.Vector3(-0.45 * diag, -0.7 * diag, 0.55 * diag));
+    // From the south-west, above: the whole map and the grid's labels in the frame.
+    camera.position.copy(centre).add(new THREE.Vector3(-0.35 * diag, -0.95 * diag, 0.75 * diag));
     var controls = new THREE.OrbitControls(camera, renderer.domElement);
     controls.target.copy(centre);
     controls.update();
@@ -284,7 +289,10 @@
      [new THREE.Vector3(0, 0, 1), 0x1f77b4, 'z']].forEach(function (a) {
       ground.add(new THREE.ArrowHelper(a[0], origin, axisLength, a[1], 0.25 * gridStep, 0.12 * gridStep));
       var s = textSprite(a[2] + ' (m)', css(a[1]), textSize * 1.2);
-      s.position.copy(origin).addScaledVector(a[0], axisLength + 0.45 * gridStep);
+      // Beside the arrow's tip, off the other axes' labels.
+      s.position.copy(origin).addScaledVector(a[0], axisLength + 0.4 * gridStep);
+      if (a[2] === 'y') s.position.x -= 0.9 * gridStep;
+      if (a[2] === 'z') s.position.add(new THREE.Vector3(-0.6 * gridStep, -0.6 * gridStep, 0));
       ground.add(s);
     });
     ground.add(new THREE.Box3Helper(new THREE.Box3(vmin, vmax), 0x999999));
@@ -320,7 +328,7 @@
         cells.setMatrixAt(q, mat);
       }
       cells.frustumCulled = false;  // r111 culls an InstancedMesh by its one cube at the origin
-      layer('region').add(cells);
+      layer('region', false).add(cells);
     }
     if (sd.tree && sd.tree.length >= 6)
       layer('RRT* tree', false).add(new THREE.LineSegments(lineGeometry(sd.tree), new THREE.LineBasicMaterial({
@@ -368,19 +376,20 @@
       for (var i = 0; i + 2 < flat.length; i += 3) out.push(new THREE.Vector3(flat[i], flat[i + 1], flat[i + 2]));
       return out;
     }
-    var tubeRadius = Math.max(diag / 300, 0.01);
+    var tubeRadius = Math.max(diag / 150, 0.02);
     // The trajectory: a wide translucent tube under the flown path.
     if (sd.trajectory && sd.trajectory.length >= 6) {
       var trajectory = new THREE.Mesh(tube(points(sd.trajectory), tubeRadius, null), new THREE.MeshLambertMaterial({
-        color: COLORS.trajectory, transparent: true, opacity: 0.3}));
+        color: COLORS.trajectory, transparent: true, opacity: 0.2}));
       trajectory.renderOrder = -1;  // before the obstacles in the transparent pass
       layer('trajectory').add(trajectory);
     }
-    // Planned path dashed, repaired path solid.
+    // Planned path dashed over the repaired path (solid): where they agree, both show.
     if (sd.planned_path && sd.planned_path.length >= 6) {
       var planned = new THREE.Line(lineGeometry(sd.planned_path), new THREE.LineDashedMaterial({
         color: COLORS.planned, dashSize: diag / 80, gapSize: diag / 160}));
       planned.computeLineDistances();
+      planned.renderOrder = 1;
       layer('planned path').add(planned);
     }
     if (sd.path && sd.path.length >= 6)
@@ -392,10 +401,10 @@
         flownPoints.push(new THREE.Vector3().fromArray(xyz('true_', f)));
         colours.push(errorRgb(error[f], errorTop));
       }
-      layer('flown').add(new THREE.Mesh(tube(flownPoints, tubeRadius * 0.4, colours), new THREE.MeshLambertMaterial({
+      layer('flown').add(new THREE.Mesh(tube(flownPoints, tubeRadius * 0.5, colours), new THREE.MeshLambertMaterial({
         vertexColors: THREE.VertexColors})));
     }
-    var markerSize = Math.max(sd.radius, diag / 120);
+    var markerSize = Math.max(1.5 * sd.radius, diag / 60);
     var ends = layer('start / goal');
     var ball = new THREE.SphereBufferGeometry(markerSize * 0.6, 16, 12);
     [[sd.start, COLORS.start], [sd.goal, COLORS.goal]].forEach(function (p) {
@@ -437,10 +446,17 @@
     playback.add(refMarker);
     vehicle.visible = refMarker.visible = false;
 
+    // Everything but the playback marker is depth-tested: the test reads this count.
+    var undepthed = 0;
+    names.forEach(function (name) {
+      if (name !== 'vehicle')
+        layers[name].traverse(function (o) { if (o.material && o.material.depthTest === false) ++undepthed; });
+    });
+
     function render() { renderer.render(scene, camera); }
     controls.addEventListener('change', render);
     return {
-      kind: '3d', canvas: renderer.domElement, layerNames: names,
+      kind: '3d', canvas: renderer.domElement, layerNames: names, undepthed: undepthed,
       visible: function (name) { return layers[name].visible; },
       setVisible: function (name, on) { layers[name].visible = on; },
       render: render,
@@ -484,7 +500,7 @@
     var names = ['grid and axes', 'map', 'region', 'RRT* tree', 'trajectory', 'planned path', 'repaired path',
                  'flown', 'start / goal', 'events', 'vehicle'];
     var shown = {};
-    names.forEach(function (nm) { shown[nm] = nm !== 'RRT* tree'; });
+    names.forEach(function (nm) { shown[nm] = nm !== 'RRT* tree' && nm !== 'region'; });
     var marker = -1;
     overlay.innerHTML = '<b>Top view (x-y)</b>: ' + why + '. Grid: <b>' + label(gridStep) + ' m</b> squares.';
     function poly(flat, stride) {
@@ -568,17 +584,17 @@
         ctx.lineWidth = 9;
         poly(sd.trajectory, 3);
       }
+      if (shown['repaired path'] && sd.path) {
+        ctx.strokeStyle = css(COLORS.path);
+        ctx.lineWidth = 1;
+        poly(sd.path, 3);
+      }
       if (shown['planned path'] && sd.planned_path) {
         ctx.strokeStyle = css(COLORS.planned);
         ctx.lineWidth = 1.5;
         ctx.setLineDash([8, 5]);
         poly(sd.planned_path, 3);
         ctx.setLineDash([]);
-      }
-      if (shown['repaired path'] && sd.path) {
-        ctx.strokeStyle = css(COLORS.path);
-        ctx.lineWidth = 1;
-        poly(sd.path, 3);
       }
       if (shown.flown && hasTruth) {
         ctx.lineWidth = 2.5;
@@ -626,7 +642,7 @@
       }
     }
     return {
-      kind: 'top', canvas: canvas, layerNames: names,
+      kind: 'top', canvas: canvas, layerNames: names, undepthed: 0,
       visible: function (name) { return shown[name]; },
       setVisible: function (name, on) { shown[name] = on; },
       render: render,

@@ -396,7 +396,8 @@ std::string render_flight_report(const FlightReportInput& in) {
        "<span style=\"color:#1f77b4\">&#9644; trajectory (wide, translucent)</span>"
        "<span>flown (truth), coloured by tracking error |p - p_ref|: 0<span id=\"error-scale\"></span>"
        "<span id=\"error-scale-max\">max</span> m</span>"
-       "<span>&#9679; vehicle at the slider's time (arms: attitude), &#9675; reference there</span>"
+       "<span>&#9679; vehicle at the slider's time (arms: attitude, red: front), &#9675; reference there</span>"
+       "<span>&#9670; where an event began (the timeline's colours)</span>"
        "<br>Drag to orbit, scroll to zoom, right-drag to pan. Ground grid in the map's x-y plane at its floor, "
        "axes at the map's lower corner (x red, y green, z blue); the grid's spacing is written on the view.</p>\n";
   if (const auto* v = s.map->voxels()) {

@@ -148,7 +148,7 @@ def read_log(path):
 
 PLOTS = ["plot-events", "plot-position-x", "plot-position-y", "plot-position-z", "plot-velocity-x",
          "plot-velocity-y", "plot-velocity-z", "plot-attitude-roll", "plot-attitude-pitch", "plot-attitude-yaw",
-         "plot-ekf-x", "plot-ekf-y", "plot-ekf-z", "plot-rotors", "plot-thrust", "plot-error", "plot-speed"]
+         "plot-ekf-x", "plot-ekf-y", "plot-ekf-z", "plot-rotors", "plot-thrust", "plot-error", "plot-tracking-axes", "plot-speed"]
 LAYERS = ["grid and axes", "map", "trajectory", "planned path", "repaired path", "flown", "start / goal", "vehicle"]
 MIN_COLOURED = 150     # coloured pixels of a plot's data lines (its frame, grid and text are grey)
 PAGE_HEIGHT = 3600     # the window of the second run: tall enough for every plot

@@ -244,8 +244,18 @@ std::string plots(const flight::FlightResult& f) {
       v_ref.y.push_back(log3(row, ref_v).norm());
       v_true.y.push_back(log3(row, truth_v).norm());
     }
+    // The tracking error per axis: what the position plots cannot show at their scale.
+    std::vector<Series> per_axis;
+    const char* axis_colors[] = {"#d62728", "#2ca02c", "#1f77b4"};
+    for (std::size_t a = 0; a < 3; ++a) {
+      Series e{std::string(axis[a]) + " - " + axis[a] + "_ref", axis_colors[a], t, {}};
+      for (std::size_t i : log.rows) e.y.push_back(f.log[i][truth + a] - f.log[i][ref + a]);
+      per_axis.push_back(std::move(e));
+    }
     section("Errors and speed",
             svg_line_plot(small("plot-error", "Tracking and estimation error", "error (m)"), {err, est_err}) +
+                svg_line_plot(small("plot-tracking-axes", "Tracking error per axis (truth - reference)", "error (m)"),
+                              per_axis) +
                 svg_line_plot(small("plot-speed", "Speed", "speed (m/s)"), {v_ref, v_true}));
   }
   return h;

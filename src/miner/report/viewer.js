@@ -222,7 +222,10 @@
     var camera = new THREE.PerspectiveCamera(40, width / height, diag / 1000, diag * 10);
     camera.up.set(0, 0, 1);  // ENU: z is up
     // From the south-west, above: the whole map and the grid's labels in the frame.
-    camera.position.copy(centre).add(new THREE.Vector3(-0.35 * diag, -0.95 * diag, 0.75 * diag));
+    // The target a little toward the near corner, so that the grid's labels stay in the frame.
+    centre.x -= 0.06 * ext[0];
+    centre.y -= 0.06 * ext[1];
+    camera.position.copy(centre).add(new THREE.Vector3(-0.6 * diag, -0.92 * diag, 0.8 * diag));
     var controls = new THREE.OrbitControls(camera, renderer.domElement);
     controls.target.copy(centre);
     controls.update();
@@ -287,12 +290,23 @@
     var origin = new THREE.Vector3(gx0, gy0, floor), axisLength = 2 * gridStep;
     [[new THREE.Vector3(1, 0, 0), 0xd62728, 'x'], [new THREE.Vector3(0, 1, 0), 0x2ca02c, 'y'],
      [new THREE.Vector3(0, 0, 1), 0x1f77b4, 'z']].forEach(function (a) {
-      ground.add(new THREE.ArrowHelper(a[0], origin, axisLength, a[1], 0.25 * gridStep, 0.12 * gridStep));
+      // A solid arrow (a shaft and a cone): 1-px lines are too thin to see from afar.
+      var turn = new THREE.Quaternion().setFromUnitVectors(new THREE.Vector3(0, 1, 0), a[0]);
+      var material = new THREE.MeshBasicMaterial({color: a[1]});
+      var shaft = new THREE.Mesh(new THREE.CylinderBufferGeometry(0.025 * gridStep, 0.025 * gridStep,
+                                                                   axisLength - 0.25 * gridStep, 8), material);
+      shaft.quaternion.copy(turn);
+      shaft.position.copy(origin).addScaledVector(a[0], (axisLength - 0.25 * gridStep) / 2);
+      var cone = new THREE.Mesh(new THREE.ConeBufferGeometry(0.08 * gridStep, 0.25 * gridStep, 12), material);
+      cone.quaternion.copy(turn);
+      cone.position.copy(origin).addScaledVector(a[0], axisLength - 0.125 * gridStep);
+      ground.add(shaft);
+      ground.add(cone);
       var s = textSprite(a[2] + ' (m)', css(a[1]), textSize * 1.2);
       // Beside the arrow's tip, off the other axes' labels.
       s.position.copy(origin).addScaledVector(a[0], axisLength + 0.4 * gridStep);
-      if (a[2] === 'y') s.position.x -= 0.9 * gridStep;
-      if (a[2] === 'z') s.position.add(new THREE.Vector3(-0.6 * gridStep, -0.6 * gridStep, 0));
+      if (a[2] === 'y') s.position.x -= 0.6 * gridStep;
+      if (a[2] === 'z') s.position.add(new THREE.Vector3(0.5 * gridStep, -0.5 * gridStep, 0));
       ground.add(s);
     });
     ground.add(new THREE.Box3Helper(new THREE.Box3(vmin, vmax), 0x999999));

@@ -141,7 +141,8 @@ TEST_CASE("the report plots every axis, attitude, EKF error, rotors; optional co
   const std::string html = report::render_flight_report({f.scenario, f.reference, f.result, {}});
   for (const char* id : {"plot-position-x", "plot-position-y", "plot-position-z", "plot-velocity-x", "plot-velocity-y",
                          "plot-velocity-z", "plot-attitude-roll", "plot-attitude-pitch", "plot-attitude-yaw", "plot-ekf-x",
-                         "plot-ekf-y", "plot-ekf-z", "plot-rotors", "plot-thrust", "plot-error", "plot-speed"}) {
+                         "plot-ekf-y", "plot-ekf-z", "plot-rotors", "plot-thrust", "plot-error", "plot-tracking-axes",
+                         "plot-speed"}) {
     INFO(id);
     const auto at = html.find(std::string("id=\"") + id + "\"");
     REQUIRE(at != std::string::npos);
@@ -156,6 +157,7 @@ TEST_CASE("the report plots every axis, attitude, EKF error, rotors; optional co
   CHECK(count(section("plot-position-x"), "<path d=\"M") == 3);
   CHECK(count(section("plot-attitude-roll"), "<path d=\"M") == 3);
   CHECK(count(section("plot-rotors"), "<path d=\"M") == 4);
+  CHECK(count(section("plot-tracking-axes"), "<path d=\"M") == 3);
   // Optional columns: a plot or band exactly when the log has them.
   CHECK((section("plot-ekf-x").find("class=\"band\"") != std::string::npos) == (column_index("est_sigma_x") >= 0));
   CHECK(section("plot-battery").empty() == (column_index("battery_v") < 0));

@@ -18,7 +18,8 @@ the DOM after the scripts ran and taking a screenshot (decoded here: PNG, zlib o
      "3d", more than 1 % of the view's pixels drawn; the screenshot's view area (where the
      viewer says it is) holds more than 1 % drawn pixels and more than 16 colours; the
      flown path has more than one error colour; the marker is the log's truth at T;
-  2. with WebGL disabled (--disable-gpu --disable-webgl --disable-3d-apis): the viewer falls back to the
+  2. with WebGL disabled (--disable-gpu --disable-webgl --disable-3d-apis), in a window as
+     tall as the page's plots (where the first run's viewer says they end): the viewer falls back to the
      top view (view "top") and says "drawn", the screenshot's view area is drawn as above,
      and each plot (per-axis position, velocity, attitude, EKF error, rotors, the event
      timeline, ...) holds data lines: coloured pixels inside its rectangle.
@@ -151,7 +152,7 @@ PLOTS = ["plot-events", "plot-position-x", "plot-position-y", "plot-position-z",
          "plot-ekf-x", "plot-ekf-y", "plot-ekf-z", "plot-rotors", "plot-thrust", "plot-error", "plot-tracking-axes", "plot-speed"]
 LAYERS = ["grid and axes", "map", "trajectory", "planned path", "repaired path", "flown", "start / goal", "vehicle"]
 MIN_COLOURED = 150     # coloured pixels of a plot's data lines (its frame, grid and text are grey)
-PAGE_HEIGHT = 3600     # the window of the second run: tall enough for every plot
+PAGE_HEIGHT = 3600     # the second run's window when the first run did not say where the plots are
 
 
 def check_view(name, dom, st, png, failures, want_view, t, log):
@@ -230,6 +231,13 @@ def main():
         if errors:
             failures.append("script errors:\n" + "\n".join(errors))
         st = status_of(run_3d.stdout)
+        # The second run's window: tall enough for every plot (the layout does not depend on WebGL).
+        page_height = PAGE_HEIGHT
+        try:
+            page_height = 40 + max(int(b.split(",")[1]) + int(b.split(",")[3])
+                                   for b in (p.split(":")[1] for p in st["plots"].split(";")))
+        except (TypeError, KeyError, ValueError, IndexError):
+            pass
         if not os.path.exists(png_3d):
             failures.append("no screenshot with WebGL: " + run_3d.stderr[-2000:])
         else:
@@ -239,7 +247,7 @@ def main():
         # --disable-gpu: no GPU process at all (software compositing), which also makes this
         # run about twice as fast.
         png_top = os.path.join(work, "report-top.png")
-        run_top = chromium(["--disable-gpu", "--disable-webgl", "--disable-3d-apis", f"--window-size=1280,{PAGE_HEIGHT}", "--dump-dom",
+        run_top = chromium(["--disable-gpu", "--disable-webgl", "--disable-3d-apis", f"--window-size=1280,{page_height}", "--dump-dom",
                             "--screenshot=" + png_top, url], profile)
         errors = [l for l in run_top.stderr.splitlines() if "Uncaught" in l or "CONSOLE" in l and "rror" in l]
         if errors:
@@ -255,9 +263,9 @@ def main():
                 name, box = item.split(":")
                 plots[name] = [int(v) for v in box.split(",")]
             bottom = max([b[1] + b[3] for b in plots.values()] + [0])
-            if bottom > PAGE_HEIGHT:
-                failures.append(f"the plots reach {bottom} px, below the {PAGE_HEIGHT} px screenshot")
-            png = decode_png(open(png_top, "rb").read(), min(bottom, PAGE_HEIGHT))
+            if bottom > page_height:
+                failures.append(f"the plots reach {bottom} px, below the {page_height} px screenshot")
+            png = decode_png(open(png_top, "rb").read(), min(bottom, page_height))
             check_view("top view (no WebGL)", run_top.stdout, st, png, failures, "top", t, log)
             for name in PLOTS:
                 if name not in plots:

@@ -226,7 +226,7 @@ std::string plots(const flight::FlightResult& f) {
       body += svg_line_plot(small("plot-thrust", "Thrust", "thrust (% of max)"),
                             {{"thrust command", kCmdColor, t, log.get("cmd_thrust_pct")}});
     if (log.has("battery_v"))
-      body += svg_line_plot(small("plot-battery", "Battery", "voltage (V)"), {{"battery", "#8c564b", t, log.get("battery_v")}});
+      body += svg_line_plot(small("plot-battery", "Battery", "voltage (V)"), {{"battery", "#17becf", t, log.get("battery_v")}});
     std::vector<Series> wind;
     for (int a = 0; a < 3; ++a)
       if (log.has(std::string("wind_") + axis[a]))

@@ -90,7 +90,10 @@ TEST_CASE("the viewer's flight data: the log every 0.05 s by column name, to 1 m
   // Events by hand: a collision from the 100th to the 150th row, a failsafe to the end.
   const auto collision = static_cast<std::size_t>(column_index("collision"));
   const auto failsafe = static_cast<std::size_t>(column_index("failsafe"));
-  for (auto& row : r.log) row[collision] = row[failsafe] = 0.0;
+  // Every event column the log has cleared first (the flight may have had some).
+  for (const char* name : {"failsafe", "saturated", "pose_dropout", "collision"})
+    if (const long c = column_index(name); c >= 0)
+      for (auto& row : r.log) row[static_cast<std::size_t>(c)] = 0.0;
   for (std::size_t i = 100; i < 150; ++i) r.log[i][collision] = 1.0;
   for (std::size_t i = r.log.size() - 20; i < r.log.size(); ++i) r.log[i][failsafe] = 1.0;
   const Json fj = report::flight_json(r);

@@ -51,8 +51,9 @@ struct Frame {
   double sy(double y) const { return axes.height - kBottom - (y - y0) / (y1 - y0) * (axes.height - kTop - kBottom); }
 };
 
-std::string open_svg(const PlotAxes& a) {
-  return "<svg xmlns=\"http://www.w3.org/2000/svg\" class=\"plot\" width=\"" + std::to_string(a.width) +
+std::string open_svg(const PlotAxes& a, const std::string& attributes = {}) {
+  return "<svg xmlns=\"http://www.w3.org/2000/svg\" class=\"plot\"" +
+         (a.id.empty() ? std::string() : " id=\"" + html_escape(a.id) + "\"" + attributes) + " width=\"" + std::to_string(a.width) +
          "\" height=\"" + std::to_string(a.height) + "\" viewBox=\"0 0 " + std::to_string(a.width) + " " +
          std::to_string(a.height) + "\" font-family=\"sans-serif\" font-size=\"11\">\n<text x=\"" +
          fmt(a.width / 2.0) + "\" y=\"16\" text-anchor=\"middle\" font-size=\"13\" font-weight=\"bold\">" +
@@ -129,8 +130,14 @@ std::string svg_line_plot(const PlotAxes& axes, const std::vector<Series>& serie
     if (s.x.size() != s.y.size())
       throw Error("plot \"" + axes.title + "\": series \"" + s.name + "\" has " + std::to_string(s.x.size()) +
                   " x values and " + std::to_string(s.y.size()) + " y values");
+    if (!s.y_low.empty() && s.y_low.size() != s.x.size())
+      throw Error("plot \"" + axes.title + "\": band \"" + s.name + "\" has " + std::to_string(s.x.size()) +
+                  " x values and " + std::to_string(s.y_low.size()) + " lower values");
     for (std::size_t i = 0; i < s.x.size(); ++i)
-      if (std::isfinite(s.x[i]) && std::isfinite(s.y[i])) rx.add(s.x[i]), ry.add(s.y[i]);
+      if (std::isfinite(s.x[i]) && std::isfinite(s.y[i])) {
+        rx.add(s.x[i]), ry.add(s.y[i]);
+        if (!s.y_low.empty()) ry.add(s.y_low[i]);
+      }
   }
   rx.settle();
   ry.settle();
@@ -139,25 +146,45 @@ std::string svg_line_plot(const PlotAxes& axes, const std::vector<Series>& serie
   std::vector<double> x_inside;
   for (double t : xt)
     if (t >= rx.lo - 1e-12 && t <= rx.hi + 1e-12) x_inside.push_back(t);
-  std::string s = open_svg(axes) + draw_axes(f, x_inside, yt, false);
+  const std::string mapping = " data-x0=\"" + tick_label(f.x0) + "\" data-x1=\"" + tick_label(f.x1) +
+                              "\" data-px0=\"" + fmt(f.sx(f.x0)) + "\" data-px1=\"" + fmt(f.sx(f.x1)) + "\"";
+  std::string s = open_svg(axes, mapping) + draw_axes(f, x_inside, yt, false);
   double legend_x = kLeft + 8;
   for (const auto& se : series) {
+    const bool band = !se.y_low.empty();
     std::string d;
     bool pen_down = false;
+    // A band: along y, then back along y_low (one closed outline per finite run).
+    std::string back;
+    auto close_band = [&] {
+      if (!back.empty()) d += back + "Z";
+      back.clear();
+    };
     for (std::size_t i = 0; i < se.x.size(); ++i) {
-      if (!std::isfinite(se.x[i]) || !std::isfinite(se.y[i])) {
+      if (!std::isfinite(se.x[i]) || !std::isfinite(se.y[i]) || (band && !std::isfinite(se.y_low[i]))) {
+        if (band) close_band();
         pen_down = false;
         continue;
       }
       d += (pen_down ? "L" : "M") + fmt(f.sx(se.x[i])) + " " + fmt(f.sy(se.y[i]));
+      if (band) back = "L" + fmt(f.sx(se.x[i])) + " " + fmt(f.sy(se.y_low[i])) + back;
       pen_down = true;
     }
-    s += "<path d=\"" + d + "\" fill=\"none\" stroke=\"" + html_escape(se.color) + "\" stroke-width=\"1.3\"/>\n";
-    s += "<rect x=\"" + fmt(legend_x) + "\" y=\"" + fmt(kTop + 6) + "\" width=\"12\" height=\"3\" fill=\"" +
-         html_escape(se.color) + "\"/><text x=\"" + fmt(legend_x + 16) + "\" y=\"" + fmt(kTop + 11) + "\">" +
-         html_escape(se.name) + "</text>\n";
+    if (band) {
+      close_band();
+      s += "<path class=\"band\" d=\"" + d + "\" fill=\"" + html_escape(se.color) + "\" fill-opacity=\"0.25\" stroke=\"none\"/>\n";
+    } else {
+      s += "<path d=\"" + d + "\" fill=\"none\" stroke=\"" + html_escape(se.color) + "\" stroke-width=\"1.3\"" +
+           (se.dash.empty() ? std::string() : " stroke-dasharray=\"" + html_escape(se.dash) + "\"") + "/>\n";
+    }
+    s += "<rect x=\"" + fmt(legend_x) + "\" y=\"" + fmt(band ? kTop + 3 : kTop + 6) + "\" width=\"12\" height=\"" +
+         (band ? "9\" fill-opacity=\"0.35" : "3") + "\" fill=\"" + html_escape(se.color) + "\"/><text x=\"" +
+         fmt(legend_x + 16) + "\" y=\"" + fmt(kTop + 11) + "\">" + html_escape(se.name) + "</text>\n";
     legend_x += 30 + 6.5 * static_cast<double>(se.name.size());
   }
+  if (!axes.id.empty())
+    s += "<line class=\"cursor\" x1=\"" + fmt(f.sx(f.x0)) + "\" x2=\"" + fmt(f.sx(f.x0)) + "\" y1=\"" + fmt(kTop) +
+         "\" y2=\"" + fmt(axes.height - kBottom) + "\" stroke=\"#000\" stroke-width=\"1\" visibility=\"hidden\"/>\n";
   return s + "</svg>\n";
 }
 
@@ -225,6 +252,54 @@ std::string svg_box_plot(const PlotAxes& axes, const std::vector<BoxGroup>& grou
       s += "<text class=\"miss\" x=\"" + fmt(cx) + "\" y=\"" + fmt(top + 4) +
            "\" text-anchor=\"middle\" fill=\"#d62728\" font-size=\"12\">&#215;</text>\n";
   }
+  return s + "</svg>\n";
+}
+
+std::string svg_event_timeline(const PlotAxes& axes, const std::vector<EventLane>& lanes, double t_end) {
+  if (!(t_end > 0.0) || !std::isfinite(t_end)) t_end = 1.0;
+  const auto xt = nice_ticks(0.0, t_end);
+  // The lanes' labels need more room than a y axis' ticks: a wider left margin.
+  constexpr double kLabels = 200;
+  PlotAxes a = axes;
+  const double lane_h = 22;
+  a.height = static_cast<int>(kTop + kBottom + lane_h * static_cast<double>(std::max<std::size_t>(lanes.size(), 1)));
+  const double px0 = kLabels, px1 = a.width - kRight;
+  auto sx = [&](double t) { return px0 + t / t_end * (px1 - px0); };
+  const std::string mapping = " data-x0=\"0\" data-x1=\"" + tick_label(t_end) + "\" data-px0=\"" + fmt(px0) +
+                              "\" data-px1=\"" + fmt(px1) + "\"";
+  std::string s = open_svg(a, mapping);
+  const double bottom = a.height - kBottom;
+  for (double t : xt) {
+    if (t > t_end + 1e-12) break;
+    s += "<line x1=\"" + fmt(sx(t)) + "\" x2=\"" + fmt(sx(t)) + "\" y1=\"" + fmt(kTop) + "\" y2=\"" + fmt(bottom) +
+         "\" stroke=\"#eee\"/><text x=\"" + fmt(sx(t)) + "\" y=\"" + fmt(bottom + 14) + "\" text-anchor=\"middle\">" +
+         tick_label(t) + "</text>\n";
+  }
+  s += "<rect x=\"" + fmt(px0) + "\" y=\"" + fmt(kTop) + "\" width=\"" + fmt(px1 - px0) + "\" height=\"" +
+       fmt(bottom - kTop) + "\" fill=\"none\" stroke=\"#888\"/>\n";
+  s += "<text x=\"" + fmt((px0 + px1) / 2) + "\" y=\"" + fmt(a.height - 8.0) + "\" text-anchor=\"middle\">" +
+       html_escape(a.x_label) + "</text>\n";
+  for (std::size_t k = 0; k < lanes.size(); ++k) {
+    const auto& lane = lanes[k];
+    const double y = kTop + lane_h * static_cast<double>(k);
+    double total = 0.0;
+    for (const auto& [t0, t1] : lane.intervals) total += std::max(0.0, t1 - t0);
+    char summary[64];
+    std::snprintf(summary, sizeof summary, ": %zu, %.2f s", lane.intervals.size(), total);
+    s += "<text x=\"" + fmt(px0 - 6) + "\" y=\"" + fmt(y + lane_h / 2 + 4) + "\" text-anchor=\"end\">" +
+         html_escape(lane.name) + (lane.intervals.empty() ? ": none" : summary) + "</text>\n";
+    if (k > 0)
+      s += "<line x1=\"" + fmt(px0) + "\" x2=\"" + fmt(px1) + "\" y1=\"" + fmt(y) + "\" y2=\"" + fmt(y) +
+           "\" stroke=\"#ddd\"/>\n";
+    for (const auto& [t0, t1] : lane.intervals) {
+      const double x0 = sx(std::clamp(t0, 0.0, t_end)), x1 = sx(std::clamp(t1, 0.0, t_end));
+      s += "<rect class=\"event\" x=\"" + fmt(x0) + "\" y=\"" + fmt(y + 4) + "\" width=\"" + fmt(std::max(x1 - x0, 2.0)) +
+           "\" height=\"" + fmt(lane_h - 8) + "\" fill=\"" + html_escape(lane.color) + "\"/>\n";
+    }
+  }
+  if (!a.id.empty())
+    s += "<line class=\"cursor\" x1=\"" + fmt(px0) + "\" x2=\"" + fmt(px0) + "\" y1=\"" + fmt(kTop) + "\" y2=\"" +
+         fmt(bottom) + "\" stroke=\"#000\" stroke-width=\"1\" visibility=\"hidden\"/>\n";
   return s + "</svg>\n";
 }
 

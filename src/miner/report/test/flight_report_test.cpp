@@ -68,3 +68,105 @@ TEST_CASE("the report is self-contained with plots, tables and timings", "[REQ-R
   const auto close = html.find("</script>", open);
   CHECK(html.substr(open, close - open).find("</") == std::string::npos);
 }
+
+namespace {
+long column_index(const std::string& name) {
+  const auto& c = flight::flight_log_columns();
+  for (std::size_t i = 0; i < c.size(); ++i)
+    if (c[i] == name) return static_cast<long>(i);
+  return -1;
+}
+std::size_t count(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (std::size_t p = text.find(what); p != std::string::npos; p = text.find(what, p + 1)) ++n;
+  return n;
+}
+}  // namespace
+
+TEST_CASE("the viewer's flight data: the log every 0.05 s by column name, to 1 mm, with the events",
+          "[REQ-REPORT-010][REQ-REPORT-012]") {
+  const auto& f = fixture();
+  flight::FlightResult r = f.result;
+  // Events by hand: a collision from the 100th to the 150th row, a failsafe to the end.
+  const auto collision = static_cast<std::size_t>(column_index("collision"));
+  const auto failsafe = static_cast<std::size_t>(column_index("failsafe"));
+  // Every event column the log has cleared first (the flight may have had some).
+  for (const char* name : {"failsafe", "saturated", "pose_dropout", "collision"})
+    if (const long c = column_index(name); c >= 0)
+      for (auto& row : r.log) row[static_cast<std::size_t>(c)] = 0.0;
+  for (std::size_t i = 100; i < 150; ++i) r.log[i][collision] = 1.0;
+  for (std::size_t i = r.log.size() - 20; i < r.log.size(); ++i) r.log[i][failsafe] = 1.0;
+  const Json fj = report::flight_json(r);
+  const auto& c = fj["columns"];
+  const std::size_t n = c["t"].size();
+  CHECK(n >= static_cast<std::size_t>(r.flight_time / report::kFlownStep));
+  for (const char* name : {"t", "ref_x", "ref_y", "ref_z", "true_x", "true_y", "true_z", "est_x", "est_y", "est_z",
+                           "true_vx", "true_vy", "true_vz", "true_roll", "true_pitch", "true_yaw"}) {
+    INFO(name);
+    REQUIRE(c.contains(name));
+    CHECK(c[name].size() == n);
+  }
+  // Samples 0.05 s apart (to one log tick) and equal to the log's rows to 1 mm.
+  const auto tx = static_cast<std::size_t>(column_index("true_x"));
+  for (std::size_t k = 1; k < n; ++k) {
+    const double dt = c["t"][k].get<double>() - c["t"][k - 1].get<double>();
+    if (k + 1 < n) CHECK(dt == Approx(report::kFlownStep).margin(0.011));
+  }
+  std::size_t row = 0;
+  for (std::size_t k = 0; k < n; k += 37) {
+    while (r.log[row][0] < c["t"][k].get<double>() - 5e-4) ++row;
+    CHECK(c["true_x"][k].get<double>() == Approx(r.log[row][tx]).margin(5e-4));
+  }
+  const auto& ev = fj["events"];
+  REQUIRE(ev.size() == 2);
+  CHECK(ev[0]["kind"] == "failsafe");
+  CHECK(ev[0]["t0"].get<double>() == Approx(r.log[r.log.size() - 20][0]).margin(5e-4));
+  CHECK(ev[0]["t1"].get<double>() == Approx(r.log.back()[0]).margin(5e-4));
+  CHECK(ev[1]["kind"] == "collision");
+  CHECK(ev[1]["t0"].get<double>() == Approx(r.log[100][0]).margin(5e-4));
+  CHECK(ev[1]["t1"].get<double>() == Approx(r.log[150][0]).margin(5e-4));
+  const std::string html = report::render_flight_report({f.scenario, f.reference, r, {}});
+  CHECK_THAT(html, Contains("<script id=\"miner-flight\" type=\"application/json\">") && Contains("id=\"playback-slider\"") &&
+                       Contains("id=\"error-scale\""));
+  // The timeline: the two bars, and the lanes of the columns the log has.
+  const auto t0 = html.find("id=\"plot-events\"");
+  REQUIRE(t0 != std::string::npos);
+  const std::string timeline = html.substr(t0, html.find("</svg>", t0) - t0);
+  CHECK(count(timeline, "class=\"event\"") == 2);
+  CHECK_THAT(timeline, Contains("collision: 1, ") && Contains("failsafe: 1, "));
+  CHECK((timeline.find("pose dropout") != std::string::npos) == (column_index("pose_dropout") >= 0));
+  CHECK((timeline.find("saturation") != std::string::npos) == (column_index("saturated") >= 0));
+}
+
+TEST_CASE("the report plots every axis, attitude, EKF error, rotors; optional columns only when logged",
+          "[REQ-REPORT-011]") {
+  const auto& f = fixture();
+  const std::string html = report::render_flight_report({f.scenario, f.reference, f.result, {}});
+  for (const char* id : {"plot-position-x", "plot-position-y", "plot-position-z", "plot-velocity-x", "plot-velocity-y",
+                         "plot-velocity-z", "plot-attitude-roll", "plot-attitude-pitch", "plot-attitude-yaw", "plot-ekf-x",
+                         "plot-ekf-y", "plot-ekf-z", "plot-rotors", "plot-thrust", "plot-error", "plot-tracking-axes",
+                         "plot-speed"}) {
+    INFO(id);
+    const auto at = html.find(std::string("id=\"") + id + "\"");
+    REQUIRE(at != std::string::npos);
+    const std::string svg = html.substr(at, html.find("</svg>", at) - at);
+    CHECK_THAT(svg, Contains("<path d=\"M") && Contains("class=\"cursor\"") && Contains("data-px1="));
+  }
+  const auto section = [&](const char* id) {
+    const auto at = html.find(std::string("id=\"") + id + "\"");
+    return at == std::string::npos ? std::string() : html.substr(at, html.find("</svg>", at) - at);
+  };
+  // Reference, truth and estimate on a position plot; truth, estimate and command on roll.
+  CHECK(count(section("plot-position-x"), "<path d=\"M") == 3);
+  CHECK(count(section("plot-attitude-roll"), "<path d=\"M") == 3);
+  CHECK(count(section("plot-rotors"), "<path d=\"M") == 4);
+  CHECK(count(section("plot-tracking-axes"), "<path d=\"M") == 3);
+  // Optional columns: a plot or band exactly when the log has them.
+  CHECK((section("plot-ekf-x").find("class=\"band\"") != std::string::npos) == (column_index("est_sigma_x") >= 0));
+  CHECK(section("plot-battery").empty() == (column_index("battery_v") < 0));
+  CHECK(section("plot-wind").empty() == (column_index("wind_x") < 0));
+  CHECK(section("plot-yaw-rate").empty() == (column_index("cmd_yaw_rate") < 0));
+  CHECK((count(section("plot-attitude-yaw"), "<path d=\"M") == 4) == (column_index("ref_yaw") >= 0));
+  // The same flight, the same bytes.
+  CHECK(html == report::render_flight_report({f.scenario, f.reference, f.result, {}}));
+}

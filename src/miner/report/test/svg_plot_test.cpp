@@ -87,3 +87,47 @@ TEST_CASE("box plots show missed runs instead of dropping them", "[REQ-REPORT-00
 TEST_CASE("html_escape escapes the five special characters", "[REQ-REPORT-004]") {
   CHECK(html_escape("<a href=\"x\">'&'</a>") == "&lt;a href=&quot;x&quot;&gt;&#39;&amp;&#39;&lt;/a&gt;");
 }
+
+TEST_CASE("line plots draw bands and dashes, and carry their time mapping and cursor when named",
+          "[REQ-REPORT-004][REQ-REPORT-011]") {
+  Series band{"+-3 sigma", "#9467bd", {0, 1, 2, 3}, {1, 2, NAN, 1}, {}, {-1, -2, NAN, -1}};
+  const Series dashed{"ref", "#1f77b4", {0, 3}, {0, 5}, "5 3"};
+  PlotAxes axes{"Band", "time (s)", "m"};
+  const std::string plain = svg_line_plot(axes, {band, dashed});
+  // A band is one filled outline per finite run (the NaN splits it), closed with Z.
+  CHECK(count(plain, "class=\"band\"") == 1);
+  const auto b0 = plain.find("class=\"band\" d=\"");
+  const std::string d = plain.substr(b0, plain.find("\" fill", b0) - b0);
+  CHECK(count(d, "M") == 2);
+  CHECK(count(d, "Z") == 2);
+  CHECK_THAT(plain, Contains("stroke-dasharray=\"5 3\""));
+  // The band's lower edge counts for the axes: -2 is inside the y ticks.
+  CHECK_THAT(plain, Contains(">-2</text>"));
+  // Unnamed: no id, mapping or cursor (the bench plots keep their bytes).
+  CHECK_THAT(plain, !Contains("data-px0") && !Contains("class=\"cursor\"") && !Contains(" id=\""));
+  axes.id = "plot-band";
+  const std::string named = svg_line_plot(axes, {band, dashed});
+  CHECK_THAT(named, Contains("id=\"plot-band\"") && Contains("data-x0=\"0\" data-x1=\"3\"") &&
+                        Contains("data-px0=\"62.0\" data-px1=\"548.0\"") && Contains("class=\"cursor\""));
+  CHECK(named == svg_line_plot(axes, {band, dashed}));
+  band.y_low.pop_back();
+  CHECK_THROWS_WITH(svg_line_plot(axes, {band}), Contains("Band") && Contains("+-3 sigma"));
+}
+
+TEST_CASE("the event timeline has a lane per kind, a bar per interval, counts and 'none'", "[REQ-REPORT-012]") {
+  PlotAxes axes{"Events", "time (s)", ""};
+  axes.width = 1200;
+  axes.id = "plot-events";
+  const std::vector<EventLane> lanes{{"failsafe", "#d62728", {{2.0, 4.5}}},
+                                     {"collision", "#000000", {{1.0, 1.0}, {8.0, 9.0}}},
+                                     {"pose dropout", "#9467bd", {}}};
+  const std::string svg = svg_event_timeline(axes, lanes, 10.0);
+  CHECK(count(svg, "class=\"event\"") == 3);
+  CHECK_THAT(svg, Contains("failsafe: 1, 2.50 s") && Contains("collision: 2, 1.00 s") && Contains("pose dropout: none"));
+  CHECK_THAT(svg, Contains("id=\"plot-events\"") && Contains("data-x1=\"10\"") && Contains("class=\"cursor\""));
+  // An instant event is still 2 px wide.
+  CHECK_THAT(svg, Contains("width=\"2.0\""));
+  // Three lanes: the svg's height grows with them.
+  CHECK_THAT(svg, Contains("height=\"134\""));
+  CHECK(svg == svg_event_timeline(axes, lanes, 10.0));
+}

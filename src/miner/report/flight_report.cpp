@@ -139,7 +139,7 @@ struct EventKind {
 /// The event timeline's lanes, in order; a lane whose column the log lacks is left out.
 constexpr EventKind kEvents[] = {{"failsafe", "failsafe", "#d62728"},
                                  {"saturated", "thrust/tilt saturation", "#ff7f0e"},
-                                 {"pose_dropout", "pose dropout", "#9467bd"},
+                                 {"pose_lost", "pose dropout", "#9467bd"},
                                  {"collision", "collision", "#000000"}};
 
 std::string plots(const flight::FlightResult& f) {

@@ -37,7 +37,7 @@ Json scene_json(const FlightReportInput& in);
 /// thinned to every `kFlownStep` s: {"step", "columns": {name: [values]}, "events": [{kind,
 /// name, color, t0, t1}]}. Columns (each only when the log has it): t, ref_x/y/z,
 /// true_x/y/z, est_x/y/z, true_vx/vy/vz (1 mm, 1 ms), true_roll/pitch/yaw (1e-4 rad). Events
-/// are the intervals of the full-rate log in which failsafe, saturated, pose_dropout or
+/// are the intervals of the full-rate log in which failsafe, saturated, pose_lost or
 /// collision is 1.
 Json flight_json(const flight::FlightResult& flight);
 

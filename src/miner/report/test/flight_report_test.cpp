@@ -91,7 +91,7 @@ TEST_CASE("the viewer's flight data: the log every 0.05 s by column name, to 1 m
   const auto collision = static_cast<std::size_t>(column_index("collision"));
   const auto failsafe = static_cast<std::size_t>(column_index("failsafe"));
   // Every event column the log has cleared first (the flight may have had some).
-  for (const char* name : {"failsafe", "saturated", "pose_dropout", "collision"})
+  for (const char* name : {"failsafe", "saturated", "pose_lost", "collision"})
     if (const long c = column_index(name); c >= 0)
       for (auto& row : r.log) row[static_cast<std::size_t>(c)] = 0.0;
   for (std::size_t i = 100; i < 150; ++i) r.log[i][collision] = 1.0;
@@ -134,7 +134,7 @@ TEST_CASE("the viewer's flight data: the log every 0.05 s by column name, to 1 m
   const std::string timeline = html.substr(t0, html.find("</svg>", t0) - t0);
   CHECK(count(timeline, "class=\"event\"") == 2);
   CHECK_THAT(timeline, Contains("collision: 1, ") && Contains("failsafe: 1, "));
-  CHECK((timeline.find("pose dropout") != std::string::npos) == (column_index("pose_dropout") >= 0));
+  CHECK((timeline.find("pose dropout") != std::string::npos) == (column_index("pose_lost") >= 0));
   CHECK((timeline.find("saturation") != std::string::npos) == (column_index("saturated") >= 0));
 }
 

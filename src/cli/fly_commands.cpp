@@ -13,8 +13,8 @@
 #include "miner/core/error.hpp"
 #include "miner/core/stopwatch.hpp"
 #include "miner/flight/closed_loop.hpp"
+#include "miner/pipeline/run_folder.hpp"
 #include "miner/report/flight_report.hpp"
-#include "miner/traj/problem_io.hpp"
 
 namespace miner::cli {
 
@@ -59,11 +59,10 @@ void run_fly(const FlyCliOptions& o, std::ostream& out) {
   const pipeline::Scenario s = resolve_scenario(o.scenario, document);
   // The run folder replaces its contents whole: it must hold none of the scenario's inputs,
   // checked before any work (REQ-CLI-003).
-  const std::string run_dir = o.out.empty() ? "runs/" + s.name + "-seed" + std::to_string(s.seed) : o.out;
+  const std::string run_dir = o.out.empty() ? pipeline::default_run_folder(s) : o.out;
   if (!o.scenario.scenario.empty())
-    for (const std::string& input : pipeline::scenario_inputs(document.doc, document.base_dir))
-      if (is_same_or_inside(run_dir, input))
-        throw CLI::ValidationError("--out", run_dir + " holds " + input + ", which the scenario reads: the run folder would replace it");
+    if (const auto input = pipeline::run_folder_conflict(run_dir, document.doc, document.base_dir))
+      throw CLI::ValidationError("--out", run_dir + " holds " + *input + ", which the scenario reads: the run folder would replace it");
   const pipeline::ReferencePlan reference = pipeline::build_reference(s);
   flight::FlyOptions options;
   options.use_ground_truth = o.ground_truth;
@@ -72,38 +71,15 @@ void run_fly(const FlyCliOptions& o, std::ostream& out) {
   auto stage_ms = reference.stage_ms;
   stage_ms.emplace_back("flight", elapsed_ms(t0));
 
-  const std::string& dir = run_dir;
-  Json summary = r.summary;
-  summary["run_folder"] = dir;
-  summary["report"] = dir + "/report.html";
-  Json stages = Json::object();
-  for (const auto& [name, ms] : stage_ms) stages[name] = ms;
-  summary["stage_ms"] = stages;
-
-  auto points = [](const Eigen::MatrixX3d& m) {
-    Json p = Json::array();
-    for (Eigen::Index i = 0; i < m.rows(); ++i) p.push_back(vec3_json(m.row(i).transpose()));
-    return p;
-  };
-  Json path{{"source", reference.source}, {"points", points(reference.path)}};
-  std::vector<std::pair<std::string, std::string>> files{
-      {"scenario.json",
-       dump_json(o.scenario.scenario.empty() ? document.doc
-                                             : pipeline::self_contained_scenario(document.doc, document.base_dir))},
-      {"map.json", dump_json(s.map->to_json())}};
-  if (reference.region) {
-    files.emplace_back("region.json", reference.region->to_json().dump() + "\n");
-    path["planned"] = points(reference.planned_path);
-    Json vertices = Json::array();
-    for (const auto& v : reference.tree_vertices) vertices.push_back(vec3_json(v));
-    files.emplace_back("tree.json", dump_json(Json{{"vertices", vertices}, {"parents", reference.tree_parents}}));
-  }
-  files.emplace_back("path.json", dump_json(path));
-  files.emplace_back("trajectory.json", dump_json(traj::answer_to_json(reference.trajectory)));
-  files.emplace_back("flight_log.csv", flight::flight_log_csv(r));
-  files.emplace_back("report.html", report::render_flight_report({s, reference, r, stage_ms}));
-  files.emplace_back("summary.json", dump_json(summary));
-  write_folder_atomic(dir, files);
+  pipeline::RunFolder folder(run_dir,
+                             o.scenario.scenario.empty() ? document.doc
+                                                         : pipeline::self_contained_scenario(document.doc, document.base_dir),
+                             s, reference, r, stage_ms);
+  folder.add_page("report.html", report::render_flight_report({s, reference, r, stage_ms}), "report");
+  folder.write();
+  const Json& summary = folder.summary();
+  const std::string& dir = folder.dir();
+  const std::vector<std::string> names = folder.names();
 
   if (o.json) {
     out << dump_json(summary);
@@ -120,7 +96,7 @@ void run_fly(const FlyCliOptions& o, std::ostream& out) {
         << "stages (ms):";
     for (const auto& [name, ms] : stage_ms) out << " " << name << " " << std::setprecision(1) << ms;
     out << "\nwrote " << dir << "/ (";
-    for (std::size_t i = 0; i < files.size(); ++i) out << (i ? ", " : "") << files[i].first;
+    for (std::size_t i = 0; i < names.size(); ++i) out << (i ? ", " : "") << names[i];
     out << ")\nreport: " << dir << "/report.html\n";
   }
   if (!r.goal_reached)

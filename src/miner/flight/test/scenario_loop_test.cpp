@@ -10,6 +10,7 @@
 
 #include "miner/core/error.hpp"
 #include "miner/flight/closed_loop.hpp"
+#include "miner/pipeline/run_folder.hpp"
 #include "miner/pipeline/scenario.hpp"
 #include "miner/traj/problem_io.hpp"
 #include "miner/testing/flight_scenarios.hpp"
@@ -213,4 +214,26 @@ TEST_CASE("A run folder is replaced whole or not at all", "[REQ-CORE-004]") {
   // A file that cannot be written leaves the previous folder as it was.
   CHECK_THROWS(miner::write_folder_atomic(dir, {{"sub/x.txt", "y"}}));
   CHECK(std::filesystem::exists(dir + "/a.txt"));
+}
+
+TEST_CASE("The pipeline owns the run folder: its files in order, the summary naming them, inputs refused",
+          "[REQ-FLIGHT-009][REQ-CLI-003]") {
+  Eigen::MatrixX3d points(2, 3);
+  points << 5, 5, 3, 8, 6, 3.5;
+  const pipeline::Scenario s = miner::testing::open_room_scenario(points, 1.0, 1.0, 4);
+  const pipeline::ReferencePlan ref = pipeline::build_reference(s);
+  const flight::FlightResult r = pipeline::fly(s, ref);
+  pipeline::RunFolder folder("runs/x", miner::Json{{"name", "x"}}, s, ref, r, {{"flight", 1.5}});
+  folder.add_page("report.html", "<html></html>", "report");
+  CHECK(folder.names() == std::vector<std::string>{"scenario.json", "map.json", "path.json", "trajectory.json",
+                                                   "flight_log.csv", "report.html", "summary.json"});
+  CHECK(folder.summary()["report"] == "runs/x/report.html");
+  CHECK(folder.summary()["run_folder"] == "runs/x");
+  CHECK(folder.summary()["stage_ms"]["flight"] == 1.5);
+  CHECK(folder.summary()["goal_reached"] == r.summary["goal_reached"]);
+  CHECK(pipeline::default_run_folder(s) == "runs/open-room-seed4");
+  // A folder holding the scenario's map would be replaced by the run: named, before any work.
+  const miner::Json doc{{"map", "maps/m.json"}, {"vehicle", "v.json"}};
+  CHECK(pipeline::run_folder_conflict("/data/maps", doc, "/data").value_or("") == "/data/maps/m.json");
+  CHECK_FALSE(pipeline::run_folder_conflict("/data/runs/a", doc, "/data").has_value());
 }

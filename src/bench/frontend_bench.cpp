@@ -392,6 +392,12 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
     if (parts[p].contains("format"))
       root.fail("is a \"" + (parts[p]["format"].is_string() ? parts[p]["format"].get<std::string>() : std::string("?")) +
                 "\" file, not the JSON of `miner bench frontend --shard i/N --json`");
+    // Every key of a campaign's JSON, and no other (issue 20: an added or renamed key was called
+    // "a different campaign" of the other file).
+    root.only_keys({"map", "start", "goal", "robot_radius", "runs", "seed", "reference_cost", "target_factor",
+                    "target_cost", "lower_bound", "steer_step", "goal_radius", "max_iterations", "time_limit_s",
+                    "safeguard", "region", "throughput", "total_s", "shard", "planners", "run_records"});
+    for (const char* k : {"map", "runs", "seed", "lower_bound", "max_iterations"}) (void)root.at(k);
     const JsonField shard = root.at("shard");
     (void)shard.at("index").integer();
     (void)shard.at("count").integer();
@@ -406,9 +412,26 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
       r.only_keys({"planner", "run", "solved", "cost", "iterations", "first", "target"});
       (void)r.at("planner").string();
       (void)r.at("run").integer();
-      // A cost is a path length: finite and >= 0 (issue 20: a cost of -5 was averaged in).
-      if (r.has("cost") && r.at("cost").value().is_number() && !(r.at("cost").number() >= 0.0))
-        r.at("cost").fail("a path cost must be >= 0");
+      // A cost is a path length: finite and >= 0 (issue 20: a cost of -5 was averaged in), never
+      // below the campaign's lower bound (the straight line), never above the run's own first
+      // solution (costs only fall); a run stops within the iteration budget.
+      const double lower = root.at("lower_bound").number();
+      constexpr double kRoundoff = 1e-9;  // relative: the bound and the costs are sums of lengths
+      if (r.has("cost") && r.at("cost").value().is_number()) {
+        const double cost = r.at("cost").number();
+        if (!(cost >= 0.0)) r.at("cost").fail("a path cost must be >= 0");
+        if (cost < lower * (1.0 - kRoundoff))
+          r.at("cost").fail("a path cost of " + r.at("cost").value().dump() + " is below the campaign's lower bound " +
+                            root.at("lower_bound").value().dump() + " (no path is shorter)");
+        if (r.has("first") && r.at("first").value().is_object() && r.at("first").has("cost") &&
+            cost > r.at("first").at("cost").number() * (1.0 + kRoundoff))
+          r.at("cost").fail("a final cost of " + r.at("cost").value().dump() + " is above the run's first solution's " +
+                            r.at("first").at("cost").value().dump() + " (costs only fall)");
+      }
+      if (r.has("iterations") && r.at("iterations").value().is_number() &&
+          r.at("iterations").number() > root.at("max_iterations").number())
+        r.at("iterations").fail("ran " + r.at("iterations").value().dump() + " iterations, more than the campaign's budget " +
+                                root.at("max_iterations").value().dump());
       try {
         runs.push_back(run_from(parts[p]["run_records"][k]));
       } catch (const nlohmann::json::exception& e) {
@@ -424,8 +447,19 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
   const nlohmann::json common = settings(parts.front());
   std::vector<nlohmann::json> tags;
   for (std::size_t p = 0; p < parts.size(); ++p) {
-    if (settings(parts[p]) != common)
-      throw Error("merge: " + names[p] + " is from a different campaign (map, query, seed, runs or settings differ)");
+    const nlohmann::json mine = settings(parts[p]);
+    if (mine != common) {
+      // Name the first setting that differs, with both values.
+      std::string key;
+      for (const auto& [k, v] : common.items())
+        if (!mine.contains(k) || mine.at(k) != v) { key = k; break; }
+      if (key.empty())
+        for (const auto& [k, v] : mine.items())
+          if (!common.contains(k)) { key = k; break; }
+      throw Error("merge: " + names[p] + " and " + names.front() + " are different campaigns: \"" + key + "\" is " +
+                  (mine.contains(key) ? mine.at(key).dump() : std::string("absent")) + " in the one and " +
+                  (common.contains(key) ? common.at(key).dump() : std::string("absent")) + " in the other");
+    }
     tags.push_back(parts[p].at("shard"));
   }
   require_complete_parts(tags, names, "merge: the campaign");

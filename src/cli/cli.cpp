@@ -131,15 +131,6 @@ const CLI::Validator kOutputFileNewFolder(
     },
     "OUTPUT FILE");
 
-const CLI::Validator kPositive(
-    [](std::string& text) -> std::string {
-      double v = 0.0;
-      if (!read_finite_decimal(text, v) || !(v > 0.0))
-        return "must be a finite decimal number > 0, got " + text;
-      return {};
-    },
-    "POSITIVE");
-
 CLI::Validator finite_in(double lo, double hi) {
   char range[96];
   std::snprintf(range, sizeof range, "[%g, %g]", lo, hi);

@@ -66,9 +66,6 @@ extern const CLI::Validator kUnsigned64;
 /// "010" was octal 8, "0x10" 16 and "+3" 3 (issue 20). Leading zeros are dropped ("010" is
 /// 10). Every INT/UINT option of every command gets it (run_cli adds it). REQ-CLI-002.
 extern const CLI::Validator kDecimalInteger;
-/// A finite number > 0, with a short message ("must be a finite number > 0, got -3"):
-/// CLI11's PositiveNumber prints the largest double with all its 309 digits. REQ-CLI-002.
-extern const CLI::Validator kPositive;
 /// --shard i/N with 0 <= i < N, checked when the line is parsed (a usage error, exit 2).
 extern const CLI::Validator kShard;
 /// A finite number in [lo, hi] ("must be a finite number in [1e-06, 3600], got nan"); CLI11's

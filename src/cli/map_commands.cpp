@@ -26,6 +26,19 @@ namespace miner::cli {
 
 namespace {
 
+/// A map file MINER writes: .json, or .bt (issue 20: ".ot" got JSON that no reader took back).
+const CLI::Validator kMapOutput(
+    [](std::string& text) -> std::string {
+      const auto ends = [&](const char* suffix) {
+        const std::string x(suffix);
+        return text.size() >= x.size() && text.compare(text.size() - x.size(), x.size(), x) == 0;
+      };
+      if (ends(".ot")) return text + ": MINER writes OctoMaps as .bt only (.ot is read, not written)";
+      return "";
+    },
+    "MAP FILE");
+
+
 using world::Map;
 
 struct GenOptions {
@@ -334,8 +347,8 @@ void add_map_commands(CLI::App& app, std::ostream& out) {
   g->add_option("--size", gen->size, "families: extents X Y Z in m instead of drawn ones")->expected(3)
       ->check(finite_in(3.0, 1000.0));  // the families' sizes (REQ-WORLD-011)
   g->add_option("--resolution", gen->resolution, "families: grid resolution in m instead of the drawn one")
-      ->check(finite_in(world::kMinResolution, world::kMaxResolution));
-  g->add_option("--out", gen->out, "output file (.json, or .bt for OctoMap)")->required()->check(kOutputFile);
+      ->check(finite_in(world::kMinFamilyResolution, world::kMaxFamilyResolution));
+  g->add_option("--out", gen->out, "output file (.json, or .bt for OctoMap)")->required()->check(kOutputFile & kMapOutput);
   g->add_flag("--json", gen->json, "print the summary as JSON");
   g->callback([gen, &out] { run_gen(*gen, out); });
 
@@ -352,7 +365,7 @@ void add_map_commands(CLI::App& app, std::ostream& out) {
   auto conv = std::make_shared<ConvertOptions>();
   CLI::App* c = map->add_subcommand("convert", "convert between miner-map-v1 JSON and OctoMap .bt (a voxel map's JSON references its .bt by path and SHA-256)");
   c->add_option("--in", conv->in, "input map (.json, .bt or .ot)")->required();
-  c->add_option("--out", conv->out, "output map (.json or .bt)")->required()->check(kOutputFile);
+  c->add_option("--out", conv->out, "output map (.json or .bt)")->required()->check(kOutputFile & kMapOutput);
   c->add_flag("--json", conv->json, "print the summary as JSON");
   c->callback([conv, &out] { run_convert(*conv, out); });
 

@@ -166,6 +166,13 @@ TEST_CASE("map convert goes to OctoMap and back", "[REQ-CLI-001][REQ-WORLD-003]"
   REQUIRE(miner_cli({"map", "convert", "--in", bt, "--out", back}).code == 0);
   const Run r = miner_cli({"astar", "--map", bt, "--start", "1", "5", "5", "--goal", "9", "5", "5"});
   CHECK(r.code == 0);
+  // .ot is read, never written (issue 20: a ".ot" output got JSON no reader took back): refused
+  // as a usage error before any work, by gen and convert alike.
+  const Run ot = miner_cli({"map", "convert", "--in", map, "--out", dir() + "/pillar.ot"});
+  CHECK(ot.code == 2);
+  CHECK_THAT(ot.err, Contains("writes OctoMaps as .bt only"));
+  CHECK_FALSE(std::filesystem::exists(dir() + "/pillar.ot"));
+  CHECK(miner_cli({"map", "gen", "--preset", "indoor", "--out", dir() + "/gen.ot"}).code == 2);
 }
 
 TEST_CASE("Bad input: each case names what is wrong and exits non-zero", "[REQ-CLI-002][REQ-WORLD-002][REQ-WORLD-010]") {
@@ -838,6 +845,21 @@ TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[RE
     doctor([](miner::Json& d) { d["run_records"][0]["run"] = 7; }, "is not a run of part 1/3");
     doctor([](miner::Json& d) { d["run_records"][0]["cost"] = -5.0; }, "a path cost must be >= 0");
     doctor([](miner::Json& d) { d["run_records"][0]["costs"] = 1.0; }, "did you mean \"cost\"");
+    // Impossible values (issue 20, second audit): a cost below the straight line, above the run's
+    // own first solution, more iterations than the budget; the top level is strict too, and a
+    // changed setting is named with both values.
+    const auto solved = [](miner::Json& d) -> miner::Json& {
+      for (auto& r : d["run_records"])
+        if (r["solved"] == true && r["first"].is_object()) return r;
+      FAIL("no solved record in the part");
+      return d;
+    };
+    doctor([&](miner::Json& d) { solved(d)["cost"] = 0.5 * d["lower_bound"].get<double>(); }, "below the campaign's lower bound");
+    doctor([&](miner::Json& d) { auto& r = solved(d); r["cost"] = 2.0 * r["first"]["cost"].get<double>(); }, "costs only fall");
+    doctor([&](miner::Json& d) { solved(d)["iterations"] = 1e9; }, "more than the campaign's budget");
+    doctor([](miner::Json& d) { d["foo"] = 1; }, "foo: unknown key");
+    doctor([](miner::Json& d) { d["sed"] = d["seed"]; d.erase("seed"); }, "did you mean \"seed\"");
+    doctor([](miner::Json& d) { d["steer_step"] = 123.0; }, "\"steer_step\" is 123.0 in the one");
   }
   // Missing, repeated and foreign parts, and malformed shards, are refused.
   CHECK(miner_cli({"bench", "merge", parts[0], parts[1]}).code == 1);

@@ -224,7 +224,9 @@ double JsonField::number_in(double lo, double hi, const std::string& unit) const
 
 int JsonField::integer() const {
   const double v = number();
-  if (std::floor(v) != v || std::fabs(v) > 2147483647.0) fail("expected an integer, got " + value_->dump());
+  if (std::floor(v) != v) fail("expected an integer, got " + value_->dump());
+  // issue 20: "expected an integer, got 1000000000000" read as if the value were not whole.
+  if (std::fabs(v) > 2147483647.0) fail("integer " + value_->dump() + " is out of range (at most 2147483647 in magnitude)");
   return static_cast<int>(v);
 }
 

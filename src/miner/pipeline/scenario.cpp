@@ -62,7 +62,13 @@ Scenario scenario_from_json(const Json& doc, const std::string& origin, const st
 
   const JsonField map_field = root.at("map");
   if (map_field.value().is_string()) {
-    s.map = std::make_shared<const world::Map>(world::Map::load(resolve(base_dir, map_field.string())));
+    // A map that cannot be read is named as the scenario's field (issue 20: "/tmp: cannot open
+    // file" named neither).
+    try {
+      s.map = std::make_shared<const world::Map>(world::Map::load(resolve(base_dir, map_field.string())));
+    } catch (const Error& e) {
+      map_field.fail(e.what());
+    }
   } else {
     s.map = std::make_shared<const world::Map>(world::Map::from_json(map_field.value(), origin + ": map"));
   }

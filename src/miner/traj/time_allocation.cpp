@@ -192,6 +192,11 @@ std::pair<double, double> feasible_objective(const MincoProblem& problem, const 
 
 AllocationResult optimise_allocation(const MincoProblem& problem, const AllocationOptions& o) {
   validate(o);
+  const auto segments = problem.points.rows() - 1;
+  if (segments > kMaxOptimisedSegments)
+    throw Error("allocation: \"optimise\" takes at most " + std::to_string(kMaxOptimisedSegments) +
+                " segments (its work grows as the square of the count), this problem has " + std::to_string(segments) +
+                ": use \"trapezoid\" or split the path");
   if (!problem.head.bottomRows(problem.order - 1).isZero(0.0) || !problem.tail.bottomRows(problem.order - 1).isZero(0.0))
     throw Error("allocation: \"optimise\" needs a problem at rest at both ends (head and tail derivatives 1..s-1 "
                 "zero): the limits are kept by stretching time, and with moving ends a longer trajectory can need "

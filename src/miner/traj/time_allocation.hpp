@@ -63,8 +63,13 @@ struct AllocationResult {
   double solve_ms = 0.0;
 };
 
+/// The most segments optimise_allocation() takes: its pattern search costs O(M) MINCO solves
+/// of O(M) each per sweep, so work grows as M^2 (100 segments: ~7 s, 400: > 5 min here;
+/// issue 20). Planner paths have 10-30 segments; longer ones keep the trapezoid or are split.
+inline constexpr int kMaxOptimisedSegments = 64;
+
 /// Throws miner::Error for a bad problem (validate()), moving ends, bad limits, rho <= 0 or
-/// not finite, or samples_per_segment < 2. `problem.durations` are ignored: the start is the
+/// not finite, samples_per_segment < 2, or more than kMaxOptimisedSegments segments. `problem.durations` are ignored: the start is the
 /// trapezoid.
 AllocationResult optimise_allocation(const MincoProblem& problem, const AllocationOptions& options);
 

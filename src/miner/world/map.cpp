@@ -343,6 +343,9 @@ VoxelLayer Map::to_voxel_layer() const {
 void Map::save_octomap(const std::string& path) const { write_octree_bt(to_voxel_layer(), path); }
 
 void Map::save(const std::string& path) const {
+  // issue 20: a ".ot" path got JSON that load() then read as an OctoMap and refused.
+  if (path.size() >= 3 && path.compare(path.size() - 3, 3, ".ot") == 0)
+    throw Error(path + ": MINER writes OctoMaps as .bt (binary occupancy) only, not .ot: name the output .bt or .json");
   if (path.size() >= 3 && path.compare(path.size() - 3, 3, ".bt") == 0) {
     save_octomap(path);
   } else if (source_ && source_->file.empty()) {

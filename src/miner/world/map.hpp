@@ -45,6 +45,8 @@ inline constexpr double kMaxGridCells = 268435456.0;
 inline constexpr double kMinResolution = 1e-3;
 /// 100 m: coarser cells than any vehicle could plan in.
 inline constexpr double kMaxResolution = 100.0;
+/// The resolutions a generated family map may be given (`map gen --resolution`): 1 cm to 10 m.
+inline constexpr double kMinFamilyResolution = 0.01, kMaxFamilyResolution = 10.0;
 /// 1000 km from the origin: double then keeps metres to ~1e-10 m, and a map of the Earth's
 /// scale still fits; beyond it a local frame is what the user needs.
 inline constexpr double kMaxCoordinate = 1e6;

@@ -212,7 +212,7 @@ Map generate_map(const GeneratorPreset& preset, std::uint64_t seed, const Genera
     if (!s.allFinite() || (s.array() < 3.0).any() || (s.array() > 1000.0).any())
       throw Error("size: every extent must be between 3 and 1000 m");
   }
-  if (overrides.resolution && !(*overrides.resolution >= 0.01 && *overrides.resolution <= 10.0))
+  if (overrides.resolution && !(*overrides.resolution >= kMinFamilyResolution && *overrides.resolution <= kMaxFamilyResolution))
     throw Error("resolution: must be between 0.01 and 10 m");
   if (preset.name == "scan") return generate_scan_map(preset, seed, overrides).map;
   if (is_family(preset)) {

@@ -463,6 +463,8 @@ TEST_CASE("Scenario disturbance sections are strict and named in their errors", 
   nlohmann::json pose = base["pose"];
   pose["dropout_rate_hz"] = 1.0;
   refused("pose", pose, "dropout_mean_s");
+  // A map file that cannot be read is named as the scenario's field (issue 20).
+  refused("map", "/nonexistent-folder/m.json", "bad.json: map: /nonexistent-folder/m.json");
 }
 
 TEST_CASE("The flight log's header names every column with its unit", "[REQ-FLIGHT-009]") {

@@ -97,6 +97,16 @@ TEST_CASE("Optimised allocation refuses moving ends, naming why", "[REQ-TRAJ-011
   CHECK_THROWS_WITH(optimise_allocation(rest_to_rest(4, zigzag(), {}), o), Contains("rho: must be positive"));
 }
 
+TEST_CASE("Optimised allocation bounds its work: more segments than it optimises are refused up front", "[REQ-TRAJ-011]") {
+  // issue 20: 400 segments ran for more than 5 minutes. The refusal comes before any solve.
+  Eigen::MatrixX3d points(miner::traj::kMaxOptimisedSegments + 2, 3);
+  for (Eigen::Index i = 0; i < points.rows(); ++i) points.row(i) << static_cast<double>(i), (i % 2) * 0.5, 0.0;
+  AllocationOptions o;
+  CHECK_THROWS_WITH(optimise_allocation(rest_to_rest(4, points, {}), o),
+                    Contains("at most 64 segments") && Contains("has 65"));
+  CHECK_NOTHROW(optimise_allocation(rest_to_rest(4, points.topRows(4), {}), o));
+}
+
 TEST_CASE("Allocation requests in problem files are checked", "[REQ-TRAJ-011]") {
   const auto doc = miner::parse_json(R"({"order": 3, "points": [[0,0,0],[1,0,0],[2,1,0]],
     "head": [[0,0,0],[0,0,0],[0,0,0]], "tail": [[2,1,0],[0,0,0],[0,0,0]],

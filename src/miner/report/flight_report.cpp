@@ -225,8 +225,12 @@ std::string plots(const flight::FlightResult& f) {
     if (log.has("cmd_thrust_pct"))
       body += svg_line_plot(small("plot-thrust", "Thrust", "thrust (% of max)"),
                             {{"thrust command", kCmdColor, t, log.get("cmd_thrust_pct")}});
-    if (log.has("battery_v"))
-      body += svg_line_plot(small("plot-battery", "Battery", "voltage (V)"), {{"battery", "#17becf", t, log.get("battery_v")}});
+    // The battery's voltage when the flight modelled one (the column is 0 without a battery).
+    if (log.has("battery_v")) {
+      const auto volts = log.get("battery_v");
+      if (std::any_of(volts.begin(), volts.end(), [](double v) { return v > 0.0; }))
+        body += svg_line_plot(small("plot-battery", "Battery", "voltage (V)"), {{"battery", "#17becf", t, volts}});
+    }
     std::vector<Series> wind;
     for (int a = 0; a < 3; ++a)
       if (log.has(std::string("wind_") + axis[a]))

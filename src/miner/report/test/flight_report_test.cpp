@@ -163,7 +163,14 @@ TEST_CASE("the report plots every axis, attitude, EKF error, rotors; optional co
   CHECK(count(section("plot-tracking-axes"), "<path d=\"M") == 3);
   // Optional columns: a plot or band exactly when the log has them.
   CHECK((section("plot-ekf-x").find("class=\"band\"") != std::string::npos) == (column_index("est_sigma_x") >= 0));
-  CHECK(section("plot-battery").empty() == (column_index("battery_v") < 0));
+  // The battery plot only when the flight modelled a battery (its column is 0 otherwise).
+  CHECK(section("plot-battery").empty() == !f.scenario.battery.enabled);
+  if (column_index("battery_v") >= 0) {
+    auto with_battery = f.result;
+    for (auto& row : with_battery.log) row[static_cast<std::size_t>(column_index("battery_v"))] = 15.5;
+    const std::string page = report::render_flight_report({f.scenario, f.reference, with_battery, {}});
+    CHECK(page.find("id=\"plot-battery\"") != std::string::npos);
+  }
   CHECK(section("plot-wind").empty() == (column_index("wind_x") < 0));
   CHECK(section("plot-yaw-rate").empty() == (column_index("cmd_yaw_rate") < 0));
   CHECK((count(section("plot-attitude-yaw"), "<path d=\"M") == 4) == (column_index("ref_yaw") >= 0));

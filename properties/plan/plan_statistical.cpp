@@ -151,6 +151,42 @@ TEST_CASE("MINER samples H with probability mu_2 before the first solution and m
   CHECK(after_h <= after.hi);
 }
 
+TEST_CASE("Guided RRT* samples a beacon's local subsets with its fraction after the first solution", "[REQ-PLAN-003]") {
+  // After the first solution each iteration samples x_goal with probability goal_bias, else a
+  // beacon's local subsets with probability guided_local_fraction (the solution on the door map
+  // always has interior vertices, so beacons exist), else the informed set; before it, never.
+  // Common random numbers make the run to K extend the run to the first solution, so the local
+  // samples of the extension are Binomial(iterations after, (1 - goal_bias) f): inside the
+  // exact interval (false fail <= 1e-6). Dropping the local sampler (0), or taking f as the
+  // informed share, moves the rate by 0.45 of thousands of draws.
+  const auto map = wall_with_door_map();
+  const auto problem = PlanningProblem::make(map, kStart, kGoal, 0.0);
+  PlannerOptions base;
+  base.planner = PlannerKind::kGuided;
+  base.seed = seed_for_set(5151, seed_set());
+  const std::size_t after_first = 2000;
+  long after_iterations = 0, local = 0;
+  for (int trial = 0; trial < 10; ++trial) {
+    PlannerOptions o = base;
+    o.stream = static_cast<std::uint64_t>(trial);
+    o.stop_at_first = true;
+    const PlanResult a = miner::plan::plan(problem, o, nullptr);
+    REQUIRE(a.first);
+    CHECK(a.guided_local_samples == 0);  // none before the first solution
+    o.stop_at_first = false;
+    o.max_iterations = a.iterations + after_first;
+    const PlanResult b = miner::plan::plan(problem, o, nullptr);
+    REQUIRE(b.first->iteration == a.first->iteration);
+    after_iterations += static_cast<long>(b.iterations - a.iterations);
+    local += static_cast<long>(b.guided_local_samples);
+  }
+  const double p = (1.0 - base.goal_bias) * base.guided_local_fraction;
+  const auto interval = miner::testing::binomial_interval(static_cast<int>(after_iterations), p);
+  INFO("local samples " << local << " of " << after_iterations << " in [" << interval.lo << ", " << interval.hi << "]");
+  CHECK(local >= interval.lo);
+  CHECK(local <= interval.hi);
+}
+
 TEST_CASE("Under common random numbers, solved after K1 iterations implies solved after K2", "[REQ-PLAN-013]") {
   const auto map = wall_with_door_map();
   const auto problem = PlanningProblem::make(map, kStart, kGoal, 0.0);

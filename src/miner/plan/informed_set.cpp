@@ -42,4 +42,15 @@ Eigen::Vector3d ProlateHyperspheroid::sample(Rng& rng) const {
   return rotation_ * Eigen::Vector3d(r1_ * u.x(), r2_ * u.y(), r2_ * u.z()) + centre_;
 }
 
+GuidedLocalSubsets::GuidedLocalSubsets(const Eigen::Vector3d& start, const Eigen::Vector3d& goal,
+                                       const Eigen::Vector3d& beacon, double cost_to_beacon, double best_cost)
+    : to_start_(start, beacon, cost_to_beacon),
+      to_goal_(beacon, goal, best_cost - cost_to_beacon),
+      m_start_(to_start_.measure()),
+      m_goal_(to_goal_.measure()) {}
+
+const ProlateHyperspheroid& GuidedLocalSubsets::pick(Rng& rng) const {
+  return rng.uniform01() * (m_start_ + m_goal_) < m_start_ ? to_start_ : to_goal_;
+}
+
 }  // namespace miner::plan

@@ -36,4 +36,25 @@ class ProlateHyperspheroid {
   Eigen::Matrix3d rotation_;
 };
 
+/// Guided RRT*'s local subsets of a beacon b (REQ-PLAN-003; Scalise et al. 2023, GuILD): with
+/// g the cost-to-come of b along the current solution of cost c_best,
+///   L_start = {x : |x - x_start| + |x - b| <= g},   L_goal = {x : |x - b| + |x - x_goal| <= c_best - g},
+/// one of which pick() chooses in proportion to their volumes, P(L_start) = m_s / (m_s + m_g).
+class GuidedLocalSubsets {
+ public:
+  GuidedLocalSubsets(const Eigen::Vector3d& start, const Eigen::Vector3d& goal, const Eigen::Vector3d& beacon,
+                     double cost_to_beacon, double best_cost);
+  const ProlateHyperspheroid& to_start() const { return to_start_; }
+  const ProlateHyperspheroid& to_goal() const { return to_goal_; }
+  /// m_s + m_g > 0 (else there is nothing local to sample: the solution is a straight line).
+  bool has_volume() const { return m_start_ + m_goal_ > 0.0; }
+  double start_share() const { return m_start_ / (m_start_ + m_goal_); }
+  /// L_start with probability start_share(), else L_goal (one uniform draw).
+  const ProlateHyperspheroid& pick(Rng& rng) const;
+
+ private:
+  ProlateHyperspheroid to_start_, to_goal_;
+  double m_start_, m_goal_;
+};
+
 }  // namespace miner::plan

@@ -187,11 +187,10 @@ void RrtStar::update_trust(std::size_t t) {
 
 Eigen::Vector3d RrtStar::sample_guided_local() {
   const auto& [b, g] = beacons_[rng_.uniform_index(beacons_.size())];
-  const ProlateHyperspheroid to_start(problem_.start, b, g);
-  const ProlateHyperspheroid to_goal(b, problem_.goal, best_cost_ - g);
-  const double m1 = to_start.measure(), m2 = to_goal.measure();
-  if (!(m1 + m2 > 0.0)) return sample_informed();
-  return rng_.uniform01() * (m1 + m2) < m1 ? sample_in(to_start) : sample_in(to_goal);
+  const GuidedLocalSubsets local(problem_.start, problem_.goal, b, g, best_cost_);
+  if (!local.has_volume()) return sample_informed();
+  ++result_.guided_local_samples;
+  return sample_in(local.pick(rng_));
 }
 
 void RrtStar::set_parent(std::size_t v, std::size_t parent, double cost) {

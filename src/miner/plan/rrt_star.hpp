@@ -135,6 +135,8 @@ struct PlanResult {
   /// miner: samples drawn from H, and the trust tau of the last iteration (1 without the
   /// safeguard or for the other planners).
   std::size_t region_samples = 0;
+  /// guided: samples drawn from a beacon's local subsets (REQ-PLAN-003).
+  std::size_t guided_local_samples = 0;
   double region_trust = 1.0;
   double steer_step = 0.0;   ///< the eta and r actually used (defaults resolved)
   double goal_radius = 0.0;

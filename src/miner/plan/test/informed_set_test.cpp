@@ -4,6 +4,7 @@
 
 #include "miner/core/rng.hpp"
 #include "miner/plan/informed_set.hpp"
+#include "miner/testing/binomial.hpp"
 
 using miner::plan::ProlateHyperspheroid;
 using V = Eigen::Vector3d;
@@ -41,4 +42,44 @@ TEST_CASE("The informed-set volume is (4/3) pi r1 r2^2 and degenerates to the se
   CHECK(std::abs(x.y()) < 1e-12);
   CHECK(x.x() >= -1e-12);
   CHECK(x.x() <= 6 + 1e-12);
+}
+
+TEST_CASE("Guided RRT*'s local subsets: the beacon's two sets, picked in proportion to their volumes", "[REQ-PLAN-003]") {
+  // Start, goal, a beacon off the straight line on a solution of cost c_best, g the beacon's
+  // cost-to-come: L_start has foci (start, b) and diameter g, L_goal foci (b, goal) and
+  // c_best - g. Samples of the picked set lie in it; L_start is picked with probability
+  // m_s / (m_s + m_g), checked against the exact binomial interval (false fail <= 1e-6): a
+  // pick by count (1/2) or swapped (m_g share) misses it by tens of standard deviations.
+  const V start(0, 0, 0), goal(10, 0, 0), beacon(4, 3, 0);
+  const double g = 1.1 * (beacon - start).norm();
+  const double c_best = g + 1.4 * (goal - beacon).norm();
+  const miner::plan::GuidedLocalSubsets local(start, goal, beacon, g, c_best);
+  REQUIRE(local.has_volume());
+  CHECK(local.to_start().transverse_diameter() == Approx(g));
+  CHECK(local.to_goal().transverse_diameter() == Approx(c_best - g));
+  const double share = local.to_start().measure() / (local.to_start().measure() + local.to_goal().measure());
+  CHECK(local.start_share() == Approx(share));
+  REQUIRE(std::abs(share - 0.5) > 0.1);  // the two sets differ, so the proportion is tested
+  miner::Rng rng(17);
+  const int n = 20000;
+  long from_start = 0;
+  for (int i = 0; i < n; ++i) {
+    const ProlateHyperspheroid& set = local.pick(rng);
+    const V x = set.sample(rng);
+    REQUIRE(set.contains(x));
+    // In L_start: |x - start| + |x - b| <= g; in L_goal the other sum.
+    if (&set == &local.to_start()) {
+      ++from_start;
+      CHECK((x - start).norm() + (x - beacon).norm() <= g * (1 + 1e-12));
+    } else {
+      CHECK((x - beacon).norm() + (x - goal).norm() <= (c_best - g) * (1 + 1e-12));
+    }
+  }
+  const auto interval = miner::testing::binomial_interval(n, share, 1e-6);
+  INFO("L_start picked " << from_start << " of " << n << ", expected share " << share);
+  CHECK(from_start >= interval.lo);
+  CHECK(from_start <= interval.hi);
+  // A straight-line solution (beacon on the segment, g and c_best exact) has no volume.
+  const miner::plan::GuidedLocalSubsets flat(start, goal, V(4, 0, 0), 4.0, 10.0);
+  CHECK_FALSE(flat.has_volume());
 }

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # cites: REQ-LIB-001
-# ci/install_test.sh BUILD_DIR [EXTRA_FLAGS] — the library as a user consumes it: installs the
+# ci/install_test.sh BUILD_DIR [EXTRA_FLAGS] [python|no-python] — the library as a user consumes it: installs the
 # build into a scratch prefix, checks what landed there (tool, static libraries, headers,
 # CMake package, weights), builds examples/ against the prefix with find_package(miner)
 # (nothing from the source or build tree on the include path) and runs each example.
@@ -9,6 +9,9 @@
 set -euo pipefail
 build=$(cd "$1" && pwd)
 extra=${2:-}
+# python: the build has the bindings (MINER_PYTHON), so the prefix must hold them and they must
+# plan; no-python: a build without them (the step is skipped, saying so).
+python=${3:-python}
 src=$(cd "$(dirname "$0")/.." && pwd)
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
@@ -37,7 +40,13 @@ fi
 "$work/examples/fly_scenario"
 # Python from the prefix (REQ-LIB-002), with Debian's python3 (numpy); an instrumented build's
 # extension needs its sanitizer runtime preloaded.
-if [ -e "$prefix/lib/python3/dist-packages/miner/__init__.py" ]; then
+if [ "$python" = python ] && [ ! -e "$prefix/lib/python3/dist-packages/miner/__init__.py" ]; then
+  echo "install_test: the build has Python bindings but the prefix holds no lib/python3/dist-packages/miner" >&2
+  exit 1
+fi
+if [ "$python" = no-python ]; then
+  echo "install_test: built without MINER_PYTHON: the Python step is skipped"
+else
   preload=""
   case "$extra" in *-fsanitize=address*) preload="$(g++ -print-file-name=libasan.so) $(g++ -print-file-name=libstdc++.so)" ;; esac
   (cd "$work" && LD_PRELOAD="$preload" ASAN_OPTIONS=detect_leaks=0 PYTHONPATH="$prefix/lib/python3/dist-packages" \

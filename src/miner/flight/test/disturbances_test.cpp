@@ -70,25 +70,22 @@ double log_mean(const flight::FlightResult& r, const std::string& name, double f
 /// Hann-windowed periodogram averaged over the series' non-overlapping segments of `length`
 /// samples, at DFT bin `bin`: an estimate of the one-sided PSD (per rad/s).
 double welch_psd(const std::vector<double>& x, double dt, std::size_t length, std::size_t bin) {
+  const double len = static_cast<double>(length), k = static_cast<double>(bin);
+  const auto hann = [&](std::size_t n) { return 0.5 - 0.5 * std::cos(2.0 * kPi * static_cast<double>(n) / len); };
   double w2 = 0.0;
-  for (std::size_t n = 0; n < length; ++n) {
-    const double w = 0.5 - 0.5 * std::cos(2.0 * kPi * n / length);
-    w2 += w * w;
-  }
+  for (std::size_t n = 0; n < length; ++n) w2 += hann(n) * hann(n);
   const std::size_t segments = x.size() / length;
   double sum = 0.0;
   for (std::size_t s = 0; s < segments; ++s) {
     std::complex<double> acc = 0.0;
     double mean = 0.0;
-    for (std::size_t n = 0; n < length; ++n) mean += x[s * length + n] / length;
-    for (std::size_t n = 0; n < length; ++n) {
-      const double w = 0.5 - 0.5 * std::cos(2.0 * kPi * n / length);
-      acc += w * (x[s * length + n] - mean) * std::polar(1.0, -2.0 * kPi * bin * n / length);
-    }
+    for (std::size_t n = 0; n < length; ++n) mean += x[s * length + n] / len;
+    for (std::size_t n = 0; n < length; ++n)
+      acc += hann(n) * (x[s * length + n] - mean) * std::polar(1.0, -2.0 * kPi * k * static_cast<double>(n) / len);
     sum += std::norm(acc);
   }
   // Two-sided per rad/s: dt |X|^2 / (2 pi sum w^2); one-sided: twice that.
-  return dt * sum / segments / (kPi * w2);
+  return dt * sum / static_cast<double>(segments) / (kPi * w2);
 }
 
 }  // namespace
@@ -109,7 +106,7 @@ TEST_CASE("Dryden turbulence has the standard's variance and spectrum on every a
   flight::WindModel wind(p, dt, rng);
   std::vector<double> axis[3];
   for (std::size_t k = 0; k < kLength * kSegments; ++k) {
-    const Eigen::Vector3d w = wind.step(k * dt, Eigen::Vector3d::Zero()) - p.mean;
+    const Eigen::Vector3d w = wind.step(static_cast<double>(k) * dt, Eigen::Vector3d::Zero()) - p.mean;
     for (int a = 0; a < 3; ++a) axis[a].push_back(w[a]);
   }
   // Each averaged bin is S chi2(2K) / 2K; the sum over kBins bins (independent under the
@@ -129,7 +126,7 @@ TEST_CASE("Dryden turbulence has the standard's variance and spectrum on every a
       // Bins 3, 7, .., 31 (0.46 .. 4.75 rad/s): clear of the window's reach of DC and far
       // apart enough to be independent.
       const std::size_t bin = 3 + 4 * static_cast<std::size_t>(b);
-      const double omega = 2.0 * kPi * bin / (kLength * dt);
+      const double omega = 2.0 * kPi * static_cast<double>(bin) / (static_cast<double>(kLength) * dt);
       const double s = welch_psd(axis[a], dt, kLength, bin);
       const double phi = a < 2 ? flight::dryden_psd_horizontal(p.sigma_horizontal, p.length_horizontal, v, omega)
                                : flight::dryden_psd_vertical(p.sigma_vertical, p.length_vertical, v, omega);
@@ -145,7 +142,7 @@ TEST_CASE("Dryden turbulence has the standard's variance and spectrum on every a
     // The variance is sigma^2 (the spectra integrate to it): within 15 %, ~7 standard errors
     // of an 8192 s record with a 1 s correlation time.
     double var = 0.0;
-    for (double x : axis[a]) var += x * x / axis[a].size();
+    for (double x : axis[a]) var += x * x / static_cast<double>(axis[a].size());
     const double sigma = a < 2 ? p.sigma_horizontal : p.sigma_vertical;
     CHECK(var == Approx(sigma * sigma).epsilon(0.15));
   }

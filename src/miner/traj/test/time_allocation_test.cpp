@@ -100,7 +100,7 @@ TEST_CASE("Optimised allocation refuses moving ends, naming why", "[REQ-TRAJ-011
 TEST_CASE("Optimised allocation bounds its work: more segments than it optimises are refused up front", "[REQ-TRAJ-011]") {
   // issue 20: 400 segments ran for more than 5 minutes. The refusal comes before any solve.
   Eigen::MatrixX3d points(miner::traj::kMaxOptimisedSegments + 2, 3);
-  for (Eigen::Index i = 0; i < points.rows(); ++i) points.row(i) << static_cast<double>(i), (i % 2) * 0.5, 0.0;
+  for (Eigen::Index i = 0; i < points.rows(); ++i) points.row(i) << static_cast<double>(i), static_cast<double>(i % 2) * 0.5, 0.0;
   AllocationOptions o;
   CHECK_THROWS_WITH(optimise_allocation(rest_to_rest(4, points, {}), o),
                     Contains("at most 64 segments") && Contains("has 65"));

@@ -186,8 +186,7 @@ FrontendBenchResult run_frontend_bench(const world::Map& map, const std::string&
   for (const std::string& name : out.options.planners) {
     const bool ompl = is_ompl_planner(name);
     // Every valid name in the message, ours and OMPL's (issue 20: it used to list 4 of 11).
-    std::vector<std::string> valid{"rrtstar", "informed", "guided", "miner", kMinerSgan};
-    for (const auto& n : ompl_planner_names()) valid.push_back(n);
+    const std::vector<std::string> valid = frontend_planner_names();
     if (std::find(valid.begin(), valid.end(), name) == valid.end()) {
       std::string list;
       for (const auto& v : valid) list += (list.empty() ? "" : ", ") + v;
@@ -347,6 +346,12 @@ RunRecord run_from(const nlohmann::json& j) {
 }
 
 }  // namespace
+
+std::vector<std::string> frontend_planner_names() {
+  std::vector<std::string> names{"rrtstar", "informed", "guided", "miner", kMinerSgan};
+  for (const auto& n : ompl_planner_names()) names.push_back(n);
+  return names;
+}
 
 nlohmann::json to_json(const FrontendBenchResult& r) {
   nlohmann::json planners = nlohmann::json::array();

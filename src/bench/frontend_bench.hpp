@@ -52,6 +52,8 @@ struct FrontendBenchOptions {
 /// MINER with the filtered sGAN region computed per run, its time included in every
 /// figure (the end-to-end front end); "miner" itself uses the A*-dilated oracle region.
 inline constexpr const char* kMinerSgan = "miner-sgan";
+/// Every planner name `--planners` takes: ours, miner-sgan and every ompl:* planner.
+std::vector<std::string> frontend_planner_names();
 
 /// One run of one planner.
 struct RunRecord {

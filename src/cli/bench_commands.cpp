@@ -1,4 +1,5 @@
 // `miner bench backend` (REQ-TRAJ-009).
+#include <algorithm>
 #include <ostream>
 #include <sstream>
 #include <tuple>
@@ -92,9 +93,20 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   CLI::App* fc = bench_cmd->add_subcommand(
       "frontend", "Monte Carlo front-end campaign like the paper's Table I, with OMPL's planners beside ours");
   add_query_options(fc, f->query);
+  // An unknown name is a usage error (exit 2) naming every valid one (issue 20: it failed later, exit 1).
+  const CLI::Validator planner_name(
+      [](std::string& name) -> std::string {
+        const auto valid = bench::frontend_planner_names();
+        if (std::find(valid.begin(), valid.end(), name) != valid.end()) return {};
+        std::string list;
+        for (const auto& v : valid) list += (list.empty() ? "" : ", ") + v;
+        return "unknown planner \"" + name + "\" (planners: " + list + ")";
+      },
+      "PLANNER");
   fc->add_option("--planners", f->bench.planners,
                  "planners (default: rrtstar,informed,guided,miner and every ompl:* planner)")
-      ->delimiter(',');
+      ->delimiter(',')
+      ->check(planner_name);
   fc->add_option("--runs", f->bench.runs, "runs per planner")->check(kRunsRange)->capture_default_str();
   fc->add_option("--seed", f->bench.seed, "master seed (run k uses stream k)")->capture_default_str()->check(kUnsigned64);
   fc->add_option("--target-factor", f->bench.target_factor, "target cost = this x the A* reference cost")

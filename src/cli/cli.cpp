@@ -24,7 +24,12 @@ namespace {
 /// A finite decimal number (no hex, inf or nan, which strtod also reads): every floating-point
 /// option goes through it.
 bool read_finite_decimal(const std::string& text, double& v) {
-  return is_decimal_number(text) && CLI::detail::lexical_cast(text, v) && std::isfinite(v);
+  if (!(is_decimal_number(text) && CLI::detail::lexical_cast(text, v) && std::isfinite(v))) return false;
+  // A non-zero number too small for a double (1e-400 read as 0, 1e-310 as a subnormal) is
+  // refused, not rounded (issue 20: astar --radius 1e-400 became radius 0).
+  const std::string mantissa = text.substr(0, text.find_first_of("eE"));
+  const bool nonzero = mantissa.find_first_of("123456789") != std::string::npos;
+  return !(nonzero && (v == 0.0 || std::fpclassify(v) == FP_SUBNORMAL));
 }
 }  // namespace
 

@@ -199,6 +199,10 @@ TEST_CASE("Bad input: each case names what is wrong and exits non-zero", "[REQ-C
       {{"astar", "--map", map, "--start", "nan", "1", "1", "--goal", "1", "1", "1"}, 2, "must be a finite decimal number"},
       {{"astar", "--map", map, "--start", "1", "1", "--goal", "1", "1", "1"}, 2, "--start"},
       {{"astar", "--map", map, "--start", "1", "1", "1", "--goal", "2", "2", "2", "--radius", "-1"}, 2, "--radius: must be a finite decimal number in [0, 10], got -1"},
+      // Underflow is refused, not rounded to 0 (issue 20).
+      {{"astar", "--map", map, "--start", "1", "1", "1", "--goal", "2", "2", "2", "--radius", "1e-400"}, 2, "--radius: must be a finite decimal number in [0, 10], got 1e-400"},
+      // An unknown planner is a usage error naming every valid one (issue 20: exit 1, after parsing).
+      {{"bench", "frontend", "--map", map, "--planners", "rrtstar,foo"}, 2, "unknown planner \"foo\" (planners: rrtstar, informed, guided, miner, miner-sgan, ompl:"},
       {{"astar", "--map", map, "--start", "3.2", "5", "5", "--goal", "9", "9", "9", "--radius", "0.5"}, 1, "lies in an occupied grid cell"},
       {{"map", "gen", "--preset", "swamp", "--out", dir() + "/x.json"}, 1, "unknown map preset \"swamp\""},
       {{"map", "info", "--map", write("garbage.bt", "not an octree")}, 1, "not an OctoMap file"},
@@ -210,6 +214,8 @@ TEST_CASE("Bad input: each case names what is wrong and exits non-zero", "[REQ-C
     CHECK_THAT(r.err, Contains(c.message));
     CHECK_THAT(r.err, Contains("miner: "));
   }
+  // A zero written with a tiny exponent is still zero, not an underflow.
+  CHECK(miner_cli({"astar", "--map", map, "--start", "1", "1", "1", "--goal", "2", "2", "2", "--radius", "0e-400"}).code == 0);
 }
 
 TEST_CASE("An unreachable goal exits 3 with the reason", "[REQ-CLI-002][REQ-WORLD-010]") {

@@ -222,6 +222,11 @@ double JsonField::number_in(double lo, double hi, const std::string& unit) const
   return v;
 }
 
+double JsonField::number_in_or(const std::string& key, double fallback, double lo, double hi,
+                               const std::string& unit) const {
+  return has(key) ? at(key).number_in(lo, hi, unit) : fallback;
+}
+
 int JsonField::integer() const {
   const double v = number();
   if (std::floor(v) != v) fail("expected an integer, got " + value_->dump());

@@ -46,6 +46,10 @@ class JsonField {
   /// m, got 1e9"). Every physical value a file gives has a range (issue 20: a goal tolerance
   /// of 1e9 m made every flight "reach" its goal).
   double number_in(double lo, double hi, const std::string& unit = "") const;
+  /// Member `key` as number_in(lo, hi, unit), or `fallback` when the object has no such key
+  /// (an optional physical value: every file section's defaults).
+  double number_in_or(const std::string& key, double fallback, double lo, double hi,
+                      const std::string& unit = "") const;
   int integer() const;                  ///< an integral number
   std::string string() const;
   Eigen::Vector3d vec3() const;         ///< array of 3 finite numbers

@@ -19,68 +19,61 @@
 
 namespace miner::flight {
 
-const std::vector<std::string>& flight_log_columns() {
-  static const std::vector<std::string> columns = [] {
-    std::vector<std::string> c{"t"};
-    auto add3 = [&](const std::string& prefix, const char* a, const char* b, const char* d) {
-      c.push_back(prefix + a);
-      c.push_back(prefix + b);
-      c.push_back(prefix + d);
-    };
-    add3("ref_", "x", "y", "z");
-    add3("ref_", "vx", "vy", "vz");
-    add3("true_", "x", "y", "z");
-    add3("true_", "vx", "vy", "vz");
-    add3("true_", "roll", "pitch", "yaw");
-    add3("est_", "x", "y", "z");
-    add3("est_", "vx", "vy", "vz");
-    add3("est_", "roll", "pitch", "yaw");
-    add3("est_ba_", "x", "y", "z");
-    add3("est_bg_", "x", "y", "z");
-    add3("true_ba_", "x", "y", "z");
-    add3("true_bg_", "x", "y", "z");
-    for (const char* n : {"cmd_roll", "cmd_pitch", "cmd_thrust_pct", "cmd_yaw"}) c.emplace_back(n);
-    for (const char* n : {"rotor_0", "rotor_1", "rotor_2", "rotor_3"}) c.emplace_back(n);
-    c.emplace_back("failsafe");
-    c.emplace_back("collision");
+namespace {
+
+/// The flight log's layout: every column with its unit, declared together.
+struct LogLayout {
+  std::vector<std::string> names, units;
+  void add(std::string name, const char* unit) {
+    names.push_back(std::move(name));
+    units.emplace_back(unit);
+  }
+  void add3(const std::string& prefix, const char* a, const char* b, const char* c, const char* unit) {
+    for (const char* axis : {a, b, c}) add(prefix + axis, unit);
+  }
+};
+
+const LogLayout& log_layout() {
+  static const LogLayout layout = [] {
+    LogLayout l;
+    l.add("t", "s");
+    l.add3("ref_", "x", "y", "z", "m");
+    l.add3("ref_", "vx", "vy", "vz", "m/s");
+    l.add3("true_", "x", "y", "z", "m");
+    l.add3("true_", "vx", "vy", "vz", "m/s");
+    l.add3("true_", "roll", "pitch", "yaw", "rad");
+    l.add3("est_", "x", "y", "z", "m");
+    l.add3("est_", "vx", "vy", "vz", "m/s");
+    l.add3("est_", "roll", "pitch", "yaw", "rad");
+    l.add3("est_ba_", "x", "y", "z", "m/s^2");
+    l.add3("est_bg_", "x", "y", "z", "rad/s");
+    l.add3("true_ba_", "x", "y", "z", "m/s^2");
+    l.add3("true_bg_", "x", "y", "z", "rad/s");
+    l.add("cmd_roll", "rad");
+    l.add("cmd_pitch", "rad");
+    l.add("cmd_thrust_pct", "%");
+    l.add("cmd_yaw", "rad");
+    for (const char* n : {"rotor_0", "rotor_1", "rotor_2", "rotor_3"}) l.add(n, "rad/s");
+    l.add("failsafe", "0/1");
+    l.add("collision", "0/1");
     // Issue 23: the reference's yaw, the yaw-rate command, the EKF's position sigma, the
     // wind, the battery, saturation and the pose stream's losses.
-    c.emplace_back("ref_yaw");
-    c.emplace_back("cmd_yaw_rate");
-    add3("est_sigma_", "x", "y", "z");
-    add3("wind_", "x", "y", "z");
-    c.emplace_back("battery_v");
-    c.emplace_back("saturated");
-    c.emplace_back("pose_lost");
-    return c;
+    l.add("ref_yaw", "rad");
+    l.add("cmd_yaw_rate", "rad/s");
+    l.add3("est_sigma_", "x", "y", "z", "m");
+    l.add3("wind_", "x", "y", "z", "m/s");
+    l.add("battery_v", "V");
+    l.add("saturated", "0/1");
+    l.add("pose_lost", "0/1");
+    return l;
   }();
-  return columns;
+  return layout;
 }
 
-const std::vector<std::string>& flight_log_units() {
-  static const std::vector<std::string> units = [] {
-    std::vector<std::string> u;
-    for (const auto& name : flight_log_columns()) {
-      const auto starts = [&](const char* prefix) { return name.rfind(prefix, 0) == 0; };
-      const auto is_v = name.find("_v") != std::string::npos && name != "battery_v";
-      std::string unit;
-      if (name == "t") unit = "s";
-      else if (starts("est_ba_") || starts("true_ba_")) unit = "m/s^2";
-      else if (starts("est_bg_") || starts("true_bg_") || name == "cmd_yaw_rate") unit = "rad/s";
-      else if (starts("rotor_")) unit = "rad/s";
-      else if (name.find("roll") != std::string::npos || name.find("pitch") != std::string::npos ||
-               name.find("yaw") != std::string::npos) unit = "rad";
-      else if (name == "cmd_thrust_pct") unit = "%";
-      else if (starts("wind_") || is_v) unit = "m/s";
-      else if (name == "battery_v") unit = "V";
-      else if (name == "failsafe" || name == "collision" || name == "saturated" || name == "pose_lost") unit = "0/1";
-      else unit = "m";
-      u.push_back(unit);
-    }
-    return u;
-  }();
-  return units;
-}
+}  // namespace
+
+const std::vector<std::string>& flight_log_columns() { return log_layout().names; }
+const std::vector<std::string>& flight_log_units() { return log_layout().units; }
 
 namespace {
 
@@ -130,8 +123,7 @@ FlightResult fly(const FlightSetup& s, const ReferenceTrajectory& reference, con
   YawReference yaw_reference(s.yaw, 0.0);
   Eigen::Vector3d wind = Eigen::Vector3d::Zero();
   double wind_sq = 0.0;
-  bool battery_limited = false, control_saturated = false, speed_limited = false;
-  double yaw_rate_command = 0.0;
+  bool battery_limited = false;  // set by the N3 tick, read at the next control tick
   out.battery_min_voltage = s.battery.enabled ? battery.voltage() : 0.0;
 
   std::deque<std::pair<long, PoseMeasurement>> in_transit;
@@ -181,12 +173,10 @@ FlightResult fly(const FlightSetup& s, const ReferenceTrajectory& reference, con
       ref.a = trajectory.evaluate(t, 2);
       std::tie(ref.yaw, ref.yaw_rate) = yaw_reference.step(ref.v, control_dt);
       const ControlOutput control = controller.update(ref, flown_on, control_dt);
-      control_saturated = control.saturated;
-      speed_limited = control.speed_limited;
-      yaw_rate_command = (control.command.flag & n3::kYawRate) ? control.command.yaw : 0.0;
-      const bool saturated_now = control_saturated || battery_limited;
+      const double yaw_rate_command = (control.command.flag & n3::kYawRate) ? control.command.yaw : 0.0;
+      const bool saturated_now = control.saturated || battery_limited;
       if (saturated_now) out.saturation_time_s += control_dt;
-      if (speed_limited) out.speed_limited_time_s += control_dt;
+      if (control.speed_limited) out.speed_limited_time_s += control_dt;
       if (pose_source.lost()) out.pose_lost_time_s += control_dt;
       const bool silent = s.command_dropout && t >= s.command_dropout->first && t < s.command_dropout->second;
       if (!silent) {

@@ -12,11 +12,6 @@ namespace miner::flight {
 
 namespace {
 
-double optional_in(const JsonField& f, const char* key, double fallback, double lo, double hi, const char* unit) {
-  if (!f.has(key)) return fallback;
-  return f.at(key).number_in(lo, hi, unit);
-}
-
 /// Mean wind up to a strong gale and turbulence up to "severe" (MIL-F-8785C: sigma ~ 7 m/s at
 /// low altitude); a quadrotor of the N3 class cannot fly in either, but the model stays defined.
 constexpr double kMaxWindSpeed = 30.0;   // m/s
@@ -34,10 +29,10 @@ WindParams wind_params_from_json(const JsonField& f) {
     w.mean = f.at("mean_m_s").vec3();
     if (w.mean.norm() > kMaxWindSpeed) f.at("mean_m_s").fail("a mean wind above 30 m/s is beyond any multirotor");
   }
-  w.sigma_horizontal = optional_in(f, "sigma_horizontal_m_s", 0.0, 0.0, kMaxTurbulence, "m/s");
-  w.sigma_vertical = optional_in(f, "sigma_vertical_m_s", 0.0, 0.0, kMaxTurbulence, "m/s");
-  w.length_horizontal = optional_in(f, "length_horizontal_m", w.length_horizontal, 0.0, kMaxScaleLength, "m");
-  w.length_vertical = optional_in(f, "length_vertical_m", w.length_vertical, 0.0, kMaxScaleLength, "m");
+  w.sigma_horizontal = f.number_in_or("sigma_horizontal_m_s", 0.0, 0.0, kMaxTurbulence, "m/s");
+  w.sigma_vertical = f.number_in_or("sigma_vertical_m_s", 0.0, 0.0, kMaxTurbulence, "m/s");
+  w.length_horizontal = f.number_in_or("length_horizontal_m", w.length_horizontal, 0.0, kMaxScaleLength, "m");
+  w.length_vertical = f.number_in_or("length_vertical_m", w.length_vertical, 0.0, kMaxScaleLength, "m");
   if (!(w.length_horizontal > 0.0)) f.at("length_horizontal_m").fail("must be positive");
   if (!(w.length_vertical > 0.0)) f.at("length_vertical_m").fail("must be positive");
   if (f.has("gusts")) {
@@ -136,11 +131,11 @@ Eigen::Vector3d WindModel::step(double t, const Eigen::Vector3d& v) {
 MismatchParams mismatch_params_from_json(const JsonField& f) {
   f.only_keys({"mass", "inertia", "thrust_coefficient", "drag", "motor_time_constant"});
   MismatchParams m;
-  m.mass = optional_in(f, "mass", 1.0, kMinMismatch, kMaxMismatch, "x nominal");
-  m.inertia = optional_in(f, "inertia", 1.0, kMinMismatch, kMaxMismatch, "x nominal");
-  m.thrust_coefficient = optional_in(f, "thrust_coefficient", 1.0, kMinMismatch, kMaxMismatch, "x nominal");
-  m.drag = optional_in(f, "drag", 1.0, kMinMismatch, kMaxMismatch, "x nominal");
-  m.motor_time_constant = optional_in(f, "motor_time_constant", 1.0, kMinMismatch, kMaxMismatch, "x nominal");
+  m.mass = f.number_in_or("mass", 1.0, kMinMismatch, kMaxMismatch, "x nominal");
+  m.inertia = f.number_in_or("inertia", 1.0, kMinMismatch, kMaxMismatch, "x nominal");
+  m.thrust_coefficient = f.number_in_or("thrust_coefficient", 1.0, kMinMismatch, kMaxMismatch, "x nominal");
+  m.drag = f.number_in_or("drag", 1.0, kMinMismatch, kMaxMismatch, "x nominal");
+  m.motor_time_constant = f.number_in_or("motor_time_constant", 1.0, kMinMismatch, kMaxMismatch, "x nominal");
   return m;
 }
 
@@ -171,12 +166,12 @@ BatteryParams battery_params_from_json(const JsonField& f) {
                "initial_charge"});
   BatteryParams b;
   b.enabled = true;
-  b.full_voltage = optional_in(f, "full_voltage_v", b.full_voltage, 0.0, 1000.0, "V");
-  b.empty_voltage = optional_in(f, "empty_voltage_v", b.empty_voltage, 0.0, 1000.0, "V");
-  b.capacity_wh = optional_in(f, "capacity_wh", b.capacity_wh, 0.0, 1e5, "Wh");
-  b.internal_resistance = optional_in(f, "internal_resistance_ohm", b.internal_resistance, 0.0, 10.0, "ohm");
-  b.efficiency = optional_in(f, "efficiency", b.efficiency, 0.0, 1.0, "");
-  b.initial_charge = optional_in(f, "initial_charge", b.initial_charge, 0.0, 1.0, "");
+  b.full_voltage = f.number_in_or("full_voltage_v", b.full_voltage, 0.0, 1000.0, "V");
+  b.empty_voltage = f.number_in_or("empty_voltage_v", b.empty_voltage, 0.0, 1000.0, "V");
+  b.capacity_wh = f.number_in_or("capacity_wh", b.capacity_wh, 0.0, 1e5, "Wh");
+  b.internal_resistance = f.number_in_or("internal_resistance_ohm", b.internal_resistance, 0.0, 10.0, "ohm");
+  b.efficiency = f.number_in_or("efficiency", b.efficiency, 0.0, 1.0, "");
+  b.initial_charge = f.number_in_or("initial_charge", b.initial_charge, 0.0, 1.0, "");
   if (!(b.empty_voltage > 0.0) || !(b.full_voltage > b.empty_voltage))
     f.fail("needs 0 < empty_voltage_v < full_voltage_v, got " + std::to_string(b.empty_voltage) + " and " +
            std::to_string(b.full_voltage));

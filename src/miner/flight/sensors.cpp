@@ -88,25 +88,19 @@ std::optional<PoseSource::Delivery> PoseSource::measure(double stamp, const Eige
   return d;
 }
 
-namespace {
-/// An optional value in [0, hi] `unit` (issue 20: an accelerometer noise of 1e300 and a pose
-/// delay of 1e6 s were accepted and flown).
-double optional_non_negative(const JsonField& f, const char* key, double fallback, double hi, const char* unit) {
-  if (!f.has(key)) return fallback;
-  return f.at(key).number_in(0.0, hi, unit);
-}
-}  // namespace
+// Every value has a range [0, hi] (issue 20: an accelerometer noise of 1e300 and a pose delay of
+// 1e6 s were accepted and flown).
 
 ImuParams imu_params_from_json(const JsonField& f) {
   f.only_keys({"accel_noise_density", "gyro_noise_density", "accel_bias_random_walk", "gyro_bias_random_walk",
                "accel_bias_initial", "gyro_bias_initial"});
   ImuParams p;
-  p.accel_noise_density = optional_non_negative(f, "accel_noise_density", p.accel_noise_density, 1.0, "m/s^2/sqrt(Hz)");
-  p.gyro_noise_density = optional_non_negative(f, "gyro_noise_density", p.gyro_noise_density, 1.0, "rad/s/sqrt(Hz)");
-  p.accel_bias_random_walk = optional_non_negative(f, "accel_bias_random_walk", p.accel_bias_random_walk, 1.0, "m/s^3/sqrt(Hz)");
-  p.gyro_bias_random_walk = optional_non_negative(f, "gyro_bias_random_walk", p.gyro_bias_random_walk, 1.0, "rad/s^2/sqrt(Hz)");
-  p.accel_bias_initial = optional_non_negative(f, "accel_bias_initial", p.accel_bias_initial, 10.0, "m/s^2");
-  p.gyro_bias_initial = optional_non_negative(f, "gyro_bias_initial", p.gyro_bias_initial, 1.0, "rad/s");
+  p.accel_noise_density = f.number_in_or("accel_noise_density", p.accel_noise_density, 0.0, 1.0, "m/s^2/sqrt(Hz)");
+  p.gyro_noise_density = f.number_in_or("gyro_noise_density", p.gyro_noise_density, 0.0, 1.0, "rad/s/sqrt(Hz)");
+  p.accel_bias_random_walk = f.number_in_or("accel_bias_random_walk", p.accel_bias_random_walk, 0.0, 1.0, "m/s^3/sqrt(Hz)");
+  p.gyro_bias_random_walk = f.number_in_or("gyro_bias_random_walk", p.gyro_bias_random_walk, 0.0, 1.0, "rad/s^2/sqrt(Hz)");
+  p.accel_bias_initial = f.number_in_or("accel_bias_initial", p.accel_bias_initial, 0.0, 10.0, "m/s^2");
+  p.gyro_bias_initial = f.number_in_or("gyro_bias_initial", p.gyro_bias_initial, 0.0, 1.0, "rad/s");
   return p;
 }
 
@@ -118,17 +112,17 @@ PoseParams pose_params_from_json(const JsonField& f) {
     p.rate_hz = f.at("rate_hz").number_in(0.0, 10000.0, "Hz");
     if (!(p.rate_hz > 0.0)) f.at("rate_hz").fail("must be positive");
   }
-  p.delay_s = optional_non_negative(f, "delay_s", p.delay_s, 1.0, "s");
-  p.position_sigma = optional_non_negative(f, "position_sigma", p.position_sigma, 10.0, "m");
-  p.attitude_sigma = optional_non_negative(f, "attitude_sigma", p.attitude_sigma, 1.0, "rad");
-  p.outlier_probability = optional_non_negative(f, "outlier_probability", p.outlier_probability, 1.0, "");
-  p.outlier_magnitude = optional_non_negative(f, "outlier_magnitude", p.outlier_magnitude, 100.0, "m");
+  p.delay_s = f.number_in_or("delay_s", p.delay_s, 0.0, 1.0, "s");
+  p.position_sigma = f.number_in_or("position_sigma", p.position_sigma, 0.0, 10.0, "m");
+  p.attitude_sigma = f.number_in_or("attitude_sigma", p.attitude_sigma, 0.0, 1.0, "rad");
+  p.outlier_probability = f.number_in_or("outlier_probability", p.outlier_probability, 0.0, 1.0, "");
+  p.outlier_magnitude = f.number_in_or("outlier_magnitude", p.outlier_magnitude, 0.0, 100.0, "m");
   if (p.outlier_probability > 1.0) f.at("outlier_probability").fail("must be in [0, 1]");
-  p.drift_random_walk = optional_non_negative(f, "drift_random_walk", 0.0, 10.0, "m/sqrt(s)");
-  p.yaw_drift_random_walk = optional_non_negative(f, "yaw_drift_random_walk", 0.0, 1.0, "rad/sqrt(s)");
-  p.delay_jitter_s = optional_non_negative(f, "delay_jitter_s", 0.0, 1.0, "s");
-  p.dropout_rate_hz = optional_non_negative(f, "dropout_rate_hz", 0.0, 100.0, "Hz");
-  p.dropout_mean_s = optional_non_negative(f, "dropout_mean_s", 0.0, 100.0, "s");
+  p.drift_random_walk = f.number_in_or("drift_random_walk", 0.0, 0.0, 10.0, "m/sqrt(s)");
+  p.yaw_drift_random_walk = f.number_in_or("yaw_drift_random_walk", 0.0, 0.0, 1.0, "rad/sqrt(s)");
+  p.delay_jitter_s = f.number_in_or("delay_jitter_s", 0.0, 0.0, 1.0, "s");
+  p.dropout_rate_hz = f.number_in_or("dropout_rate_hz", 0.0, 0.0, 100.0, "Hz");
+  p.dropout_mean_s = f.number_in_or("dropout_mean_s", 0.0, 0.0, 100.0, "s");
   if (p.dropout_rate_hz > 0.0 && !(p.dropout_mean_s > 0.0))
     f.at("dropout_rate_hz").fail("needs a positive dropout_mean_s (how long a loss lasts)");
   if (p.delay_s + p.delay_jitter_s > 1.0) f.at("delay_jitter_s").fail("delay_s + delay_jitter_s must be at most 1 s");

@@ -42,6 +42,14 @@ std::vector<std::string> default_frontend_planners() {
   return names;
 }
 
+std::string unknown_planner(const std::string& name) {
+  const std::vector<std::string> valid = default_frontend_planners();
+  if (std::find(valid.begin(), valid.end(), name) != valid.end()) return {};
+  std::string list;
+  for (const auto& v : valid) list += (list.empty() ? "" : ", ") + v;
+  return "unknown planner \"" + name + "\" (planners: " + list + ")";
+}
+
 PlannerSummary summarise(const std::string& planner, const std::vector<RunRecord>& runs) {
   PlannerSummary s;
   s.planner = planner;
@@ -185,13 +193,7 @@ FrontendBenchResult run_frontend_bench(const world::Map& map, const std::string&
   std::vector<Entry> entries;
   for (const std::string& name : out.options.planners) {
     const bool ompl = is_ompl_planner(name);
-    // Every valid name in the message, ours and OMPL's (issue 20: it used to list 4 of 11).
-    const std::vector<std::string> valid = frontend_planner_names();
-    if (std::find(valid.begin(), valid.end(), name) == valid.end()) {
-      std::string list;
-      for (const auto& v : valid) list += (list.empty() ? "" : ", ") + v;
-      throw Error("unknown planner \"" + name + "\" (planners: " + list + ")");
-    }
+    if (const std::string why = unknown_planner(name); !why.empty()) throw Error(why);
     const bool sgan_planner = name == kMinerSgan;
     const plan::PlannerKind kind =
         ompl ? plan::PlannerKind::kRrtStar : sgan_planner ? plan::PlannerKind::kMiner : plan::planner_from_name(name);
@@ -347,12 +349,6 @@ RunRecord run_from(const nlohmann::json& j) {
 
 }  // namespace
 
-std::vector<std::string> frontend_planner_names() {
-  std::vector<std::string> names{"rrtstar", "informed", "guided", "miner", kMinerSgan};
-  for (const auto& n : ompl_planner_names()) names.push_back(n);
-  return names;
-}
-
 nlohmann::json to_json(const FrontendBenchResult& r) {
   nlohmann::json planners = nlohmann::json::array();
   for (const PlannerSummary& s : r.summaries) planners.push_back(summary_json(s));
@@ -402,7 +398,7 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
     root.only_keys({"map", "start", "goal", "robot_radius", "runs", "seed", "reference_cost", "target_factor",
                     "target_cost", "lower_bound", "steer_step", "goal_radius", "max_iterations", "time_limit_s",
                     "safeguard", "region", "throughput", "total_s", "shard", "planners", "run_records"});
-    for (const char* k : {"map", "runs", "seed", "lower_bound", "max_iterations"}) (void)root.at(k);
+    for (const char* k : {"runs", "seed"}) (void)root.at(k);
     const JsonField shard = root.at("shard");
     (void)shard.at("index").integer();
     (void)shard.at("count").integer();
@@ -411,6 +407,8 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
     for (const char* k : {"throughput", "region"}) (void)root.at(k);
     const JsonField planners = root.at("planners");
     for (std::size_t i = 0; i < planners.array_size(); ++i) (void)planners.at(i).at("planner").string();
+    const double lower = root.at("lower_bound").number(), budget = root.at("max_iterations").number();
+    constexpr double kRoundoff = 1e-9;  // relative: the bound and the costs are sums of lengths
     const JsonField records = root.at("run_records");
     for (std::size_t k = 0; k < records.array_size(); ++k) {
       const JsonField r = records.at(k);
@@ -420,8 +418,6 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
       // A cost is a path length: finite and >= 0 (issue 20: a cost of -5 was averaged in), never
       // below the campaign's lower bound (the straight line), never above the run's own first
       // solution (costs only fall); a run stops within the iteration budget.
-      const double lower = root.at("lower_bound").number();
-      constexpr double kRoundoff = 1e-9;  // relative: the bound and the costs are sums of lengths
       if (r.has("cost") && r.at("cost").value().is_number()) {
         const double cost = r.at("cost").number();
         if (!(cost >= 0.0)) r.at("cost").fail("a path cost must be >= 0");
@@ -434,7 +430,7 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
                             r.at("first").at("cost").value().dump() + " (costs only fall)");
       }
       if (r.has("iterations") && r.at("iterations").value().is_number() &&
-          r.at("iterations").number() > root.at("max_iterations").number())
+          r.at("iterations").number() > budget)
         r.at("iterations").fail("ran " + r.at("iterations").value().dump() + " iterations, more than the campaign's budget " +
                                 root.at("max_iterations").value().dump());
       try {

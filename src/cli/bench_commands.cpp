@@ -94,15 +94,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
       "frontend", "Monte Carlo front-end campaign like the paper's Table I, with OMPL's planners beside ours");
   add_query_options(fc, f->query);
   // An unknown name is a usage error (exit 2) naming every valid one (issue 20: it failed later, exit 1).
-  const CLI::Validator planner_name(
-      [](std::string& name) -> std::string {
-        const auto valid = bench::frontend_planner_names();
-        if (std::find(valid.begin(), valid.end(), name) != valid.end()) return {};
-        std::string list;
-        for (const auto& v : valid) list += (list.empty() ? "" : ", ") + v;
-        return "unknown planner \"" + name + "\" (planners: " + list + ")";
-      },
-      "PLANNER");
+  const CLI::Validator planner_name([](std::string& name) { return bench::unknown_planner(name); }, "PLANNER");
   fc->add_option("--planners", f->bench.planners,
                  "planners (default: rrtstar,informed,guided,miner and every ompl:* planner)")
       ->delimiter(',')

@@ -6,6 +6,7 @@
 #include <map>
 
 #include "miner/core/error.hpp"
+#include "miner/core/units.hpp"
 #include "miner/report/svg_plot.hpp"
 
 namespace miner::report {
@@ -72,7 +73,7 @@ std::string fixed(double v, int digits) {
   return buf;
 }
 
-constexpr double kDeg = 180.0 / 3.14159265358979323846;
+constexpr double kDeg = rad2deg(1.0);  // degrees per radian (core/units.hpp)
 
 /// The thinned log as named columns: lookups that tolerate an absent column.
 struct Log {

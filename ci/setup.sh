@@ -21,13 +21,14 @@ PACKAGES=(
   libcli11-dev         # the `miner` command line
   # benchmark peers
   libompl-dev ompl-demos libboost-filesystem-dev libboost-system-dev libboost-serialization-dev
-  libboost-dev         # Boost.Math: chi-square quantiles (EKF gate, NEES/NIS tests)
+  libboost-dev         # Boost.Math: chi-square quantiles (EKF gate, NEES/NIS tests); Boost.Multiprecision: exact waypoint misses (traj properties)
   # verification
   catch2               # unit tests (Catch2 v2)
   librapidcheck-dev    # property tests
   gcovr                # coverage reports and thresholds
   clang-16 libclang-rt-16-dev libfuzzer-16-dev libomp-16-dev   # libFuzzer targets (ci/fuzz.sh; omp.h for sgan.cpp)
   python3              # traceability checker
+  python3-mpmath       # docs/figures/answer_check.sh: the exact optimum of refused trajectory problems
   pybind11-dev python3-dev python3-pytest   # the Python bindings (`import miner`, src/python) and their tests
   # learned heuristic
   libdnnl-dev          # oneDNN: the sGAN's 3D convolutions in C++ (~20x LibTorch's default CPU path)

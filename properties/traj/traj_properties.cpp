@@ -2,11 +2,19 @@
 // with independent solvers (dense pivoted LU of A c = b, and Ceres minimising the
 // effort by quadrature), gradients against finite differences, the time-scaling law,
 // and the trapezoidal allocation. Random problems are built from a generated seed.
-#include <catch2/catch.hpp>
-
 #include <cmath>
 
+// Boost.Multiprecision's rationals (the exact waypoint miss): GCC's -Wmaybe-uninitialized
+// misreads a static zero inside cpp_int (a false positive of the optimiser in a system header).
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#include <boost/multiprecision/cpp_int.hpp>
+#pragma GCC diagnostic pop
 #include <ceres/ceres.h>
+// Ceres brings glog, whose CHECK aborts the process; Catch's CHECK (a counted, reported
+// assertion that lets the test go on) must be the one this file uses.
+#undef CHECK
+#include <catch2/catch.hpp>
 #include <Eigen/LU>
 
 #include "miner/core/error.hpp"
@@ -341,17 +349,25 @@ MincoProblem spread_problem(std::uint64_t seed, double spread) {
   }
   return p;
 }
-/// Position of segment i at local time t in long double (Horner), from the answer's
-/// coefficients: an evaluation independent of the check's own.
-Eigen::Vector3d position_long_double(const PolynomialTrajectory& t, int i, double tau) {
-  const auto c = t.segment_coefficients(i);
-  Eigen::Vector3d out;
-  for (int a = 0; a < 3; ++a) {
-    long double v = 0.0L;
-    for (Eigen::Index j = c.rows() - 1; j >= 0; --j) v = v * static_cast<long double>(tau) + c(j, a);
-    out[a] = static_cast<double>(v);
+/// The exact largest distance (max norm, over the axes and both ends of every segment) of the
+/// answer's segment ends from their waypoints, relative to L: the stored doubles evaluated in
+/// rational arithmetic (Boost.Multiprecision), independent of the check's compensated Horner.
+double exact_waypoint_miss(const MincoProblem& p, const PolynomialTrajectory& t) {
+  using Q = boost::multiprecision::cpp_rational;
+  const double L = std::max(p.points.cwiseAbs().maxCoeff(),
+                            (p.points.colwise().maxCoeff() - p.points.colwise().minCoeff()).maxCoeff());
+  Q worst = 0;
+  for (int i = 0; i < t.segments(); ++i) {
+    const auto c = t.segment_coefficients(i);
+    const Q T = Q(p.durations[static_cast<std::size_t>(i)]);
+    for (int a = 0; a < 3; ++a) {
+      Q end = 0;
+      for (Eigen::Index j = c.rows() - 1; j >= 0; --j) end = end * T + Q(c(j, a));
+      const Q start_miss = abs(Q(c(0, a)) - Q(p.points(i, a))), end_miss = abs(end - Q(p.points(i + 1, a)));
+      worst = std::max(worst, std::max(start_miss, end_miss));
+    }
   }
-  return out;
+  return static_cast<double>(worst) / L;
 }
 }  // namespace
 
@@ -365,41 +381,68 @@ TEST_CASE("Durations spread over 1e3: an answer meets its waypoints to 1e-9 or i
       RC_ASSERT(std::string(e.what()).find("cannot be trusted") != std::string::npos);
       return;  // refused, naming the cause
     }
-    const double L = std::max(p.points.cwiseAbs().maxCoeff(),
-                              (p.points.colwise().maxCoeff() - p.points.colwise().minCoeff()).maxCoeff());
-    for (int i = 0; i < t.segments(); ++i) {
-      RC_ASSERT((position_long_double(t, i, 0.0) - p.points.row(i).transpose()).cwiseAbs().maxCoeff() <= 1e-9 * L);
-      RC_ASSERT((position_long_double(t, i, p.durations[static_cast<std::size_t>(i)]) -
-                 p.points.row(i + 1).transpose()).cwiseAbs().maxCoeff() <= 1e-9 * L);
-    }
+    RC_ASSERT(exact_waypoint_miss(p, t) <= kAnswerInterpolation);
     const auto c = measure_answer(p, t);
     RC_ASSERT(c.constraint <= kAnswerConstraint);
     RC_ASSERT(c.optimality <= kAnswerOptimality);
   });
 }
 
-TEST_CASE("Durations spread over 1e3: the check refuses the answers that miss, not the others", "[REQ-TRAJ-010]") {
-  // 200 fixed problems: measured 47 % accepted (docs/traj.md); a check that refused
-  // everything, or accepted everything, fails here.
-  int accepted = 0, refused = 0, missed_but_accepted = 0;
+TEST_CASE("Durations spread over 1e3: the check refuses exactly the answers that miss", "[REQ-TRAJ-010]") {
+  // The solver's raw answers (no polish), 200 fixed problems: about half of them miss a
+  // waypoint by more than 1e-9 L (docs/traj.md). Judged against the exact miss: every answer
+  // the check accepts meets the bound, every answer that misses it is refused, and every
+  // answer within half the bound is accepted (the compensated evaluation is tight; a check
+  // that refused everything, or accepted everything, fails here).
+  int accepted = 0, missed = 0;
   for (std::uint64_t seed = 0; seed < 200; ++seed) {
     const MincoProblem p = spread_problem(seed, 1e3);
-    MincoSolver solver;
     PolynomialTrajectory t;
-    solver.solve(p, t);
+    MincoSolver().solve(p, t);
+    const double exact = exact_waypoint_miss(p, t);
     const auto c = measure_answer(p, t);
+    INFO("seed " << seed << ": exact miss " << exact << " L, check's bound " << c.interpolation << " L");
+    CHECK(c.interpolation >= exact);                   // an upper bound ...
+    CHECK(c.interpolation <= exact + 1e-20);           // ... and a tight one
     bool ok = true;
     try {
       check_answer(p, t);
     } catch (const miner::Error&) {
       ok = false;
     }
-    (ok ? accepted : refused) += 1;
-    if (ok && c.interpolation > kAnswerInterpolation) ++missed_but_accepted;
+    if (exact > kAnswerInterpolation) CHECK_FALSE(ok);
+    if (exact <= 0.5 * kAnswerInterpolation && c.constraint <= kAnswerConstraint && c.optimality <= kAnswerOptimality)
+      CHECK(ok);
+    accepted += ok;
+    missed += exact > kAnswerInterpolation;
   }
-  CHECK(missed_but_accepted == 0);
+  CHECK(missed >= 40);  // the raw solve misses often enough for the check to be exercised
   CHECK(accepted >= 60);
-  CHECK(refused >= 20);
+}
+
+TEST_CASE("Durations spread over 1e3: the waypoint polish meets the waypoints the raw solve misses", "[REQ-TRAJ-010]") {
+  // Same 200 problems. The polish never moves an end away from its waypoint, never moves a
+  // constraint residual by more than its damage bound (two passes), keeps the optimality
+  // conditions, and brings most raw misses under the bound (measured: 103 raw answers
+  // within 1e-9 L, 192 polished).
+  int raw_within = 0, polished_within = 0;
+  for (std::uint64_t seed = 0; seed < 200; ++seed) {
+    const MincoProblem p = spread_problem(seed, 1e3);
+    PolynomialTrajectory raw;
+    MincoSolver().solve(p, raw);
+    PolynomialTrajectory polished = raw;
+    polish_waypoints(p, polished);
+    const double before = exact_waypoint_miss(p, raw), after = exact_waypoint_miss(p, polished);
+    const auto c0 = measure_answer(p, raw), c1 = measure_answer(p, polished);
+    INFO("seed " << seed << ": exact miss " << before << " -> " << after << " L");
+    CHECK(after <= before);
+    CHECK(c1.constraint <= c0.constraint + 4.0 * kPolishDamage);
+    CHECK(c1.optimality <= c0.optimality + 4.0 * kPolishDamage);
+    raw_within += before <= kAnswerInterpolation;
+    polished_within += after <= kAnswerInterpolation;
+  }
+  CHECK(polished_within >= 180);
+  CHECK(polished_within >= raw_within + 60);
 }
 
 TEST_CASE("Analytic gradients of the optimal cost match central differences", "[REQ-TRAJ-005]") {

@@ -374,7 +374,106 @@ std::string sci(double v) {
   return os.str();
 }
 
+// Error-free transformations in long double (Knuth's TwoSum; Dekker's TwoProduct with
+// Veltkamp's split, 2^32 + 1 for the 64-bit significand): a + b = sum + err and
+// a b = product + err exactly, barring overflow.
+using ld = long double;
+void two_sum(ld a, ld b, ld& sum, ld& err) {
+  sum = a + b;
+  const ld z = sum - a;
+  err = (a - (sum - z)) + (b - z);
+}
+void split(ld a, ld& hi, ld& lo) {
+  const ld c = 4294967297.0L * a;  // 2^32 + 1
+  hi = c - (c - a);
+  lo = a - hi;
+}
+void two_product(ld a, ld b, ld& product, ld& err) {
+  product = a * b;
+  ld ah, al, bh, bl;
+  split(a, ah, al);
+  split(b, bh, bl);
+  err = ((ah * bh - product) + ah * bl + al * bh) + al * bl;
+}
+
+/// q(T) - target for q = sum_j c_j T^j (one axis of one segment's coefficients), by the
+/// compensated Horner scheme (Graillat, Langlois, Louvet, "Compensated Horner scheme", 2005):
+/// as accurate as Horner's rule in twice long double's precision,
+///   |value - exact| <= u |exact| + gamma_2n^2 sum_j |c_j| T^j,  gamma_k = k u / (1 - k u),
+/// u = 2^-64, n the degree. `bound` returns that right-hand side (with |value| for |exact|,
+/// doubled for the rounding of the bound itself): an upper bound on the exact difference is
+/// |value| + bound. Used where the miss must be known far below double's rounding of the
+/// terms: an optimum that swings 1e10 L between waypoints still meets them to ~1e-30 L.
+struct Compensated {
+  ld value;
+  ld bound;
+};
+template <class Column>
+Compensated compensated_miss(const Column& c, int N, double T, double target) {
+  const ld t = T;
+  ld s = c(N - 1), corr = 0.0L, terms = std::abs(static_cast<ld>(c(N - 1)));
+  for (int j = N - 2; j >= 0; --j) {
+    ld p, pi, sigma;
+    two_product(s, t, p, pi);
+    ld a = c(j), a_err = 0.0L;
+    if (j == 0) two_sum(a, -static_cast<ld>(target), a, a_err);  // c_0 - target, exactly as a + a_err
+    two_sum(p, a, s, sigma);
+    corr = corr * t + (pi + sigma + a_err);
+    terms = terms * t + std::abs(static_cast<ld>(c(j)));
+  }
+  terms += std::abs(static_cast<ld>(target));
+  const ld u = std::numeric_limits<ld>::epsilon() / 2.0L;
+  const ld gamma = 2.0L * (N - 1) * u / (1.0L - 2.0L * (N - 1) * u);
+  const ld value = s + corr;
+  return {value, 2.0L * (u * std::abs(value) + gamma * gamma * terms)};
+}
+
 }  // namespace
+
+void polish_waypoints(const MincoProblem& p, PolynomialTrajectory& tr) {
+  constexpr int kMaxN = 8;  // s <= 4 (validate())
+  const int s = p.order, N = 2 * s, M = tr.segments();
+  if (N > kMaxN || M != static_cast<int>(p.durations.size()) || tr.coefficients().rows() != N * M || !tr.coefficients().allFinite())
+    return;  // nothing to polish; check_answer names the fault
+  Eigen::MatrixX3d& C = tr.mutable_coefficients();
+  for (int i = 0; i < M; ++i) {
+    const double T = p.durations[static_cast<std::size_t>(i)];
+    for (int ax = 0; ax < 3; ++ax) {
+      auto c = C.col(ax).segment(N * i, N);
+      const double target = p.points(i + 1, ax);
+      for (int pass = 0; pass < 2; ++pass) {
+        const Compensated miss = compensated_miss(c, N, T, target);
+        if (miss.value == 0.0L) break;
+        // T^k S_ik of check_answer (the scale each continuity residual is measured against,
+        // with the solve's rounding floor S_i0), and |c_j| T^j.
+        ld tp[kMaxN], term[kMaxN], scaled[kMaxN];
+        tp[0] = 1.0L;
+        for (int j = 1; j < N; ++j) tp[j] = tp[j - 1] * T;
+        for (int j = 0; j < N; ++j) term[j] = std::abs(static_cast<ld>(c(j))) * tp[j];
+        for (int k = 0; k < N; ++k) {
+          ld sum = 0.0L;
+          for (int j = k; j < N; ++j) sum += term[j] * falling_factorial(j, k);
+          scaled[k] = k == 0 ? sum : std::max(sum, scaled[0]);
+        }
+        const ld r = -miss.value;
+        int best = -1;
+        for (int j = 1; j < N; ++j) {
+          ld damage = 0.0L;
+          for (int k = 1; k <= std::min(j, 2 * s - 2); ++k)
+            damage = std::max(damage, std::abs(r) * falling_factorial(j, k) / scaled[k]);
+          if (damage <= kPolishDamage && (best < 0 || term[j] < term[best])) best = j;
+        }
+        if (best < 0) break;
+        const double before = c(best);
+        c(best) = static_cast<double>(static_cast<ld>(c(best)) + r / tp[best]);
+        if (std::abs(compensated_miss(c, N, T, target).value) >= std::abs(miss.value)) {
+          c(best) = before;  // no gain: keep the solve's coefficient
+          break;
+        }
+      }
+    }
+  }
+}
 
 AnswerCheck measure_answer(const MincoProblem& p, const PolynomialTrajectory& tr) {
   AnswerCheck out;
@@ -423,20 +522,18 @@ AnswerCheck measure_answer(const MincoProblem& p, const PolynomialTrajectory& tr
     const Eigen::Vector3d a = p.points.row(i).transpose(), b = p.points.row(i + 1).transpose();
     const Eigen::Vector3d ea = tr.evaluate_segment(i, 0.0) - a, eb = tr.evaluate_segment(i, p.durations[i]) - b;
     out.constraint = std::max({out.constraint, residual(ea, scale(i, 0)), residual(eb, scale(i, 0))});
-    // An upper bound on the exact miss of the coefficients as stored: the miss evaluated by
-    // Horner's rule in long double plus the bound on its rounding, 2N eps_ld of the terms'
-    // size (Higham, Accuracy and Stability, 5.1); in double that bound alone would be ~1e-13 S.
+    // An upper bound on the exact miss of the coefficients as stored: the end by the
+    // compensated Horner scheme plus its error bound (compensated_miss), the start exactly
+    // (c_0 - p_i as the sum of two long doubles).
     const auto c = tr.segment_coefficients(i);
-    const long double T = p.durations[static_cast<std::size_t>(i)];
-    long double miss_ld = 0.0L;
+    ld miss_ld = 0.0L;
     for (int ax = 0; ax < 3; ++ax) {
-      long double end = 0.0L;
-      for (int j = N - 1; j >= 0; --j) end = end * T + static_cast<long double>(c(j, ax));
-      miss_ld = std::max({miss_ld, std::abs(static_cast<long double>(c(0, ax)) - static_cast<long double>(p.points(i, ax))),
-                          std::abs(end - static_cast<long double>(p.points(i + 1, ax)))});
+      ld d, e;
+      two_sum(c(0, ax), -static_cast<ld>(p.points(i, ax)), d, e);
+      const Compensated end = compensated_miss(c.col(ax), N, p.durations[static_cast<std::size_t>(i)], p.points(i + 1, ax));
+      miss_ld = std::max({miss_ld, std::abs(d) + std::abs(e), std::abs(end.value) + end.bound});
     }
-    const double horner = 2.0 * N * static_cast<double>(std::numeric_limits<long double>::epsilon()) * scale(i, 0);
-    const double miss = (static_cast<double>(miss_ld) + horner) / out.position_scale;
+    const double miss = static_cast<double>(miss_ld) / out.position_scale;
     if (out.worst_segment < 0 || miss > out.interpolation) {
       out.interpolation = miss;
       out.worst_segment = i;
@@ -491,6 +588,7 @@ PolynomialTrajectory solve_minco(const MincoProblem& problem) {
   validate(problem);
   PolynomialTrajectory out;
   MincoSolver().solve(problem, out);
+  polish_waypoints(problem, out);
   check_answer(problem, out);
   return out;
 }

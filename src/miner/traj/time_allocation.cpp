@@ -273,6 +273,7 @@ AllocationResult optimise_allocation(const MincoProblem& problem, const Allocati
   AllocationResult r;
   r.durations = best.problem.durations;
   r.trajectory = best.trajectory;
+  polish_waypoints(best.problem, r.trajectory);
   check_answer(best.problem, r.trajectory);
   r.objective = best.F;
   r.cost = best.J;

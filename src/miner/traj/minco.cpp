@@ -56,16 +56,37 @@ using SegmentMatrix = Eigen::Matrix<double, 2 * S, 2 * S>;
 
 /// Q(T)_{ab} = K_ab T^{1 - 2S + k(a) + k(b)}, k(r) = r mod S (derivative order of row r),
 /// i.e. Q = T^{1-2S} (d d^T) o K with d_r = T^{k(r)}.
+/// d_r = T^{k(r)} (k(r) = r mod S) and the factor T^{1-2S}: Q(T) = T^{1-2S} (d d^T) o K.
 template <int S>
-void segment_cost_matrix(double T, SegmentMatrix<S>& Q) {
-  const auto& K = UnitHermite<S>::get().K;
-  Eigen::Matrix<double, 2 * S, 1> d;
+double cost_scaling(double T, Eigen::Matrix<double, 2 * S, 1>& d) {
   d[0] = d[S] = 1.0;
   for (int k = 1; k < S; ++k) d[k] = d[S + k] = d[k - 1] * T;
   const double inv = 1.0 / T;
   double scale = inv;  // T^{1-2S}
   for (int k = 1; k < 2 * S - 1; ++k) scale *= inv;
+  return scale;
+}
+
+template <int S>
+void segment_cost_matrix(double T, SegmentMatrix<S>& Q) {
+  const auto& K = UnitHermite<S>::get().K;
+  Eigen::Matrix<double, 2 * S, 1> d;
+  const double scale = cost_scaling<S>(T, d);
   Q.noalias() = (scale * d * d.transpose()).cwiseProduct(K);
+}
+
+/// The columns of Q(T) the reduced system reads: those of the free derivatives 1..S-1 at
+/// either end (rows 0 and S, the positions, are read through the symmetry Q_ab = Q_ba, exact
+/// since d_0 = d_S = 1); each entry rounded as segment_cost_matrix rounds it.
+template <int S>
+void segment_cost_columns(double T, SegmentMatrix<S>& Q) {
+  const auto& K = UnitHermite<S>::get().K;
+  Eigen::Matrix<double, 2 * S, 1> d;
+  const Eigen::Matrix<double, 2 * S, 1> sd = cost_scaling<S>(T, d) * d;
+  for (int k = 1; k < S; ++k) {
+    Q.col(k) = (sd * d[k]).cwiseProduct(K.col(k));
+    Q.col(S + k) = (sd * d[S + k]).cwiseProduct(K.col(S + k));
+  }
 }
 
 /// dQ/dT: exponent times Q / T.
@@ -95,13 +116,18 @@ Eigen::Matrix<double, F, F> small_cholesky(const Eigen::Matrix<double, F, F>& A)
   return L;
 }
 
-/// X <- (L L^T)^{-1} X by forward and back substitution.
+/// X <- L^{-1} X (forward substitution; L's diagonal stored inverted).
 template <int F, int C>
-void small_cholesky_solve(const Eigen::Matrix<double, F, F>& L, Eigen::Matrix<double, F, C>& X) {
+void forward_solve(const Eigen::Matrix<double, F, F>& L, Eigen::Matrix<double, F, C>& X) {
   for (int i = 0; i < F; ++i) {
     for (int k = 0; k < i; ++k) X.row(i) -= L(i, k) * X.row(k);
     X.row(i) *= L(i, i);
   }
+}
+
+/// X <- L^{-T} X (back substitution).
+template <int F, int C>
+void back_solve(const Eigen::Matrix<double, F, F>& L, Eigen::Matrix<double, F, C>& X) {
   for (int i = F - 1; i >= 0; --i) {
     for (int k = i + 1; k < F; ++k) X.row(i) -= L(k, i) * X.row(k);
     X.row(i) *= L(i, i);
@@ -112,13 +138,12 @@ void small_cholesky_solve(const Eigen::Matrix<double, F, F>& L, Eigen::Matrix<do
 template <int S>
 struct OrderWorkspace {
   static constexpr int F = S - 1;
-  std::vector<Eigen::Matrix<double, F, F>> A;  // diagonal blocks of the reduced Hessian
-  std::vector<Eigen::Matrix<double, F, F>> B;  // sub-diagonal blocks (B_j couples z_j to z_{j-1})
   std::vector<Eigen::Matrix<double, F, F>> L;  // Cholesky factors of the Schur complements
-  std::vector<Eigen::Matrix<double, F, F>> W;  // B_j S_{j-1}^{-1}
-  std::vector<Eigen::Matrix<double, F, 3>> r;  // right-hand sides
-  std::vector<Eigen::Matrix<double, F, 3>> z;  // derivatives 1..S-1 per waypoint (rows) per axis
-  std::vector<Eigen::Matrix<double, 2 * S, 3>> x;  // Hermite data per segment (real time)
+  std::vector<Eigen::Matrix<double, F, F>> Y;  // L_{j-1}^{-1} B_j^T: the block L_{j,j-1} = Y_j^T of the factor
+  std::vector<Eigen::Matrix<double, F, 3>> r;  // forward-substituted right-hand sides u_j
+  std::vector<Eigen::Matrix<double, F, 3>> z;  // derivatives 1..S-1 per waypoint (rows) per axis, normalised time
+  double tau = 1.0;  // the time unit z is in (the mean duration of the last solve)
+  int solved = 0;    // segments of the last solve (cost_and_gradients reads its z)
 };
 
 }  // namespace
@@ -139,28 +164,35 @@ MincoSolver& MincoSolver::operator=(MincoSolver&&) noexcept = default;
 
 namespace {
 
-/// Block tridiagonal SPD solve, unknowns j = 1..M-1:
-/// B_j z_{j-1} + A_j z_j + B_{j+1}^T z_{j+1} = r_j (block Cholesky / block Thomas), in place
-/// on z (r is consumed as the forward-substituted right-hand side).
+/// The reduced system of the interior derivatives, unknowns z_j for j = 1..M-1:
+///   B_j z_{j-1} + A_j z_j + B_{j+1}^T z_{j+1} = r_j  (block tridiagonal SPD),
+/// by block Cholesky: the factor has diagonal blocks L_j (Cholesky of the Schur complement
+/// S_j = A_j - Y_j^T Y_j) and sub-diagonal blocks Y_j^T with Y_j = L_{j-1}^{-1} B_j^T. The
+/// forward sweep u_j = L_j^{-1} (r_j - Y_j^T u_{j-1}) runs in solve_order() as each block is
+/// assembled (forward_step); the back sweep z_j = L_j^{-T} (u_j - Y_{j+1} z_{j+1}) here.
 template <int S>
-void solve_reduced(OrderWorkspace<S>& w, int M) {
+void forward_step(OrderWorkspace<S>& w, int j, Eigen::Matrix<double, S - 1, S - 1> Sj,
+                  const Eigen::Matrix<double, S - 1, S - 1>& Bj, Eigen::Matrix<double, S - 1, 3> r) {
   constexpr int F = S - 1;
-  for (int j = 1; j < M; ++j) {
-    // Schur complement S_j = A_j - B_j S_{j-1}^{-1} B_j^T; y_j = r_j - W_j y_{j-1}.
-    Eigen::Matrix<double, F, F> Sj = w.A[j];
-    if (j > 1) {
-      Eigen::Matrix<double, F, F> Wt = w.B[j].transpose();
-      small_cholesky_solve<F, F>(w.L[j - 1], Wt);  // S_{j-1}^{-1} B_j^T
-      w.W[j] = Wt.transpose();
-      Sj.noalias() -= w.W[j] * w.B[j].transpose();
-      w.r[j].noalias() -= w.W[j] * w.r[j - 1];
-    }
-    w.L[j] = small_cholesky<F>(Sj);
+  if (j > 1) {
+    Eigen::Matrix<double, F, F>& Y = w.Y[j];
+    Y = Bj.transpose();
+    forward_solve<F, F>(w.L[j - 1], Y);
+    Sj.noalias() -= Y.transpose() * Y;
+    r.noalias() -= Y.transpose() * w.r[j - 1];
   }
+  w.L[j] = small_cholesky<F>(Sj);
+  forward_solve<F, 3>(w.L[j], r);
+  w.r[j] = r;
+}
+
+template <int S>
+void back_sweep(OrderWorkspace<S>& w, int M) {
+  constexpr int F = S - 1;
   for (int j = M - 1; j >= 1; --j) {
     Eigen::Matrix<double, F, 3> v = w.r[j];
-    if (j < M - 1) v.noalias() -= w.B[j + 1].transpose() * w.z[j + 1];
-    small_cholesky_solve<F, 3>(w.L[j], v);
+    if (j < M - 1) v.noalias() -= w.Y[j + 1] * w.z[j + 1];
+    back_solve<F, 3>(w.L[j], v);
     w.z[j] = v;
   }
 }
@@ -170,11 +202,8 @@ void solve_order(const MincoProblem& p, OrderWorkspace<S>& ws, PolynomialTraject
   constexpr int F = S - 1;  // free derivatives per waypoint
   constexpr int N = 2 * S;
   const int M = static_cast<int>(p.durations.size());
-  ws.x.resize(M);
-  ws.A.resize(M + 1);
-  ws.B.resize(M + 1);
   ws.L.resize(M + 1);
-  ws.W.resize(M + 1);
+  ws.Y.resize(M + 1);
   ws.r.resize(M + 1);
   ws.z.resize(M + 1);
 
@@ -185,11 +214,10 @@ void solve_order(const MincoProblem& p, OrderWorkspace<S>& ws, PolynomialTraject
   for (double T : p.durations) tau += T;
   tau /= M;
   const double inv_tau = 1.0 / tau;
-  double tau_pow[S], inv_tau_pow[S], taylor[S];  // tau^k, tau^-k, 1 / (k! tau^k)
-  tau_pow[0] = inv_tau_pow[0] = taylor[0] = 1.0;
+  double tau_pow[S], taylor[S];  // tau^k, 1 / (k! tau^k)
+  tau_pow[0] = taylor[0] = 1.0;
   for (int k = 1; k < S; ++k) {
     tau_pow[k] = tau_pow[k - 1] * tau;
-    inv_tau_pow[k] = inv_tau_pow[k - 1] * inv_tau;
     taylor[k] = taylor[k - 1] * inv_tau / k;
   }
   // Known derivatives at the ends, in normalised time: d^k/ds^k = tau^k d^k/dt^k.
@@ -200,22 +228,30 @@ void solve_order(const MincoProblem& p, OrderWorkspace<S>& ws, PolynomialTraject
 
   // Equation of interior waypoint j (segment j-1 ends and segment j starts there):
   //   dJ/dz_j = 0  <=>  B_j z_{j-1} + A_j z_j + B_{j+1}^T z_{j+1} = r_j.
-  // Q of the two segments is computed once each, rolling along the path.
-  SegmentMatrix<S> Qa, Qb;
-  segment_cost_matrix<S>(p.durations[0] * inv_tau, Qa);
+  // Q of the two segments is computed once each, rolling along the path (two buffers that
+  // swap roles: the segment starting at waypoint j becomes the one ending at j + 1).
+  SegmentMatrix<S> Q0, Q1;
+  SegmentMatrix<S>* pa = &Q0;
+  SegmentMatrix<S>* pb = &Q1;
+  segment_cost_columns<S>(p.durations[0] * inv_tau, Q0);
   for (int j = 1; j < M; ++j) {
-    segment_cost_matrix<S>(p.durations[j] * inv_tau, Qb);
-    ws.A[j] = Qa.template block<F, F>(S + 1, S + 1) + Qb.template block<F, F>(1, 1);
-    ws.B[j] = Qa.template block<F, F>(S + 1, 1);
-    Eigen::Matrix<double, F, 3> r = -(Qa.template block<F, 1>(S + 1, 0) * p.points.row(j - 1) +
-                                      (Qa.template block<F, 1>(S + 1, S) + Qb.template block<F, 1>(1, 0)) * p.points.row(j) +
-                                      Qb.template block<F, 1>(1, S) * p.points.row(j + 1));
-    if (j == 1) r.noalias() -= ws.B[1] * ws.z[0];
+    segment_cost_columns<S>(p.durations[static_cast<std::size_t>(j)] * inv_tau, *pb);
+    const SegmentMatrix<S>& Qa = *pa;
+    const SegmentMatrix<S>& Qb = *pb;
+    const Eigen::Matrix<double, F, F> A = Qa.template block<F, F>(S + 1, S + 1) + Qb.template block<F, F>(1, 1);
+    const Eigen::Matrix<double, F, F> B = Qa.template block<F, F>(S + 1, 1);
+    Eigen::Matrix<double, F, 3> r =
+        -(Qa.template block<1, F>(0, S + 1).transpose() * p.points.row(j - 1) +
+          (Qa.template block<1, F>(S, S + 1).transpose() + Qb.template block<1, F>(0, 1).transpose()) * p.points.row(j) +
+          Qb.template block<1, F>(S, 1).transpose() * p.points.row(j + 1));
+    if (j == 1) r.noalias() -= B * ws.z[0];
     if (j == M - 1) r.noalias() -= Qb.template block<F, F>(1, S + 1) * ws.z[M];
-    ws.r[j] = r;
-    Qa = Qb;
+    forward_step<S>(ws, j, A, B, r);
+    std::swap(pa, pb);
   }
-  if (M > 1) solve_reduced<S>(ws, M);
+  back_sweep<S>(ws, M);
+  ws.tau = tau;
+  ws.solved = M;
 
   // Coefficients c_i(j, :) = sum_r G(j, r) T^{k(r) - j} x_i(r, :).
   const auto& G = UnitHermite<S>::get().G;
@@ -223,38 +259,46 @@ void solve_order(const MincoProblem& p, OrderWorkspace<S>& ws, PolynomialTraject
   c.resize(N * M, 3);
   out.mutable_durations() = p.durations;
   for (int i = 0; i < M; ++i) {
-    auto& x = ws.x[i];
-    x.row(0) = p.points.row(i);
-    x.template middleRows<F>(1) = ws.z[i];
-    x.row(S) = p.points.row(i + 1);
-    x.template middleRows<F>(S + 1) = ws.z[i + 1];
-    const double Tn = p.durations[i] / tau, T = p.durations[i];
-    double tn[S], inv_tp[N];  // tn[k] = Tn^k, inv_tp[j] = T^-j
-    const double inv_T = 1.0 / T;
-    tn[0] = inv_tp[0] = 1.0;
-    for (int k = 1; k < S; ++k) tn[k] = tn[k - 1] * Tn;
-    for (int j = 1; j < N; ++j) inv_tp[j] = inv_tp[j - 1] * inv_T;
-    Eigen::Matrix<double, N, 3> scaled;  // unit-interval Hermite data
-    for (int r = 0; r < S; ++r) {
-      scaled.row(r) = x.row(r) * tn[r];
-      scaled.row(S + r) = x.row(S + r) * tn[r];
+    const double Tn = p.durations[static_cast<std::size_t>(i)] / tau;
+    const double inv_T = 1.0 / p.durations[static_cast<std::size_t>(i)];
+    double tn = 1.0, inv_tp = 1.0;
+    for (int j = 1; j < S; ++j) inv_tp *= inv_T;  // T^-(S-1)
+    Eigen::Matrix<double, N, 3> unit;  // Hermite data on the unit interval: d^k/du^k = Tn^k d^k/ds^k
+    unit.row(0) = p.points.row(i);
+    unit.row(S) = p.points.row(i + 1);
+    for (int k = 1; k < S; ++k) {
+      tn *= Tn;
+      unit.row(k) = ws.z[static_cast<std::size_t>(i)].row(k - 1) * tn;
+      unit.row(S + k) = ws.z[static_cast<std::size_t>(i) + 1].row(k - 1) * tn;
     }
     // Rows j < S of G are the Taylor terms q^{(j)}(0) / j!; only rows S..2S-1 mix the ends.
     auto ci = c.template middleRows<N>(N * i);
-    for (int j = 0; j < S; ++j) ci.row(j) = x.row(j) * taylor[j];
-    ci.template bottomRows<S>().noalias() = G.template bottomRows<S>() * scaled;
-    for (int j = S; j < N; ++j) ci.row(j) *= inv_tp[j];
-    // Keep the Hermite data in real time for cost_and_gradients().
-    for (int k = 1; k < S; ++k) {
-      x.row(k) *= inv_tau_pow[k];
-      x.row(S + k) *= inv_tau_pow[k];
-    }
+    ci.row(0) = p.points.row(i);
+    for (int j = 1; j < S; ++j) ci.row(j) = ws.z[static_cast<std::size_t>(i)].row(j - 1) * taylor[j];
+    ci.template bottomRows<S>().noalias() = G.template bottomRows<S>() * unit;
+    for (int j = S; j < N; ++j) ci.row(j) *= (inv_tp *= inv_T);
   }
 }
 
+/// The Hermite data of segment i in real time (derivatives 0..S-1 at both ends), from the
+/// last solve's junction derivatives.
 template <int S>
-double cost_order(const MincoProblem& p, const std::vector<Eigen::Matrix<double, 2 * S, 3>>& xs,
-                  MincoGradients* g) {
+Eigen::Matrix<double, 2 * S, 3> hermite_data(const MincoProblem& p, const OrderWorkspace<S>& ws, int i) {
+  Eigen::Matrix<double, 2 * S, 3> x;
+  x.row(0) = p.points.row(i);
+  x.row(S) = p.points.row(i + 1);
+  const double inv_tau = 1.0 / ws.tau;
+  double inv = 1.0;
+  for (int k = 1; k < S; ++k) {
+    inv *= inv_tau;
+    x.row(k) = ws.z[static_cast<std::size_t>(i)].row(k - 1) * inv;
+    x.row(S + k) = ws.z[static_cast<std::size_t>(i) + 1].row(k - 1) * inv;
+  }
+  return x;
+}
+
+template <int S>
+double cost_order(const MincoProblem& p, const OrderWorkspace<S>& ws, MincoGradients* g) {
   constexpr int N = 2 * S;
   const int M = static_cast<int>(p.durations.size());
   double J = 0.0;
@@ -265,7 +309,7 @@ double cost_order(const MincoProblem& p, const std::vector<Eigen::Matrix<double,
   for (int i = 0; i < M; ++i) {
     SegmentMatrix<S> Q;
     segment_cost_matrix<S>(p.durations[i], Q);
-    const auto& x = xs[i];
+    const Eigen::Matrix<double, N, 3> x = hermite_data<S>(p, ws, i);
     const Eigen::Matrix<double, N, 3> Qx = Q * x;
     J += (x.transpose() * Qx).trace();
     if (g) {
@@ -297,9 +341,9 @@ void MincoSolver::solve(const MincoProblem& p, PolynomialTrajectory& out) {
 }
 
 double MincoSolver::cost_and_gradients(const MincoProblem& p, MincoGradients* gradients) const {
-  const std::size_t solved = p.order == 3 ? ws_->jerk.x.size() : ws_->snap.x.size();
-  if (solved < p.durations.size()) throw Error("MincoSolver: cost_and_gradients needs a solve() first");
-  return p.order == 3 ? cost_order<3>(p, ws_->jerk.x, gradients) : cost_order<4>(p, ws_->snap.x, gradients);
+  const int solved = p.order == 3 ? ws_->jerk.solved : ws_->snap.solved;
+  if (solved != static_cast<int>(p.durations.size())) throw Error("MincoSolver: cost_and_gradients needs a solve() first");
+  return p.order == 3 ? cost_order<3>(p, ws_->jerk, gradients) : cost_order<4>(p, ws_->snap, gradients);
 }
 
 MincoProblem rest_to_rest(int order, const Eigen::MatrixX3d& points, std::vector<double> durations) {

@@ -508,8 +508,10 @@ void polish_waypoints(const MincoProblem& p, PolynomialTrajectory& tr) {
           if (damage <= kPolishDamage && (best < 0 || term[j] < term[best])) best = j;
         }
         if (best < 0) break;
+        const ld moved = static_cast<ld>(c(best)) + r / tp[best];
+        if (!std::isfinite(moved) || std::abs(moved) > std::numeric_limits<double>::max()) break;  // T^j underflowed
         const double before = c(best);
-        c(best) = static_cast<double>(static_cast<ld>(c(best)) + r / tp[best]);
+        c(best) = static_cast<double>(moved);
         if (std::abs(compensated_miss(c, N, T, target).value) >= std::abs(miss.value)) {
           c(best) = before;  // no gain: keep the solve's coefficient
           break;

@@ -35,7 +35,8 @@ HeuristicRegion astar_region(const PlanningProblem& problem) {
 
 }  // namespace
 
-TEST_CASE("Every planner returns a collision-free path from start to goal whose cost is its length", "[REQ-PLAN-001][REQ-PLAN-004][REQ-PLAN-009]") {
+TEST_CASE("Every planner returns a collision-free path from start to goal whose cost is its length", "[REQ-PLAN-001][REQ-PLAN-004][REQ-PLAN-009][REQ-PLAN-018]") {
+  // REQ-PLAN-018 for the project's planners: the path ends exactly at x_goal, its cost is its whole length.
   const auto map = miner::testing::wall_with_door_map();
   const auto problem = PlanningProblem::make(map, V(1, 1, 0.5), V(9, 1, 0.5), 0.1);
   const HeuristicRegion region = astar_region(problem);

@@ -3,6 +3,7 @@
 // effort by quadrature), gradients against finite differences, the time-scaling law,
 // and the trapezoidal allocation. Random problems are built from a generated seed.
 #include <cmath>
+#include <vector>
 
 // Boost.Multiprecision's rationals (the exact waypoint miss): GCC's -Wmaybe-uninitialized
 // misreads a static zero inside cpp_int (a false positive of the optimiser in a system header).
@@ -369,6 +370,21 @@ double exact_waypoint_miss(const MincoProblem& p, const PolynomialTrajectory& t)
   }
   return static_cast<double>(worst) / L;
 }
+
+/// The 200 fixed problems of spread 1e3 the answer-check tests share, each with the solver's
+/// raw answer (no polish, no check).
+struct RawAnswer {
+  MincoProblem problem;
+  PolynomialTrajectory raw;
+};
+std::vector<RawAnswer> raw_spread_answers() {
+  std::vector<RawAnswer> out(200);
+  for (std::size_t seed = 0; seed < out.size(); ++seed) {
+    out[seed].problem = spread_problem(seed, 1e3);
+    MincoSolver().solve(out[seed].problem, out[seed].raw);
+  }
+  return out;
+}
 }  // namespace
 
 TEST_CASE("Durations spread over 1e3: an answer meets its waypoints to 1e-9 or is refused, never wrong", "[REQ-TRAJ-010]") {
@@ -394,14 +410,11 @@ TEST_CASE("Durations spread over 1e3: the check refuses exactly the answers that
   // the check accepts meets the bound, every answer that misses it is refused, and every
   // answer within half the bound is accepted (the compensated evaluation is tight; a check
   // that refused everything, or accepted everything, fails here).
-  int accepted = 0, missed = 0;
-  for (std::uint64_t seed = 0; seed < 200; ++seed) {
-    const MincoProblem p = spread_problem(seed, 1e3);
-    PolynomialTrajectory t;
-    MincoSolver().solve(p, t);
+  int accepted = 0, missed = 0, seed = 0;
+  for (const auto& [p, t] : raw_spread_answers()) {
     const double exact = exact_waypoint_miss(p, t);
     const auto c = measure_answer(p, t);
-    INFO("seed " << seed << ": exact miss " << exact << " L, check's bound " << c.interpolation << " L");
+    INFO("seed " << seed++ << ": exact miss " << exact << " L, check's bound " << c.interpolation << " L");
     CHECK(c.interpolation >= exact);                   // an upper bound ...
     CHECK(c.interpolation <= exact + 1e-20);           // ... and a tight one
     bool ok = true;
@@ -425,16 +438,13 @@ TEST_CASE("Durations spread over 1e3: the waypoint polish meets the waypoints th
   // constraint residual by more than its damage bound (two passes), keeps the optimality
   // conditions, and brings most raw misses under the bound (measured: 103 raw answers
   // within 1e-9 L, 192 polished).
-  int raw_within = 0, polished_within = 0;
-  for (std::uint64_t seed = 0; seed < 200; ++seed) {
-    const MincoProblem p = spread_problem(seed, 1e3);
-    PolynomialTrajectory raw;
-    MincoSolver().solve(p, raw);
+  int raw_within = 0, polished_within = 0, seed = 0;
+  for (const auto& [p, raw] : raw_spread_answers()) {
     PolynomialTrajectory polished = raw;
     polish_waypoints(p, polished);
     const double before = exact_waypoint_miss(p, raw), after = exact_waypoint_miss(p, polished);
     const auto c0 = measure_answer(p, raw), c1 = measure_answer(p, polished);
-    INFO("seed " << seed << ": exact miss " << before << " -> " << after << " L");
+    INFO("seed " << seed++ << ": exact miss " << before << " -> " << after << " L");
     CHECK(after <= before);
     // The damage bound of spec REQ-TRAJ-010 (1e-12 of each derivative's scale, fixed here
     // so that the product's constant cannot loosen it), per pass, two passes, both sides of

@@ -54,6 +54,12 @@ import tensors  # noqa: E402
 #                (x and y mirrors, and the x <-> y swap when the grid and the bounds are square):
 #                it maps a query and its A* path to a query of the same map family and a path of
 #                the same length, so it is 8x data for free; gravity (z) is never flipped
+#   augment 2    every symmetry of the cube (3 mirrors x 6 axis orders: 48) when the grid is a
+#                cube (nx = ny = nz, always for `miner dataset`): sigma is permuted with the axes,
+#                so the network is told the metric size of what became each axis. The query is
+#                geometric (A* and RRT* see no gravity), so a turned map with its turned path is
+#                still a map and its optimal path: walls with doors become floors with holes,
+#                a forest's trunks become beams, the cross-family variety a held-out family needs
 #   schedule     "cosine": both learning rates decay as (1 + cos(pi t)) / 2 over the run, t the
 #                share of steps done, so the last epochs settle instead of oscillating
 #   select       "best": export the epoch (and threshold) with the best validation
@@ -135,19 +141,42 @@ def square_grid(meta):
     return nx == ny
 
 
-def augment(batch, sigma, code, swap_xy):
-    """Applies per sample the symmetry code (bit 0: mirror x, bit 1: mirror y, bit 2: swap x
-    and y) to uint8 [B, 3, nz, ny, nx] and its sigma [B, 3]; code is an int tensor [B] on the
-    batch's device."""
-    def where(bit, changed):
-        mask = ((code >> bit) & 1).bool().view(-1, 1, 1, 1, 1)
-        return torch.where(mask, changed, batch)
-    batch = where(0, batch.flip(4))
-    batch = where(1, batch.flip(3))
+def cube_grid(meta):
+    """True when every axis order maps the grid onto itself (nx = ny = nz)."""
+    nx, ny, nz = meta["dims"]
+    return nx == ny == nz
+
+
+# The six orders of the axes (x, y, z) = (0, 1, 2): new axis a is old axis AXIS_ORDERS[p][a].
+AXIS_ORDERS = [(0, 1, 2), (1, 0, 2), (0, 2, 1), (2, 1, 0), (1, 2, 0), (2, 0, 1)]
+
+
+def augment(batch, sigma, code, swap_xy, cube=False):
+    """Applies per sample the symmetry code to uint8 [B, 3, nz, ny, nx] and its sigma [B, 3]
+    (code: an int tensor [B] on the batch's device). Bit 0: mirror x, bit 1: mirror y; without
+    cube, bit 2: swap x and y (when swap_xy); with cube, bit 2: mirror z and code >> 3 in 0..5
+    picks the axis order AXIS_ORDERS[code >> 3], sigma permuted with it."""
+    def where(mask, changed):
+        return torch.where(mask.view(-1, 1, 1, 1, 1), changed, batch)
+
+    def bit(b):
+        return ((code >> b) & 1).bool()
+    batch = where(bit(0), batch.flip(4))
+    batch = where(bit(1), batch.flip(3))
+    if cube:
+        batch = where(bit(2), batch.flip(2))
+        order = code >> 3
+        # tensor dims (z, y, x) = (2, 3, 4): axis a (x = 0) lives in dim 4 - a
+        out, out_sigma = batch, sigma
+        for p, axes in enumerate(AXIS_ORDERS[1:], start=1):
+            dims = [0, 1] + [4 - axes[2 - d] for d in range(3)]
+            mask = order == p
+            out = torch.where(mask.view(-1, 1, 1, 1, 1), batch.permute(*dims), out)
+            out_sigma = torch.where(mask.view(-1, 1), sigma[:, list(axes)], out_sigma)
+        return out, out_sigma
     if swap_xy:
-        batch = where(2, batch.transpose(3, 4))
-        swap = ((code >> 2) & 1).bool().view(-1, 1)
-        sigma = torch.where(swap, sigma[:, [1, 0, 2]], sigma)
+        batch = where(bit(2), batch.transpose(3, 4))
+        sigma = torch.where(bit(2).view(-1, 1), sigma[:, [1, 0, 2]], sigma)
     return batch, sigma
 
 
@@ -200,8 +229,8 @@ def parse_args(argv):
         raise SystemExit("train: --schedule must be constant or cosine")
     if a.select not in ("best", "last"):
         raise SystemExit("train: --select must be best or last")
-    if a.augment not in (0, 1) or a.val_samples < 0:
-        raise SystemExit("train: --augment must be 0 or 1 and --val-samples >= 0")
+    if a.augment not in (0, 1, 2) or a.val_samples < 0:
+        raise SystemExit("train: --augment must be 0, 1 or 2 and --val-samples >= 0")
     try:
         a.candidates = sorted({float(t) for t in a.thresholds.split(",")} | {a.threshold})
     except ValueError:
@@ -243,6 +272,9 @@ def main(argv=None):
     train = torch.from_numpy(train).to(dev)  # uint8 on the device: 96 KiB a sample
     train_sigma = torch.from_numpy(train_sigma).to(dev)
     swap_xy = square_grid(meta)
+    cube = a.augment == 2
+    if cube and not cube_grid(meta):
+        raise SystemExit("train: --augment 2 needs a cubic grid (nx = ny = nz)")
     val_endpoints = [quality.endpoints(val[k, 1]) for k in range(len(val))]
     val_set = {"x": val, "sigma": val_sigma, "family": val_family, "ends": val_endpoints,
                "names": [m["preset"] for m in metas]}
@@ -272,7 +304,7 @@ def main(argv=None):
         raise SystemExit(f"train: {a.resume} has {first_epoch} epochs done, more than --epochs {a.epochs}")
     for epoch in range(first_epoch, a.epochs):
         order = torch.randperm(len(train), generator=gen)
-        codes = torch.randint(0, 8, (len(train),), generator=gen)
+        codes = torch.randint(0, 48 if cube else 8, (len(train),), generator=gen)
         sums = torch.zeros(6, dtype=torch.float64, device=dev)
         bar = ProgressBar(f"epoch {epoch + 1}/{a.epochs}", steps_per_epoch)
         for step in range(steps_per_epoch):
@@ -285,7 +317,7 @@ def main(argv=None):
             idx = torch.sort(order[step * a.batch:(step + 1) * a.batch]).values
             batch, sigma = train[idx.to(dev)], train_sigma[idx.to(dev)]
             if a.augment:
-                batch, sigma = augment(batch, sigma, codes[idx].to(dev), swap_xy)
+                batch, sigma = augment(batch, sigma, codes[idx].to(dev), swap_xy, cube)
             env, state, target, solid = to_inputs(batch)
             noise = torch.randn(env.shape, generator=noise_gen, device=dev)
             o = G(env, state, noise, sigma)

@@ -4,6 +4,9 @@
 # on one H100, all eight runs at once (~6 min).
 #   bash docs/sgan-training/families.sh data    [miner]   -> fam-*/ (train, val, 40 test maps each)
 #   bash docs/sgan-training/families.sh train   [cuda]    -> runs/all, runs/without-F (sgan-0.1.bin: shipped)
+#   bash docs/sgan-training/families.sh cube    [cuda]    -> the same with the cube's 48 symmetries
+#        (--augment 2) and a width-4 network beside them: session 18's experiment, not shipped
+#        (docs/heuristic.md); one H200, all nine runs at once, 421 s
 set -euo pipefail
 families=(sim indoor cluttered rooms forest multilevel scan)
 declare -A count=([sim]=2000 [indoor]=1200 [cluttered]=2000 [rooms]=2000 [forest]=2000 [multilevel]=1500 [scan]=700)
@@ -30,5 +33,19 @@ case "${1:-}" in
       python3 "$here/src/python/sgan/set_threshold.py" --weights "$r/sgan.bin" --threshold 0.1 \
         --reason "chosen on the validation split by strict connectivity + safety" --out "$r/sgan-0.1.bin"
     done ;;
-  *) echo "usage: $0 data [miner] | train [cuda]" >&2; exit 2 ;;
+  cube)
+    device=${2:-cuda}
+    here=$(cd "$(dirname "$0")/../.." && pwd)
+    all=(); for f in "${families[@]}"; do all+=("fam-$f"); done
+    for w in 8 4; do
+      python3 "$here/src/python/sgan/train.py" --data "${all[@]}" --device "$device" --threads 1 --width $w \
+        --augment 2 --epochs 16 --val-samples 280 --out runs-cube/all-w$w > runs-cube-all-w$w.log &
+    done
+    for held in "${families[@]}"; do
+      rest=(); for f in "${families[@]}"; do [ "$f" != "$held" ] && rest+=("fam-$f"); done
+      python3 "$here/src/python/sgan/train.py" --data "${rest[@]}" --device "$device" --threads 1 --width 8 \
+        --augment 2 --epochs 8 --val-samples 280 --out "runs-cube/without-$held" > "runs-cube-without-$held.log" &
+    done
+    wait ;;
+  *) echo "usage: $0 data [miner] | train [cuda] | cube [cuda]" >&2; exit 2 ;;
 esac

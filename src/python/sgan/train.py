@@ -288,7 +288,7 @@ def main(argv=None):
     pos_weight = torch.tensor(a.pos_weight, device=dev)
     log, best, first_epoch = [], None, 0
     if a.resume:
-        state = torch.load(a.resume, map_location=dev)
+        state = torch.load(a.resume, map_location=dev, weights_only=False)  # our own file: RNG states, numpy scalars
         if state.get("options") != options_key(a):
             raise SystemExit(f"train: {a.resume} was written with other options; resume with the same ones")
         for m, k in ((G, "G"), (Dc, "Dc"), (Ds, "Ds"), (opt_g, "opt_g"), (opt_d, "opt_d")):

@@ -10,6 +10,24 @@
 set -euo pipefail
 families=(sim indoor cluttered rooms forest multilevel scan)
 declare -A count=([sim]=2000 [indoor]=1200 [cluttered]=2000 [rooms]=2000 [forest]=2000 [multilevel]=1500 [scan]=700)
+here=$(cd "$(dirname "$0")/../.." && pwd)
+all=(); for f in "${families[@]}"; do all+=("fam-$f"); done
+# train_bg OUT LOG WIDTH EPOCHS AUGMENT DATA...: one train.py run in the background (AUGMENT empty:
+# train.py's default). The options keep one order: train.py records its command in the weights.
+train_bg() {
+  local out=$1 log=$2 width=$3 epochs=$4 augment=$5
+  shift 5
+  python3 "$here/src/python/sgan/train.py" --data "$@" --device "$device" --threads 1 --width "$width" \
+    ${augment:+--augment "$augment"} --epochs "$epochs" --val-samples 280 --out "$out" > "$log" &
+}
+# lofo_bg PREFIX AUGMENT: the seven leave-one-family-out runs (width 8, 8 epochs).
+lofo_bg() {
+  local held f rest
+  for held in "${families[@]}"; do
+    rest=(); for f in "${families[@]}"; do [ "$f" != "$held" ] && rest+=("fam-$f"); done
+    train_bg "$1/without-$held" "$1-without-$held.log" 8 8 "$2" "${rest[@]}"
+  done
+}
 case "${1:-}" in
   data)
     miner=${2:-build/release/miner}
@@ -18,15 +36,8 @@ case "${1:-}" in
     done ;;
   train)
     device=${2:-cuda}
-    here=$(cd "$(dirname "$0")/../.." && pwd)
-    all=(); for f in "${families[@]}"; do all+=("fam-$f"); done
-    python3 "$here/src/python/sgan/train.py" --data "${all[@]}" --device "$device" --threads 1 --width 8 \
-      --epochs 16 --val-samples 280 --out runs/all > runs-all.log &
-    for held in "${families[@]}"; do
-      rest=(); for f in "${families[@]}"; do [ "$f" != "$held" ] && rest+=("fam-$f"); done
-      python3 "$here/src/python/sgan/train.py" --data "${rest[@]}" --device "$device" --threads 1 --width 8 \
-        --epochs 8 --val-samples 280 --out "runs/without-$held" > "runs-without-$held.log" &
-    done
+    train_bg runs/all runs-all.log 8 16 "" "${all[@]}"
+    lofo_bg runs ""
     wait
     # The threshold, chosen on the validation split by the strict rates (docs/heuristic.md):
     for r in runs/all runs/without-*; do
@@ -35,17 +46,8 @@ case "${1:-}" in
     done ;;
   cube)
     device=${2:-cuda}
-    here=$(cd "$(dirname "$0")/../.." && pwd)
-    all=(); for f in "${families[@]}"; do all+=("fam-$f"); done
-    for w in 8 4; do
-      python3 "$here/src/python/sgan/train.py" --data "${all[@]}" --device "$device" --threads 1 --width $w \
-        --augment 2 --epochs 16 --val-samples 280 --out runs-cube/all-w$w > runs-cube-all-w$w.log &
-    done
-    for held in "${families[@]}"; do
-      rest=(); for f in "${families[@]}"; do [ "$f" != "$held" ] && rest+=("fam-$f"); done
-      python3 "$here/src/python/sgan/train.py" --data "${rest[@]}" --device "$device" --threads 1 --width 8 \
-        --augment 2 --epochs 8 --val-samples 280 --out "runs-cube/without-$held" > "runs-cube-without-$held.log" &
-    done
+    for w in 8 4; do train_bg "runs-cube/all-w$w" "runs-cube-all-w$w.log" "$w" 16 2 "${all[@]}"; done
+    lofo_bg runs-cube 2
     wait ;;
   *) echo "usage: $0 data [miner] | train [cuda] | cube [cuda]" >&2; exit 2 ;;
 esac

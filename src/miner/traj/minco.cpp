@@ -286,9 +286,8 @@ void solve_order(const MincoProblem& p, OrderWorkspace<S>& ws, PolynomialTraject
     auto ci = c.template middleRows<N>(N * i);
     ci.row(0) = p.points.row(i);
     for (int j = 1; j < S; ++j) ci.row(j) = ws.z[static_cast<std::size_t>(i)].row(j - 1) * taylor[j];
-    Eigen::Matrix<double, S, 3> high;
-    high.noalias() = G.template bottomRows<S>() * unit;
-    for (int j = S; j < N; ++j) ci.row(j) = high.row(j - S) * (inv_tp *= inv_T);
+    ci.template bottomRows<S>().noalias() = G.template bottomRows<S>() * unit;
+    for (int j = S; j < N; ++j) ci.row(j) *= (inv_tp *= inv_T);
   }
 }
 

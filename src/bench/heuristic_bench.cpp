@@ -96,7 +96,7 @@ HeuristicBenchResult run_heuristic_bench(const HeuristicBenchOptions& o, std::os
       rec.map_seed = s.map_seed;
       const Clock::time_point t0 = Clock::now();
       const heuristic::HeuristicQuery q =
-          heuristic::query_region(sgan, map, s.start, s.goal, preset.robot_radius, o.seed + k);
+          heuristic::query_region(sgan, map, s.start, s.goal, preset.robot_radius, o.seed + k, true, o.strict_bridge);
       rec.region_ms = elapsed_ms(t0);
       rec.inference_ms = q.inference_ms;
       rec.raw_connected = q.report.raw_connected;
@@ -106,6 +106,9 @@ HeuristicBenchResult run_heuristic_bench(const HeuristicBenchOptions& o, std::os
       rec.raw_cells = q.report.raw_cells;
       rec.cells = q.report.cells;
       rec.bridge_cells = q.report.bridge_cells;
+      rec.strict_cells = q.report.strict_cells;
+      rec.strict_witness = q.report.strict_connected;
+      rec.filter_ms = q.filter_ms;
       // Strict quality (REQ-HEUR-011) on the map's voxels, raw and filtered.
       const world::VoxelGrid voxels(map, preset.robot_radius);
       const plan::HeuristicRegion raw(map.bounds(), sgan.architecture().dims,
@@ -148,10 +151,12 @@ namespace {
 
 /// Quality, timing and planner figures over a set of samples (all, or one family's).
 nlohmann::json quality_json(const std::vector<HeuristicSampleRecord>& samples, bool planners) {
-  std::vector<double> inference, region, raw_cells, cells;
-  std::size_t bridged = 0;
+  std::vector<double> inference, region, raw_cells, cells, filter;
+  std::size_t bridged = 0, strict_bridged = 0;
   for (const auto& s : samples) {
     inference.push_back(s.inference_ms);
+    filter.push_back(s.filter_ms);
+    strict_bridged += s.strict_cells > 0 ? 1 : 0;
     region.push_back(s.region_ms);
     raw_cells.push_back(static_cast<double>(s.raw_cells));
     cells.push_back(static_cast<double>(s.cells));
@@ -172,7 +177,11 @@ nlohmann::json quality_json(const std::vector<HeuristicSampleRecord>& samples, b
                       {"bridged_rate", static_cast<double>(bridged) / static_cast<double>(std::max<std::size_t>(samples.size(), 1))},
                       {"raw_cells_median", num(median(raw_cells))},
                       {"cells_median", num(median(cells))},
+                      {"strict_bridged_rate", static_cast<double>(strict_bridged) / static_cast<double>(std::max<std::size_t>(samples.size(), 1))},
+                      {"strict_witness_rate", rate(samples, &R::strict_witness)},
                       {"inference_ms", num(median(inference))},
+                      {"filter_ms", num(median(filter))},
+                      {"filter_ms_max", num(filter.empty() ? 0.0 : *std::max_element(filter.begin(), filter.end()))},
                       {"region_ms", num(median(region))}};
   if (planners) {
     j["miner"] = stage_summary(samples, &R::miner);

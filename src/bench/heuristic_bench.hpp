@@ -28,6 +28,7 @@ struct HeuristicBenchOptions {
   std::size_t max_iterations = 20000;
   double target_factor = 1.0;   ///< target cost = factor x the sample's A* cost
   bool planners = true;         ///< also run MINER and RRT* (false: quality only)
+  bool strict_bridge = false;   ///< filter step 5 too (REQ-HEUR-014); false: steps 1-4
 };
 
 struct HeuristicSampleRecord {
@@ -40,6 +41,9 @@ struct HeuristicSampleRecord {
   /// network would score.
   bool truth_connected_strict = false, truth_safe_strict = false;
   std::size_t raw_cells = 0, cells = 0, bridge_cells = 0;
+  std::size_t strict_cells = 0;     ///< filter step 5: cells added
+  bool strict_witness = false;      ///< step 5 found a checked polyline inside H
+  double filter_ms = 0.0;
   double inference_ms = 0.0, region_ms = 0.0;  ///< region: encode + inference + filter
   plan::PlanResult miner, rrtstar;
 };

@@ -155,6 +155,8 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   hc->add_option("--target-factor", h->bench.target_factor, "target cost = this x the sample's A* cost")
       ->capture_default_str()->check(finite_in(0.01, 100.0));
   hc->add_flag("!--no-planners", h->bench.planners, "quality only: do not run MINER and RRT*");
+  hc->add_flag("--strict-bridge", h->bench.strict_bridge,
+               "filter step 5 too: the strict bridge on the continuous map (REQ-HEUR-014)");
   add_output_options(hc, h->output);
   hc->callback([h, &out] {
     const bench::HeuristicBenchResult r = bench::run_heuristic_bench(h->bench, progress_stream());

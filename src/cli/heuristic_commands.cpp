@@ -35,6 +35,7 @@ struct HeuristicCliOptions {
   std::string weights;
   std::uint64_t seed = 1;
   bool raw = false;
+  bool strict_bridge = false;
   std::string region_out;
   OutputOptions output;
 };
@@ -45,11 +46,22 @@ Json report_json(const heuristic::FilterReport& r) {
           {"cells", r.cells},                 {"connected", r.connected},           {"safe", r.safe}};
 }
 
+/// Step 5's part of the report (REQ-HEUR-014), when it ran.
+Json strict_json(const heuristic::HeuristicQuery& h) {
+  const heuristic::FilterReport& r = h.report;
+  Json witness = Json::array();
+  for (const Eigen::Vector3d& p : h.strict_witness) witness.push_back({p.x(), p.y(), p.z()});
+  return {{"searched", r.strict_searched}, {"connected", r.strict_connected}, {"cells", r.strict_cells},
+          {"expansions", r.strict_expansions}, {"budget_exhausted", r.strict_budget_exhausted}, {"witness", witness}};
+}
+
 void run_heuristic(const HeuristicCliOptions& o, std::ostream& out) {
   const ResolvedQuery q = resolve_query(o.query);
   plan::PlanningProblem::make(q.map, q.start, q.goal, q.radius);  // start/goal checks, named errors
   const heuristic::Sgan sgan = heuristic::Sgan::load_or_builtin(o.weights);
-  const heuristic::HeuristicQuery h = heuristic::query_region(sgan, q.map, q.start, q.goal, q.radius, o.seed, !o.raw);
+  if (o.raw && o.strict_bridge) throw Error("--strict-bridge: is a filter step, --raw writes the unfiltered output");
+  const heuristic::HeuristicQuery h =
+      heuristic::query_region(sgan, q.map, q.start, q.goal, q.radius, o.seed, !o.raw, o.strict_bridge);
   h.region.save(o.region_out);
   Json doc = {{"region", o.region_out},
               {"source", h.region.source()},
@@ -60,6 +72,7 @@ void run_heuristic(const HeuristicCliOptions& o, std::ostream& out) {
               {"encode_ms", h.encode_ms},
               {"inference_ms", h.inference_ms},
               {"filter_ms", h.filter_ms}};
+  if (o.strict_bridge) doc["strict_bridge"] = strict_json(h);
   std::ostringstream s;
   const auto& r = h.report;
   s << "wrote " << o.region_out << " (" << h.region.source() << "): " << h.region.cells().size() << " of "
@@ -68,8 +81,14 @@ void run_heuristic(const HeuristicCliOptions& o, std::ostream& out) {
     << (r.raw_safe ? "safe" : "unsafe") << "\n"
     << "filter: -" << r.solid_dropped << " solid, -" << r.island_dropped << " island, +" << r.bridge_cells
     << " bridge -> " << r.cells << " cells, " << (r.connected ? "connected" : "not connected") << ", "
-    << (r.safe ? "safe" : "unsafe") << "\n"
-    << std::fixed << std::setprecision(2) << "time: encode " << h.encode_ms << " ms, inference " << h.inference_ms
+    << (r.safe ? "safe" : "unsafe") << "\n";
+  if (o.strict_bridge)
+    s << "strict bridge: +" << r.strict_cells << " cells, "
+      << (r.strict_connected ? "a collision-free way inside H (" + std::to_string(h.strict_witness.size()) + " vertices)"
+                             : std::string(r.strict_budget_exhausted ? "no way found within the work bound"
+                                                                     : "no way found near H"))
+      << ", " << r.strict_expansions << " nodes\n";
+  s << std::fixed << std::setprecision(2) << "time: encode " << h.encode_ms << " ms, inference " << h.inference_ms
     << " ms, filter " << h.filter_ms << " ms\n";
   emit(o.output, doc, s.str(), out);
 }
@@ -137,6 +156,8 @@ void add_heuristic_commands(CLI::App& app, std::ostream& out) {
   c->add_option("--weights", h->weights, "sGAN weights file (default: the shipped fixtures/sgan/sgan.bin)");
   c->add_option("--seed", h->seed, "seed of the generator's noise")->capture_default_str()->check(kUnsigned64);
   c->add_flag("--raw", h->raw, "write the thresholded network output's probabilities, unfiltered");
+  c->add_flag("--strict-bridge", h->strict_bridge,
+              "filter step 5: add the cells a collision-free way from start to goal needs (REQ-HEUR-014)");
   c->add_option("--out", h->region_out, "region file to write (miner-region-v1)")->required()->check(kOutputFile);
   c->add_flag("--json", h->output.json, "print the summary as JSON");
   c->callback([h, &out] { run_heuristic(*h, out); });

@@ -39,6 +39,7 @@ struct PlanCliOptions {
   std::string planner = "miner";
   std::string region = "sgan";
   std::string weights;
+  bool strict_bridge = false;
   RegionGridOptions grid;
   plan::PlannerOptions planner_options;
   double target_factor = 0.0;
@@ -73,7 +74,8 @@ void run_plan(PlanCliOptions o, std::ostream& out) {
   if (o.planner_options.planner == plan::PlannerKind::kMiner) {
     if (o.region == "sgan") {
       const heuristic::Sgan sgan = heuristic::Sgan::load_or_builtin(o.weights);
-      sgan_query = heuristic::query_region(sgan, q.map, q.start, q.goal, q.radius, o.planner_options.seed);
+      sgan_query = heuristic::query_region(sgan, q.map, q.start, q.goal, q.radius, o.planner_options.seed, true,
+                                           o.strict_bridge);
       region = sgan_query->region;
     } else if (o.region == "astar") {
       const Eigen::Vector3i dims(o.grid.dims[0], o.grid.dims[1], o.grid.dims[2]);
@@ -116,6 +118,10 @@ void run_plan(PlanCliOptions o, std::ostream& out) {
     if (sgan_query) {
       doc["region"]["connected"] = sgan_query->report.connected;
       doc["region"]["bridge_cells"] = sgan_query->report.bridge_cells;
+      if (o.strict_bridge) {
+        doc["region"]["strict_cells"] = sgan_query->report.strict_cells;
+        doc["region"]["strict_connected"] = sgan_query->report.strict_connected;
+      }
       if (o.timing) doc["region"]["time_ms"] = sgan_query->encode_ms + sgan_query->inference_ms + sgan_query->filter_ms;
     }
   }
@@ -194,6 +200,9 @@ void add_plan_commands(CLI::App& app, std::ostream& out) {
                 "miner-region-v1 file")
       ->capture_default_str();
   p->add_option("--weights", po->weights, "sGAN weights file (default: the shipped fixtures/sgan/sgan.bin)");
+  p->add_flag("--strict-bridge", po->strict_bridge,
+              "miner, --region sgan: filter step 5, a collision-free way from start to goal inside the region "
+              "(REQ-HEUR-014)");
   add_region_grid_options(p, po->grid);
   p->add_option("--iterations", po->planner_options.max_iterations, "iteration budget (Alg. 1's N)")
       ->check(kIterationsRange)
@@ -234,10 +243,12 @@ void add_plan_commands(CLI::App& app, std::ostream& out) {
     // The region, its grid and the safeguard belong to miner: given to another planner they
     // would be ignored without a word (issue 20).
     if (po->planner != "miner")
-      for (const char* name : {"--region", "--weights", "--dims", "--dilation", "--mu1", "--mu2", "--no-safeguard",
-                               "--safeguard-iterations"})
+      for (const char* name : {"--region", "--weights", "--strict-bridge", "--dims", "--dilation", "--mu1", "--mu2",
+                               "--no-safeguard", "--safeguard-iterations"})
         if (p->get_option(name)->count() > 0)
           throw CLI::ValidationError(name, std::string("applies to --planner miner only, not ") + po->planner);
+    if (po->strict_bridge && po->region != "sgan")
+      throw CLI::ValidationError("--strict-bridge", "is a step of the sGAN region's filter, not of --region " + po->region);
     po->planner_options.record_tree = po->tree;
     run_plan(*po, out);
   });

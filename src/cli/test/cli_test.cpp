@@ -15,6 +15,7 @@
 #include "miner/heuristic/sgan.hpp"
 #include "miner/pipeline/scenario.hpp"
 #include "miner/plan/heuristic_region.hpp"
+#include "miner/world/map.hpp"
 
 using Catch::Matchers::Contains;
 
@@ -1017,6 +1018,59 @@ TEST_CASE("miner sgan check compares C++ inference with PyTorch's reference tens
   const Run bad = miner_cli({"sgan", "check", "--reference", dir() + "/missing.bin"});
   CHECK(bad.code == 1);
   CHECK_THAT(bad.err, Contains("missing.bin"));
+}
+
+TEST_CASE("--strict-bridge adds filter step 5 and reports its checked polyline", "[REQ-HEUR-014]") {
+  const std::string map = dir() + "/rooms-strict.json";
+  REQUIRE(miner_cli({"map", "gen", "--preset", "rooms", "--seed", "5", "--out", map}).code == 0);
+  const Run plain = miner_cli({"heuristic", "--map", map, "--out", dir() + "/plain-region.json", "--json"});
+  REQUIRE(plain.code == 0);
+  CHECK_FALSE(miner::parse_json(plain.out, "stdout").contains("strict_bridge"));  // opt-in
+  const Run r = miner_cli({"heuristic", "--map", map, "--out", dir() + "/strict-region.json", "--strict-bridge", "--json"});
+  INFO(r.err);
+  REQUIRE(r.code == 0);
+  const miner::Json doc = miner::parse_json(r.out, "stdout");
+  const miner::Json& s = doc["strict_bridge"];
+  CHECK(s["searched"] == true);
+  REQUIRE(s["connected"] == true);
+  // The polyline joins the query's start and goal, collision-free, inside the written region.
+  const miner::world::Map m = miner::world::Map::load(map);
+  const auto region = miner::plan::HeuristicRegion::load(dir() + "/strict-region.json");
+  const auto& w = s["witness"];
+  REQUIRE(w.size() >= 2);
+  auto point = [&](std::size_t i) { return Eigen::Vector3d(w[i][0].get<double>(), w[i][1].get<double>(), w[i][2].get<double>()); };
+  CHECK((point(0) - m.query()->start).norm() == 0.0);
+  CHECK((point(w.size() - 1) - m.query()->goal).norm() == 0.0);
+  for (std::size_t i = 1; i < w.size(); ++i) {
+    CHECK(m.segment_free(point(i - 1), point(i), m.query()->robot_radius));
+    CHECK(region.contains(0.5 * (point(i - 1) + point(i))));
+  }
+  CHECK(doc["filter"]["cells"].get<std::size_t>() == region.cells().size());
+  CHECK_THAT(miner_cli({"heuristic", "--map", map, "--out", dir() + "/s.json", "--strict-bridge"}).out,
+             Contains("strict bridge: +"));
+  // Same inputs, same region bytes and polyline.
+  const Run again = miner_cli({"heuristic", "--map", map, "--out", dir() + "/strict-region2.json", "--strict-bridge", "--json"});
+  REQUIRE(again.code == 0);
+  CHECK(miner::parse_json(again.out, "stdout")["strict_bridge"]["witness"] == w);
+  auto bytes = [](const std::string& path) {
+    std::ifstream f(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(f), {});
+  };
+  CHECK(bytes(dir() + "/strict-region.json") == bytes(dir() + "/strict-region2.json"));
+  // It is a filter step: refused with --raw, and with a region other than the sGAN's.
+  const Run raw = miner_cli({"heuristic", "--map", map, "--out", dir() + "/z.json", "--strict-bridge", "--raw"});
+  CHECK(raw.code == 1);
+  CHECK_THAT(raw.err, Contains("--strict-bridge") && Contains("--raw"));
+  CHECK_FALSE(std::filesystem::exists(dir() + "/z.json"));
+  const Run astar = miner_cli({"plan", "--map", map, "--planner", "miner", "--region", "astar", "--strict-bridge"});
+  CHECK(astar.code == 2);
+  CHECK_THAT(astar.err, Contains("--strict-bridge"));
+  const Run rrt = miner_cli({"plan", "--map", map, "--planner", "rrtstar", "--strict-bridge"});
+  CHECK(rrt.code == 2);
+  const Run planned = miner_cli({"plan", "--map", map, "--planner", "miner", "--strict-bridge", "--iterations", "2000", "--json"});
+  INFO(planned.err);
+  REQUIRE(planned.code == 0);
+  CHECK(miner::parse_json(planned.out, "stdout")["region"]["strict_connected"] == true);
 }
 
 TEST_CASE("miner bench heuristic measures raw and filtered quality and the planners on unseen maps",

@@ -10,6 +10,7 @@
 #include "miner/core/stopwatch.hpp"
 #include "miner/heuristic/grid.hpp"
 #include "miner/heuristic/sgan.hpp"
+#include "miner/heuristic/strict_bridge.hpp"
 #include "miner/world/map.hpp"
 
 namespace miner::heuristic {
@@ -130,7 +131,8 @@ FilteredRegion filter_region(const std::vector<float>& p, const std::vector<std:
 }
 
 HeuristicQuery query_region(const Sgan& sgan, const world::Map& map, const Eigen::Vector3d& start,
-                            const Eigen::Vector3d& goal, double robot_radius, std::uint64_t seed, bool filter) {
+                            const Eigen::Vector3d& goal, double robot_radius, std::uint64_t seed, bool filter,
+                            bool strict) {
   const SganArchitecture& arch = sgan.architecture();
   const world::Box& b = map.bounds();
   const Eigen::Vector3i dims = arch.dims;
@@ -145,6 +147,18 @@ HeuristicQuery query_region(const Sgan& sgan, const world::Map& map, const Eigen
   const double inference_ms = elapsed_ms(t0);
   t0 = std::chrono::steady_clock::now();
   FilteredRegion f = filter_region(prob, env, dims, cell_of(b, dims, start), cell_of(b, dims, goal), arch.threshold);
+  std::vector<Eigen::Vector3d> witness;
+  if (filter && strict) {
+    StrictBridgeReport s = strict_bridge(map, robot_radius, dims, env, f.mask, start, goal);
+    FilterReport& r = f.report;
+    r.strict_searched = s.searched;
+    r.strict_connected = s.connected;
+    r.strict_cells = s.added;
+    r.strict_expansions = s.expansions;
+    r.strict_budget_exhausted = s.budget_exhausted;
+    r.cells += s.added;
+    witness = std::move(s.polyline);
+  }
   std::vector<double> probabilities(prob.size(), 0.0);
   if (filter) {
     for (std::size_t i = 0; i < prob.size(); ++i) probabilities[i] = f.mask[i] ? 1.0 : 0.0;
@@ -154,7 +168,8 @@ HeuristicQuery query_region(const Sgan& sgan, const world::Map& map, const Eigen
   const double filter_ms = elapsed_ms(t0);
   plan::HeuristicRegion region(b, dims, std::move(probabilities), filter ? 0.5 : arch.threshold,
                                filter ? "sgan-filtered" : "sgan-raw");
-  return {std::move(region), std::move(prob), std::move(env), f.report, encode_ms, inference_ms, filter_ms};
+  return {std::move(region), std::move(prob), std::move(env), f.report, std::move(witness), encode_ms, inference_ms,
+          filter_ms};
 }
 
 }  // namespace miner::heuristic

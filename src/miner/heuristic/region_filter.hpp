@@ -12,8 +12,11 @@
 ///      joining their components (a cell already in H costs 0, any other 1 + (1 - R)), grown
 ///      by one cell within the non-solid cells so the planner has room to sample around it.
 /// The result is safe by construction and connected whenever the non-solid cells connect
-/// start and goal at all (always when A* finds a path: its cells are never solid). The
-/// report says what each step changed, so the raw network's quality stays visible.
+/// start and goal at all (always when A* finds a path: its cells are never solid).
+///   5. (opt-in) strict bridge (strict_bridge.hpp, REQ-HEUR-014): on the continuous map, a checked
+///      collision-free polyline for the robot radius from start to goal inside H, H growing
+///      by the cells it has to leave H through (none when H already holds one).
+/// The report says what each step changed, so the raw network's quality stays visible.
 
 #include <cstddef>
 #include <cstdint>
@@ -45,6 +48,11 @@ struct FilterReport {
   std::size_t cells = 0;           ///< cells in the filtered region
   bool connected = false;          ///< REQ-HEUR-004 on the filtered region
   bool safe = false;
+  bool strict_searched = false;    ///< step 5 ran
+  bool strict_connected = false;   ///< step 5 found and checked a polyline inside H
+  std::size_t strict_cells = 0;    ///< step 5: cells added
+  std::size_t strict_expansions = 0;
+  bool strict_budget_exhausted = false;
 };
 
 struct FilteredRegion {
@@ -62,13 +70,16 @@ struct HeuristicQuery {
   std::vector<float> probabilities;        ///< R, the network output
   std::vector<std::uint8_t> environment;   ///< E levels
   FilterReport report;
+  std::vector<Eigen::Vector3d> strict_witness;  ///< step 5's polyline, start to goal (empty if none)
   double encode_ms = 0.0, inference_ms = 0.0, filter_ms = 0.0;
 };
 
 /// Encodes E (obstacles grown by robot_radius) and S on the network's grid over the map
 /// bounds, runs the generator with noise from Rng(seed, stream 0x5347414e) and filters
-/// (or, with filter = false, only thresholds) the output.
+/// (or, with filter = false, only thresholds) the output; step 5 runs only with strict = true
+/// (opt-in: it costs 0.2-5 ms a query, docs/heuristic.md).
 HeuristicQuery query_region(const Sgan& sgan, const world::Map& map, const Eigen::Vector3d& start,
-                            const Eigen::Vector3d& goal, double robot_radius, std::uint64_t seed, bool filter = true);
+                            const Eigen::Vector3d& goal, double robot_radius, std::uint64_t seed, bool filter = true,
+                            bool strict = false);
 
 }  // namespace miner::heuristic

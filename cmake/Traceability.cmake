@@ -13,7 +13,7 @@ set(_miner_script_citations
     ${PROJECT_SOURCE_DIR}/ci/check_report.py ${PROJECT_SOURCE_DIR}/ci/cluster_test.sh
     ${PROJECT_SOURCE_DIR}/ci/install_test.sh ${PROJECT_SOURCE_DIR}/src/python/tests/test_miner.py
     ${PROJECT_SOURCE_DIR}/ci/check_layout.py ${PROJECT_SOURCE_DIR}/ci/test_mutation.py
-    ${PROJECT_SOURCE_DIR}/src/python/sgan/test_augment.py)
+    ${PROJECT_SOURCE_DIR}/src/python/sgan/test_augment.py ${PROJECT_SOURCE_DIR}/src/python/sgan/test_pool.py)
 add_test(NAME traceability
   COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/ci/trace.py ${_miner_test_files}
           --spec ${PROJECT_SOURCE_DIR}/spec

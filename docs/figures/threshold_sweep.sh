@@ -4,6 +4,8 @@
 # (docs/heuristic.md, "The shipped weights") and how a new network is compared with it.
 #   bash docs/figures/threshold_sweep.sh [build/release/miner] WEIGHTS DATA_ROOT [samples per family] [thresholds]
 # DATA_ROOT holds fam-sim ... fam-scan; prints per threshold the rates over all families and per family.
+# SPLIT=test PREFIX=s16- in the environment: another split and folder prefix (a 16^3 network
+# is swept on 16^3 datasets of its own, docs/heuristic.md).
 set -euo pipefail
 miner=${1:-build/release/miner}
 weights=$2
@@ -15,13 +17,15 @@ py=/usr/bin/python3; [ -x "$py" ] || py=python3
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
 families=(sim indoor cluttered rooms forest multilevel scan)
-folders=(); for f in "${families[@]}"; do folders+=("$data/fam-$f"); done
+split=${SPLIT:-val}
+prefix=${PREFIX:-fam-}
+folders=(); for f in "${families[@]}"; do folders+=("$data/$prefix$f"); done
 echo "| threshold | n | strict connected | strict safe | per family (connected / safe) |"
 echo "|---|---|---|---|---|"
 for t in $thresholds; do
   "$py" "$root/src/python/sgan/set_threshold.py" --weights "$weights" --threshold "$t" --reason sweep \
     --out "$dir/w.bin" >/dev/null
-  "$miner" bench heuristic --data "${folders[@]}" --split val --samples "$n" --no-planners --quiet --json \
+  "$miner" bench heuristic --data "${folders[@]}" --split "$split" --samples "$n" --no-planners --quiet --json \
     --weights "$dir/w.bin" >"$dir/r.json"
   "$py" - "$dir/r.json" "$t" <<'PY'
 import json, sys

@@ -7,6 +7,9 @@
 #   bash docs/sgan-training/families.sh cube    [cuda]    -> the same with the cube's 48 symmetries
 #        (--augment 2) and a width-4 network beside them: session 18's experiment, not shipped
 #        (docs/heuristic.md); one H200, all nine runs at once, 421 s
+#   bash docs/sgan-training/families.sh grid16  [cuda]    -> runs-grid16/all, runs-grid16/without-F: the 16^3
+#        network (train.py --pool 2, fixtures/sgan/grid16 at threshold 0.2); one H200, all eight
+#        runs at once, 178 s (session 19)
 set -euo pipefail
 families=(sim indoor cluttered rooms forest multilevel scan)
 declare -A count=([sim]=2000 [indoor]=1200 [cluttered]=2000 [rooms]=2000 [forest]=2000 [multilevel]=1500 [scan]=700)
@@ -49,5 +52,22 @@ case "${1:-}" in
     for w in 8 4; do train_bg "runs-cube/all-w$w" "runs-cube-all-w$w.log" "$w" 16 2 "${all[@]}"; done
     lofo_bg runs-cube 2
     wait ;;
-  *) echo "usage: $0 data [miner] | train [cuda] | cube [cuda]" >&2; exit 2 ;;
+  grid16)
+    device=${2:-cuda}
+    sgan="$here/src/python/sgan/train.py"
+    python3 "$sgan" --data "${all[@]}" --device "$device" --threads 2 --width 8 --pool 2 --epochs 16 --val-samples 280 \
+      --out runs-grid16/all > runs-grid16-all.log &
+    for held in "${families[@]}"; do
+      rest=(); for f in "${families[@]}"; do [ "$f" != "$held" ] && rest+=("fam-$f"); done
+      python3 "$sgan" --data "${rest[@]}" --device "$device" --threads 1 --width 8 --pool 2 --epochs 8 --val-samples 280 \
+        --out "runs-grid16/without-$held" > "runs-grid16-without-$held.log" &
+    done
+    wait
+    # The threshold, chosen on held-back 16^3 maps (dataset seed 2000003) by strict connectivity
+    # + safety (docs/figures/threshold_sweep.sh with SPLIT=test PREFIX=s16-; docs/heuristic.md):
+    for r in runs-grid16/all runs-grid16/without-*; do
+      python3 "$here/src/python/sgan/set_threshold.py" --weights "$r/sgan.bin" --threshold 0.2 \
+        --reason "chosen on held-back 16^3 maps (seed 2000003) by strict connectivity + safety" --out "$r/sgan-0.2.bin"
+    done ;;
+  *) echo "usage: $0 data [miner] | train [cuda] | cube [cuda] | grid16 [cuda]" >&2; exit 2 ;;
 esac

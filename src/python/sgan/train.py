@@ -66,16 +66,50 @@ import tensors  # noqa: E402
 #                connectivity + safety (GAN training oscillates); "last": the last epoch
 #   val_samples  validation samples scored after each epoch (0: all of them), the first of
 #                each family in turn
+#   pool         1: train on the dataset's grid; 2: on a grid of half the cells per axis, made from
+#                the dataset's (E: free when all 8 cells are, solid when all 8 are, else partial,
+#                which is what `miner dataset --dims` gives for the coarse cell; S: the state cubes
+#                drawn again on the coarse grid from the index's start, goal and bounds, as C++'s
+#                encode_state does; T: a coarse cell is in T when one of its cells is): the
+#                network is 8x cheaper to run (docs/heuristic.md)
 #   scale_channels  3: the network is told sigma, its cells' metric size (model.py); 0: the
 #                graph of the weights trained before (one map family, one scale)
 DEFAULTS = dict(epochs=10, batch=32, lr_g=2e-3, lr_d=2e-4, kappa=1.0, alpha1=0.002, alpha2=1.0, alpha3=0.5,
                 alpha4=100.0, delta=0.5, pos_weight=8.0, width=8, scale_channels=3, threshold=0.5, seed=1, threads=2,
                 max_train=0, references=2, thresholds="0.3,0.4,0.5,0.6,0.7,0.8", augment=1, schedule="cosine",
-                select="best", val_samples=400)
+                select="best", val_samples=400, pool=1)
 
 
-def load_split(data, split):
-    """One folder's split: (meta, uint8 [N, 3, nz, ny, nx], float32 sigma [N, 3])."""
+def cell_of(lo, hi, dims, p):
+    """C++'s heuristic::cell_of: the cell holding p, clamped onto the grid (x, y, z)."""
+    return [int(min(max(math.floor((p[a] - lo[a]) / ((hi[a] - lo[a]) / dims[a])), 0), dims[a] - 1)) for a in range(3)]
+
+
+def pool_samples(x, index, meta, pool):
+    """uint8 [N, 3, nz, ny, nx] on the dataset's grid -> the same on the grid of dims / pool
+    (see `pool` above); meta["dims"] is updated."""
+    n, _, nz, ny, nx = x.shape
+    if nx % pool or ny % pool or nz % pool:
+        raise SystemExit(f"train: --pool {pool} does not divide the grid {meta['dims']}")
+    d = [nx // pool, ny // pool, nz // pool]
+    blocks = x.reshape(n, 3, d[2], pool, d[1], pool, d[0], pool)
+    lo_e, hi_e = blocks[:, 0].min(axis=(2, 4, 6)), blocks[:, 0].max(axis=(2, 4, 6))
+    env = np.where(hi_e == 0, 0, np.where(lo_e == 2, 2, 1)).astype(np.uint8)
+    target = blocks[:, 2].max(axis=(2, 4, 6))
+    state = np.zeros_like(target)
+    r = int(meta.get("dilation", 1))
+    for k, e in enumerate(index):
+        lo, hi = e["bounds"]["min"], e["bounds"]["max"]
+        for p in (e["start"], e["goal"]):
+            c = cell_of(lo, hi, d, p)
+            state[k, max(0, c[2] - r):c[2] + r + 1, max(0, c[1] - r):c[1] + r + 1, max(0, c[0] - r):c[0] + r + 1] = 1
+    meta["dims"] = d
+    return np.ascontiguousarray(np.stack([env, state, target], axis=1))
+
+
+def load_split(data, split, pool=1):
+    """One folder's split: (meta, uint8 [N, 3, nz, ny, nx], float32 sigma [N, 3]), on the
+    dataset's grid or, with pool > 1, on the coarser one of pool_samples."""
     path = os.path.join(data, "dataset.json")
     if not os.path.isfile(path):
         raise SystemExit(f"train: {path} not found (make one with `miner dataset`)")
@@ -98,16 +132,18 @@ def load_split(data, split):
     if len(index) != len(x) or any("bounds" not in e for e in index):
         raise SystemExit(f"train: {index_path} must hold one entry with the map's bounds per sample "
                          "(a dataset written before the bounds were recorded: generate it again)")
+    if pool > 1:
+        x = pool_samples(x, index, meta, pool)
     sigma = np.array([sgan.scale_input(e["bounds"]["min"], e["bounds"]["max"], meta["dims"], meta["robot_radius"])
                       for e in index], dtype=np.float64).astype(np.float32).reshape(-1, 3)
     return meta, x, sigma
 
 
-def load_families(folders, split):
+def load_families(folders, split, pool=1):
     """The folders' split joined: (metas, uint8 samples, float32 sigma, int family of each sample)."""
     metas, xs, sigmas, family = [], [], [], []
     for i, d in enumerate(folders):
-        meta, x, sigma = load_split(d, split)
+        meta, x, sigma = load_split(d, split, pool)
         if metas and meta["dims"] != metas[0]["dims"]:
             raise SystemExit(f"train: {d} has a {meta['dims']} grid, {folders[0]} a {metas[0]['dims']} one")
         metas.append(meta)
@@ -260,8 +296,10 @@ def main(argv=None):
     torch.backends.cudnn.benchmark = False
     torch.manual_seed(a.seed)
     dev = torch.device(a.device)
-    metas, train, train_sigma, _ = load_families(a.data, "train")
-    _, val, val_sigma, val_family = load_families(a.data, "val")
+    if a.pool not in (1, 2):
+        raise SystemExit("train: --pool must be 1 or 2")
+    metas, train, train_sigma, _ = load_families(a.data, "train", a.pool)
+    _, val, val_sigma, val_family = load_families(a.data, "val", a.pool)
     meta = metas[0]
     if a.max_train > 0:
         train, train_sigma = train[:a.max_train], train_sigma[:a.max_train]

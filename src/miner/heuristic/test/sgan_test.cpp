@@ -131,6 +131,23 @@ TEST_CASE("MINER's own kernels and oneDNN's agree with each other and with PyTor
   CHECK(worst <= 1e-5);
 }
 
+TEST_CASE("The 16^3 network (fixtures/sgan/grid16) agrees with PyTorch on both kernel paths", "[REQ-HEUR-005]") {
+  const std::string dir = kFixtures + "grid16/";
+  const std::string blob = miner::read_file_bytes(dir + "sgan.bin");
+  const heuristic::Sgan fast = heuristic::Sgan::from_bytes(blob, "grid16");
+  const heuristic::Sgan onednn = heuristic::Sgan::from_bytes(blob, "grid16", heuristic::Sgan::Kernels::kOneDnn);
+  CHECK(fast.architecture().dims == Eigen::Vector3i(16, 16, 16));
+  CHECK(fast.own_kernels());
+  for (const heuristic::Sgan* g : {&fast, &onednn}) {
+    const std::vector<double> errors = heuristic::reference_errors(*g, dir + "reference.bin");
+    REQUIRE(errors.size() >= 1);
+    for (double e : errors) CHECK(e <= heuristic::kReferenceTolerance);
+  }
+  // Each leave-one-family-out network loads and shares the grid.
+  for (const char* f : {"sim", "indoor", "cluttered", "rooms", "forest", "multilevel", "scan"})
+    CHECK(heuristic::Sgan::load(dir + "lofo/without-" + f + ".bin").architecture().dims == Eigen::Vector3i(16, 16, 16));
+}
+
 TEST_CASE("The same inputs and seed give the same region bytes", "[REQ-HEUR-005]") {
   const heuristic::Sgan g = heuristic::Sgan::builtin();
   const auto n = static_cast<std::size_t>(g.architecture().dims.prod());

@@ -4,6 +4,7 @@
 # planner, interleaved; miner-sgan (region query included) against the fastest other planner,
 # the A*-oracle `miner` shown apart (an upper bound, not a competitor).
 #   bash docs/figures/frontend-unseen.sh [build/release/miner] [runs] [families...]
+# WEIGHTS=fixtures/sgan/grid16/sgan.bin in the environment: miner-sgan with other weights.
 set -euo pipefail
 miner=${1:-build/release/miner}
 runs=${2:-20}
@@ -14,7 +15,8 @@ dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
 for f in "${families[@]}"; do
   "$miner" map gen --preset "$f" --seed 1000003 --quiet --out "$dir/$f.json" >/dev/null
-  "$miner" bench frontend --map "$dir/$f.json" --runs "$runs" --time-limit 1 --quiet --json >"$dir/$f-bench.json"
+  "$miner" bench frontend --map "$dir/$f.json" --runs "$runs" --time-limit 1 --quiet --json \
+    ${WEIGHTS:+--weights "$WEIGHTS"} >"$dir/$f-bench.json"
 done
 python3 - "$dir" "${families[@]}" <<'PY'
 import json, sys

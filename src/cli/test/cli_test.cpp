@@ -1020,7 +1020,7 @@ TEST_CASE("miner sgan check compares C++ inference with PyTorch's reference tens
   CHECK_THAT(bad.err, Contains("missing.bin"));
 }
 
-TEST_CASE("--strict-bridge adds filter step 5 and reports its checked polyline", "[REQ-HEUR-014]") {
+TEST_CASE("miner heuristic --strict-bridge adds filter step 5 and reports its checked polyline", "[REQ-HEUR-014]") {
   const std::string map = dir() + "/rooms-strict.json";
   REQUIRE(miner_cli({"map", "gen", "--preset", "rooms", "--seed", "5", "--out", map}).code == 0);
   const Run plain = miner_cli({"heuristic", "--map", map, "--out", dir() + "/plain-region.json", "--json"});

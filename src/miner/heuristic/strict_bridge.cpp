@@ -98,8 +98,9 @@ class Graph {
     }
     return near_[c] == 1;
   }
-  /// The polyline of a move from u to v: its interior vertex (the point where it crosses
-  /// from a whole cell into a sub-cell's cell or back), if any, goes in `via`.
+  /// The interior vertex of a move between a whole cell and a sub-cell of a neighbouring
+  /// cell: the sub-cell's centre moved onto the face the two cells share. Written to
+  /// `point`; false (no vertex) for any other move.
   bool via(Id u, Id v, Eigen::Vector3d& point) const {
     if (u >= kGoal || v >= kGoal || fine(u) == fine(v)) return false;
     const Id f = fine(u) ? u : v;
@@ -109,8 +110,8 @@ class Graph {
     point = position(f);
     for (int a = 0; a < 3; ++a) {
       const int wf = wc[a] * k_[a];  // the whole cell's first sub-cell along a
-      if (fc[a] < wf) point[a] = origin_[a] + wc[a] * cell_[a];             // whole cell above
-      else if (fc[a] >= wf + k_[a]) point[a] = origin_[a] + (wc[a] + 1) * cell_[a];  // below
+      if (fc[a] < wf) point[a] = origin_[a] + wc[a] * cell_[a];  // sub-cell below: the lower face
+      else if (fc[a] >= wf + k_[a]) point[a] = origin_[a] + (wc[a] + 1) * cell_[a];  // above: the upper
     }
     return true;
   }

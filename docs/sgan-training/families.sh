@@ -15,20 +15,31 @@ families=(sim indoor cluttered rooms forest multilevel scan)
 declare -A count=([sim]=2000 [indoor]=1200 [cluttered]=2000 [rooms]=2000 [forest]=2000 [multilevel]=1500 [scan]=700)
 here=$(cd "$(dirname "$0")/../.." && pwd)
 all=(); for f in "${families[@]}"; do all+=("fam-$f"); done
-# train_bg OUT LOG WIDTH EPOCHS AUGMENT DATA...: one train.py run in the background (AUGMENT empty:
-# train.py's default). The options keep one order: train.py records its command in the weights.
+# train_bg OUT LOG WIDTH EPOCHS OPTIONS DATA...: one train.py run in the background; OPTIONS (may
+# be empty) go after --width, e.g. "--augment 2" or "--pool 2"; threads=N before the call sets
+# --threads (default 1). The options keep one order: train.py records its command in the weights.
 train_bg() {
-  local out=$1 log=$2 width=$3 epochs=$4 augment=$5
+  local out=$1 log=$2 width=$3 epochs=$4 options=$5
   shift 5
-  python3 "$here/src/python/sgan/train.py" --data "$@" --device "$device" --threads 1 --width "$width" \
-    ${augment:+--augment "$augment"} --epochs "$epochs" --val-samples 280 --out "$out" > "$log" &
+  # shellcheck disable=SC2086  # OPTIONS are words
+  python3 "$here/src/python/sgan/train.py" --data "$@" --device "$device" --threads "${threads:-1}" --width "$width" \
+    $options --epochs "$epochs" --val-samples 280 --out "$out" > "$log" &
 }
-# lofo_bg PREFIX AUGMENT: the seven leave-one-family-out runs (width 8, 8 epochs).
+# lofo_bg PREFIX OPTIONS: the seven leave-one-family-out runs (width 8, 8 epochs).
 lofo_bg() {
   local held f rest
   for held in "${families[@]}"; do
     rest=(); for f in "${families[@]}"; do [ "$f" != "$held" ] && rest+=("fam-$f"); done
     train_bg "$1/without-$held" "$1-without-$held.log" 8 8 "$2" "${rest[@]}"
+  done
+}
+# set_threshold T REASON RUN...: RUN/sgan-T.bin, each RUN's weights with threshold T.
+set_threshold() {
+  local t=$1 reason=$2 r
+  shift 2
+  for r in "$@"; do
+    python3 "$here/src/python/sgan/set_threshold.py" --weights "$r/sgan.bin" --threshold "$t" --reason "$reason" \
+      --out "$r/sgan-$t.bin"
   done
 }
 case "${1:-}" in
@@ -43,31 +54,20 @@ case "${1:-}" in
     lofo_bg runs ""
     wait
     # The threshold, chosen on the validation split by the strict rates (docs/heuristic.md):
-    for r in runs/all runs/without-*; do
-      python3 "$here/src/python/sgan/set_threshold.py" --weights "$r/sgan.bin" --threshold 0.1 \
-        --reason "chosen on the validation split by strict connectivity + safety" --out "$r/sgan-0.1.bin"
-    done ;;
+    set_threshold 0.1 "chosen on the validation split by strict connectivity + safety" runs/all runs/without-* ;;
   cube)
     device=${2:-cuda}
-    for w in 8 4; do train_bg "runs-cube/all-w$w" "runs-cube-all-w$w.log" "$w" 16 2 "${all[@]}"; done
-    lofo_bg runs-cube 2
+    for w in 8 4; do train_bg "runs-cube/all-w$w" "runs-cube-all-w$w.log" "$w" 16 "--augment 2" "${all[@]}"; done
+    lofo_bg runs-cube "--augment 2"
     wait ;;
   grid16)
     device=${2:-cuda}
-    sgan="$here/src/python/sgan/train.py"
-    python3 "$sgan" --data "${all[@]}" --device "$device" --threads 2 --width 8 --pool 2 --epochs 16 --val-samples 280 \
-      --out runs-grid16/all > runs-grid16-all.log &
-    for held in "${families[@]}"; do
-      rest=(); for f in "${families[@]}"; do [ "$f" != "$held" ] && rest+=("fam-$f"); done
-      python3 "$sgan" --data "${rest[@]}" --device "$device" --threads 1 --width 8 --pool 2 --epochs 8 --val-samples 280 \
-        --out "runs-grid16/without-$held" > "runs-grid16-without-$held.log" &
-    done
+    threads=2 train_bg runs-grid16/all runs-grid16-all.log 8 16 "--pool 2" "${all[@]}"
+    lofo_bg runs-grid16 "--pool 2"
     wait
     # The threshold, chosen on held-back 16^3 maps (dataset seed 2000003) by strict connectivity
     # + safety (docs/figures/threshold_sweep.sh with SPLIT=test PREFIX=s16-; docs/heuristic.md):
-    for r in runs-grid16/all runs-grid16/without-*; do
-      python3 "$here/src/python/sgan/set_threshold.py" --weights "$r/sgan.bin" --threshold 0.2 \
-        --reason "chosen on held-back 16^3 maps (seed 2000003) by strict connectivity + safety" --out "$r/sgan-0.2.bin"
-    done ;;
+    set_threshold 0.2 "chosen on held-back 16^3 maps (seed 2000003) by strict connectivity + safety" \
+      runs-grid16/all runs-grid16/without-* ;;
   *) echo "usage: $0 data [miner] | train [cuda] | cube [cuda] | grid16 [cuda]" >&2; exit 2 ;;
 esac

@@ -163,6 +163,10 @@ nlohmann::json quality_json(const std::vector<HeuristicSampleRecord>& samples, b
     bridged += s.bridge_cells > 0 ? 1 : 0;
   }
   using R = HeuristicSampleRecord;
+  // The share of the samples counted (0 for none).
+  const auto share = [&](std::size_t count) {
+    return static_cast<double>(count) / static_cast<double>(std::max<std::size_t>(samples.size(), 1));
+  };
   nlohmann::json j = {{"samples", samples.size()},
                       {"connectivity_rate_raw", rate(samples, &R::raw_connected)},
                       {"safety_rate_raw", rate(samples, &R::raw_safe)},
@@ -174,10 +178,10 @@ nlohmann::json quality_json(const std::vector<HeuristicSampleRecord>& samples, b
                       {"safety_rate_strict_filtered", rate(samples, &R::safe_strict)},
                       {"connectivity_rate_strict_truth", rate(samples, &R::truth_connected_strict)},
                       {"safety_rate_strict_truth", rate(samples, &R::truth_safe_strict)},
-                      {"bridged_rate", static_cast<double>(bridged) / static_cast<double>(std::max<std::size_t>(samples.size(), 1))},
+                      {"bridged_rate", share(bridged)},
                       {"raw_cells_median", num(median(raw_cells))},
                       {"cells_median", num(median(cells))},
-                      {"strict_bridged_rate", static_cast<double>(strict_bridged) / static_cast<double>(std::max<std::size_t>(samples.size(), 1))},
+                      {"strict_bridged_rate", share(strict_bridged)},
                       {"strict_witness_rate", rate(samples, &R::strict_witness)},
                       {"inference_ms", num(median(inference))},
                       {"filter_ms", num(median(filter))},

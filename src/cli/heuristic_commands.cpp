@@ -56,10 +56,10 @@ Json strict_json(const heuristic::HeuristicQuery& h) {
 }
 
 void run_heuristic(const HeuristicCliOptions& o, std::ostream& out) {
+  if (o.raw && o.strict_bridge) throw Error("--strict-bridge: is a filter step, --raw writes the unfiltered output");
   const ResolvedQuery q = resolve_query(o.query);
   plan::PlanningProblem::make(q.map, q.start, q.goal, q.radius);  // start/goal checks, named errors
   const heuristic::Sgan sgan = heuristic::Sgan::load_or_builtin(o.weights);
-  if (o.raw && o.strict_bridge) throw Error("--strict-bridge: is a filter step, --raw writes the unfiltered output");
   const heuristic::HeuristicQuery h =
       heuristic::query_region(sgan, q.map, q.start, q.goal, q.radius, o.seed, !o.raw, o.strict_bridge);
   h.region.save(o.region_out);

@@ -68,13 +68,6 @@ class Graph {
     }
     return origin_ + (fine_coords(id).cast<double>().array() + 0.5).matrix().cwiseProduct(sub_);
   }
-  /// The sub-cell holding p (clamped onto the fine grid).
-  Eigen::Vector3i fine_of(const Eigen::Vector3d& p) const {
-    Eigen::Vector3i f;
-    for (int a = 0; a < 3; ++a)
-      f[a] = std::clamp(static_cast<int>(std::floor((p[a] - origin_[a]) / sub_[a])), 0, fine_[a] - 1);
-    return f;
-  }
   /// A whole node: a kFree cell. On a box map no point of it is within the robot radius of
   /// an obstacle; a voxel layer's kFree is read from voxel centres, not exact, so there its
   /// moves are tested too (move_free).
@@ -212,7 +205,6 @@ class Graph {
   }
 
   double to_goal(Id id) const { return (position(id) - goal_).norm(); }
-  const Eigen::Vector3i& split() const { return k_; }
 
  private:
   const world::Map& map_;

@@ -267,6 +267,8 @@ def parse_args(argv):
         raise SystemExit("train: --select must be best or last")
     if a.augment not in (0, 1, 2) or a.val_samples < 0:
         raise SystemExit("train: --augment must be 0, 1 or 2 and --val-samples >= 0")
+    if a.pool not in (1, 2):
+        raise SystemExit("train: --pool must be 1 or 2")
     try:
         a.candidates = sorted({float(t) for t in a.thresholds.split(",")} | {a.threshold})
     except ValueError:
@@ -296,8 +298,6 @@ def main(argv=None):
     torch.backends.cudnn.benchmark = False
     torch.manual_seed(a.seed)
     dev = torch.device(a.device)
-    if a.pool not in (1, 2):
-        raise SystemExit("train: --pool must be 1 or 2")
     metas, train, train_sigma, _ = load_families(a.data, "train", a.pool)
     _, val, val_sigma, val_family = load_families(a.data, "val", a.pool)
     meta = metas[0]

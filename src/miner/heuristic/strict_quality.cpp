@@ -1,11 +1,13 @@
 #include "miner/heuristic/strict_quality.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <vector>
 
 #include "miner/plan/heuristic_region.hpp"
+#include "miner/world/astar.hpp"
 #include "miner/world/map.hpp"
 #include "miner/world/voxel_grid.hpp"
 
@@ -44,21 +46,28 @@ StrictQuality strict_quality(const world::Map& map, const world::VoxelGrid& grid
   if (!a || !b) return q;
   const std::size_t from = grid.index(*a), to = grid.index(*b);
   if (!passable[from] || !passable[to]) return q;
+  // A*'s own graph (world::grid_moves): 26 neighbours, a diagonal step only where every cell
+  // of the block it crosses is free. The step's segment runs between the two voxel centres and
+  // so stays inside those two voxels, both in H; the block's other voxels need only be free.
+  const std::array<world::GridMove, 26> moves = world::grid_moves(dims);
   std::vector<std::size_t> queue{from};
   passable[from] = 2;  // visited
   for (std::size_t head = 0; head < queue.size() && !q.connected; ++head) {
-    const Eigen::Vector3i c = grid.coords(queue[head]);
-    for (int axis = 0; axis < 3; ++axis)
-      for (int step : {-1, 1}) {
-        Eigen::Vector3i n = c;
-        n[axis] += step;
-        if (n[axis] < 0 || n[axis] >= dims[axis]) continue;
-        const std::size_t v = grid.index(n);
-        if (passable[v] != 1) continue;
-        passable[v] = 2;
-        if (v == to) q.connected = true;
-        queue.push_back(v);
-      }
+    const std::size_t cur = queue[head];
+    const Eigen::Vector3i c = grid.coords(cur);
+    for (const world::GridMove& m : moves) {
+      const Eigen::Vector3i n = c + Eigen::Vector3i(m.dx, m.dy, m.dz);
+      if ((n.array() < 0).any() || (n.array() >= dims.array()).any()) continue;
+      const std::size_t v = grid.index(n);
+      if (passable[v] != 1) continue;
+      bool block_free = true;
+      for (int w = 0; w < m.n_between && block_free; ++w)
+        block_free = !grid.occupied(static_cast<std::size_t>(static_cast<std::ptrdiff_t>(cur) + m.between[static_cast<std::size_t>(w)]));
+      if (!block_free) continue;
+      passable[v] = 2;
+      if (v == to) q.connected = true;
+      queue.push_back(v);
+    }
   }
   return q;
 }

@@ -6,13 +6,15 @@
 /// open; these do not:
 ///
 ///   connected_strict: a collision-free path for the robot radius joins x_init and x_goal
-///     inside H. Checked by a planner restricted to H: breadth-first search over the cells
-///     of the map's conservative voxel grid (world::VoxelGrid, occupied when the cell meets
-///     an obstacle grown by the robot radius) that are free and whose centres lie in H,
-///     face to face. A chain of free face-adjacent cells is a collision-free polyline of
-///     cell centres (REQ-WORLD-008), and a 26-connected chain without corner cutting (what
-///     A* allows) always has a face-connected one through the same free block, so the
-///     answer is A*'s restricted to H.
+///     inside H. Checked by a planner restricted to H: A*'s own graph (world::grid_moves)
+///     searched breadth first over the cells of the map's conservative voxel grid
+///     (world::VoxelGrid, occupied when the cell meets an obstacle grown by the robot radius)
+///     that are free and whose centres lie in H: 26 neighbours, a diagonal step only where
+///     every cell of the block it crosses is free (no corner cutting, REQ-WORLD-008). A step
+///     runs between two voxel centres and so stays inside those two voxels, both in H; the
+///     block's other voxels need only be free, not in H. The answer is A*'s restricted to H:
+///     the A* path's own cells are connected, which a face-to-face search (sessions 12-19)
+///     denied whenever a diagonal step crossed the corner of a cell outside H.
 ///   safe_strict: at most kStrictUnsafeFraction (5 %) of H's volume lies within the robot
 ///     radius of an obstacle (its interior included), measured by the midpoint rule on the
 ///     same voxels: a voxel of H counts as unsafe when its centre lies within the robot

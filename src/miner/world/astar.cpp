@@ -14,31 +14,20 @@
 namespace miner::world {
 
 namespace {
-
 constexpr double kSqrt2 = 1.4142135623730951;
 constexpr double kSqrt3 = 1.7320508075688772;
+}  // namespace
 
-/// A 26-connected step in index arithmetic for one grid: the neighbour is `offset` cells away
-/// and the block it spans with the current cell holds `between` (the cells other than the two
-/// ends: 0, 2 or 6 of them), which must be free too (no corner cutting).
-struct Move {
-  int dx, dy, dz;
-  double length;  // in cells
-  std::ptrdiff_t offset;
-  std::array<std::ptrdiff_t, 6> between;
-  int n_between;
-};
-
-std::array<Move, 26> make_moves(const Eigen::Vector3i& dims) {
+std::array<GridMove, 26> grid_moves(const Eigen::Vector3i& dims) {
   const std::ptrdiff_t sy = dims.x(), sz = static_cast<std::ptrdiff_t>(dims.x()) * dims.y();
-  std::array<Move, 26> moves{};
+  std::array<GridMove, 26> moves{};
   int n = 0;
   for (int dz = -1; dz <= 1; ++dz)
     for (int dy = -1; dy <= 1; ++dy)
       for (int dx = -1; dx <= 1; ++dx) {
         const int nonzero = (dx != 0) + (dy != 0) + (dz != 0);
         if (nonzero == 0) continue;
-        Move& m = moves[static_cast<std::size_t>(n++)];
+        GridMove& m = moves[static_cast<std::size_t>(n++)];
         m.dx = dx;
         m.dy = dy;
         m.dz = dz;
@@ -55,6 +44,8 @@ std::array<Move, 26> make_moves(const Eigen::Vector3i& dims) {
       }
   return moves;
 }
+
+namespace {
 
 /// The octile distance in cells for coordinate differences (the same expression as
 /// octile_distance at resolution 1, so costs and the expansion order are unchanged).
@@ -94,7 +85,7 @@ GridPath astar(const Map& map, const VoxelGrid& grid, const Eigen::Vector3d& sta
   const Eigen::Vector3i g = endpoint_cell(map, grid, goal, "goal");
   // Index arithmetic in the inner loop: A* runs inside every generated map's solvability
   // check and every dataset sample, so this loop is most of their cost.
-  const std::array<Move, 26> moves = make_moves(grid.dims());
+  const std::array<GridMove, 26> moves = grid_moves(grid.dims());
   const std::size_t nx = static_cast<std::size_t>(grid.dims().x()), ny = static_cast<std::size_t>(grid.dims().y());
   const int dims[3] = {grid.dims().x(), grid.dims().y(), grid.dims().z()};
 
@@ -121,7 +112,7 @@ GridPath astar(const Map& map, const VoxelGrid& grid, const Eigen::Vector3d& sta
     if (cur == gi) break;
     const int cx = static_cast<int>(cur % nx), cy = static_cast<int>((cur / nx) % ny), cz = static_cast<int>(cur / (nx * ny));
     const auto at = [cur](std::ptrdiff_t offset) { return static_cast<std::size_t>(static_cast<std::ptrdiff_t>(cur) + offset); };
-    for (const Move& m : moves) {
+    for (const GridMove& m : moves) {
       const int x = cx + m.dx, y = cy + m.dy, z = cz + m.dz;
       if (x < 0 || y < 0 || z < 0 || x >= dims[0] || y >= dims[1] || z >= dims[2]) continue;
       const std::size_t ni = at(m.offset);

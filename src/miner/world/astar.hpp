@@ -4,6 +4,7 @@
 /// path of the sGAN dataset and the reference cost for planners (REQ-WORLD-007,
 /// REQ-WORLD-008).
 
+#include <array>
 #include <cstddef>
 #include <vector>
 
@@ -23,6 +24,22 @@ struct GridPath {
   double cost = 0.0;       ///< Euclidean length of `points` (start and goal legs included)
   std::size_t expanded = 0;  ///< cells taken off the open list
 };
+
+/// One edge of A*'s graph in index arithmetic for a grid of `dims` cells: the neighbour is
+/// `offset` cells away, and the block the step spans with the current cell holds `between`
+/// (the cells other than its two ends: 0, 2 or 6 of them), which must be free too, so no move
+/// cuts a corner of an occupied cell. The strict connectivity of a heuristic region
+/// (REQ-HEUR-011) searches the same graph, so both answer "is there a path" alike.
+struct GridMove {
+  int dx, dy, dz;
+  double length;  ///< in cells: 1, sqrt 2 or sqrt 3
+  std::ptrdiff_t offset;
+  std::array<std::ptrdiff_t, 6> between;
+  int n_between;
+};
+
+/// The 26 moves of the grid graph (the caller checks that the neighbour is inside the grid).
+std::array<GridMove, 26> grid_moves(const Eigen::Vector3i& dims);
 
 /// Shortest path on the grid's 26-neighbour graph between the cells of `start` and
 /// `goal`, with edge length = distance between cell centres. A diagonal move is allowed

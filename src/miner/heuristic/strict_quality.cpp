@@ -18,26 +18,48 @@ StrictQuality strict_quality(const world::Map& map, const world::VoxelGrid& grid
   StrictQuality q;
   // passable[v]: voxel v is free and its centre lies in H. Only the voxels under H's cells
   // are visited (H is a few per cent of the map), each once: a voxel belongs to the cell
-  // holding its centre.
+  // holding its centre. Which cell that is depends on each axis alone (HeuristicRegion::
+  // cell_at floors each coordinate), so the voxels of cell column c along axis a are one
+  // run [first[a][c], last[a][c]], found once per axis with cell_at itself (the same
+  // arithmetic, so the same answer at every boundary), not once per voxel.
   std::vector<std::uint8_t> passable(grid.cell_count(), 0);
   std::size_t unsafe = 0;
   const Eigen::Vector3i dims = grid.dims();
-  for (const std::size_t cell : region.cells()) {
-    const world::Box box = region.cell_box(cell);
-    Eigen::Vector3i lo, hi;
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = std::max(0, static_cast<int>(std::floor((box.min[a] - grid.origin()[a]) / grid.resolution())));
-      hi[a] = std::min(dims[a] - 1, static_cast<int>(std::floor((box.max[a] - grid.origin()[a]) / grid.resolution())));
+  const Eigen::Vector3i cells = region.dims();
+  std::array<std::vector<int>, 3> first, last;
+  for (int a = 0; a < 3; ++a) {
+    first[static_cast<std::size_t>(a)].assign(static_cast<std::size_t>(cells[a]), 0);
+    last[static_cast<std::size_t>(a)].assign(static_cast<std::size_t>(cells[a]), -1);
+    Eigen::Vector3d p = region.bounds().min;
+    for (int i = 0; i < dims[a]; ++i) {
+      Eigen::Vector3i v = Eigen::Vector3i::Zero();
+      v[a] = i;
+      p[a] = grid.cell_center(v)[a];
+      const long c = region.cell_at(p);
+      if (c < 0) continue;  // a voxel centre outside H's bounds belongs to no cell
+      const int column = region.coords(static_cast<std::size_t>(c))[a];
+      auto& f = first[static_cast<std::size_t>(a)][static_cast<std::size_t>(column)];
+      auto& l = last[static_cast<std::size_t>(a)][static_cast<std::size_t>(column)];
+      if (l < f) f = i;
+      l = i;
     }
-    for (int k = lo.z(); k <= hi.z(); ++k)
-      for (int j = lo.y(); j <= hi.y(); ++j)
-        for (int i = lo.x(); i <= hi.x(); ++i) {
-          const Eigen::Vector3d centre = grid.cell_center(Eigen::Vector3i(i, j, k));
-          if (region.cell_at(centre) != static_cast<long>(cell)) continue;
+  }
+  const std::size_t nx = static_cast<std::size_t>(dims.x()), nxy = nx * static_cast<std::size_t>(dims.y());
+  const double radius = grid.robot_radius();
+  for (const std::size_t cell : region.cells()) {
+    const Eigen::Vector3i c = region.coords(cell);
+    const int i0 = first[0][static_cast<std::size_t>(c.x())], i1 = last[0][static_cast<std::size_t>(c.x())];
+    const int j0 = first[1][static_cast<std::size_t>(c.y())], j1 = last[1][static_cast<std::size_t>(c.y())];
+    const int k0 = first[2][static_cast<std::size_t>(c.z())], k1 = last[2][static_cast<std::size_t>(c.z())];
+    for (int k = k0; k <= k1; ++k)
+      for (int j = j0; j <= j1; ++j) {
+        std::size_t v = static_cast<std::size_t>(k) * nxy + static_cast<std::size_t>(j) * nx + static_cast<std::size_t>(i0);
+        for (int i = i0; i <= i1; ++i, ++v) {
           ++q.voxels;
-          if (!map.is_free(centre, grid.robot_radius())) ++unsafe;
-          if (!grid.occupied(Eigen::Vector3i(i, j, k))) passable[grid.index(i, j, k)] = 1;
+          if (!map.is_free(grid.cell_center(Eigen::Vector3i(i, j, k)), radius)) ++unsafe;
+          if (!grid.occupied(v)) passable[v] = 1;
         }
+      }
   }
   q.unsafe_fraction = q.voxels > 0 ? static_cast<double>(unsafe) / static_cast<double>(q.voxels) : 1.0;
   q.safe = q.voxels > 0 && q.unsafe_fraction <= kStrictUnsafeFraction;
@@ -52,17 +74,19 @@ StrictQuality strict_quality(const world::Map& map, const world::VoxelGrid& grid
   const std::array<world::GridMove, 26> moves = world::grid_moves(dims);
   std::vector<std::size_t> queue{from};
   passable[from] = 2;  // visited
+  const int dim[3] = {dims.x(), dims.y(), dims.z()};
   for (std::size_t head = 0; head < queue.size() && !q.connected; ++head) {
     const std::size_t cur = queue[head];
-    const Eigen::Vector3i c = grid.coords(cur);
+    const int cx = static_cast<int>(cur % nx), cy = static_cast<int>((cur / nx) % static_cast<std::size_t>(dim[1])),
+              cz = static_cast<int>(cur / nxy);
     for (const world::GridMove& m : moves) {
-      const Eigen::Vector3i n = c + Eigen::Vector3i(m.dx, m.dy, m.dz);
-      if ((n.array() < 0).any() || (n.array() >= dims.array()).any()) continue;
-      const std::size_t v = grid.index(n);
+      const int x = cx + m.dx, y = cy + m.dy, z = cz + m.dz;
+      if (x < 0 || y < 0 || z < 0 || x >= dim[0] || y >= dim[1] || z >= dim[2]) continue;
+      const auto at = [cur](std::ptrdiff_t offset) { return static_cast<std::size_t>(static_cast<std::ptrdiff_t>(cur) + offset); };
+      const std::size_t v = at(m.offset);
       if (passable[v] != 1) continue;
       bool block_free = true;
-      for (int w = 0; w < m.n_between && block_free; ++w)
-        block_free = !grid.occupied(static_cast<std::size_t>(static_cast<std::ptrdiff_t>(cur) + m.between[static_cast<std::size_t>(w)]));
+      for (int w = 0; w < m.n_between && block_free; ++w) block_free = !grid.occupied(at(m.between[static_cast<std::size_t>(w)]));
       if (!block_free) continue;
       passable[v] = 2;
       if (v == to) q.connected = true;

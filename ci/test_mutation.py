@@ -46,6 +46,17 @@ class CatalogueTest(unittest.TestCase):
         got = self.load([mutant(), mutant(id="traj-002", operator="comparison", find="1 < 2", replace="1 <= 2")])
         self.assertEqual([m["id"] for m in got], ["traj-001", "traj-002"])
 
+    def test_the_repository_catalogue_applies_to_this_tree(self):
+        # Every mutant's `find` still occurs exactly once in its file and every requirement it
+        # names exists in spec/: a refactoring that moves the mutated line must move the mutant.
+        root = pathlib.Path(__file__).resolve().parent.parent
+        got = mutation.load_catalogue(root / "ci" / "mutants.json", root)
+        self.assertGreaterEqual(len(got), 50)
+        spec = "".join(p.read_text() for p in (root / "spec").glob("*.md"))
+        for m in got:
+            for req in m["requirements"]:
+                self.assertIn("### " + req + ":", spec, m["id"])
+
     def test_bad_catalogues_are_refused_naming_the_fault(self):
         self.refused([mutant()], "format must be", fmt="other")
         self.refused([], "non-empty")

@@ -462,15 +462,21 @@ std::vector<std::string> numeric_options_without_checks() {
 
 namespace {
 
-int cli_main(const std::vector<std::string>& args, std::ostream& out, std::ostream& err, Mode mode) {
-  g_quiet = false;
-  CLI::App app{"miner — MINER-RRT* quadrotor planning and flight stack", "miner"};
+constexpr const char* kAppDescription = "miner — MINER-RRT* quadrotor planning and flight stack";
+
+/// Every command and option on `app`; commands print to `out`.
+void build_app(CLI::App& app, std::ostream& out, Mode mode) {
   add_commands(app, out);
   app.parse_complete_callback([&app, mode] {
     check_outputs_against_inputs(&app);
     if (mode == Mode::kParseOnly) throw ParsedOnly{};
   });
+}
 
+/// One command line on a built app. CLI11 clears an app's parse state (option results,
+/// counts, chosen subcommands) at the start of every parse, so an app may parse many lines.
+int parse_line(CLI::App& app, const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+  g_quiet = false;
   {
     std::string path, unknown_command;
     CLI::App* cmd = addressed_command(&app, args, path, unknown_command);
@@ -527,7 +533,26 @@ int cli_main(const std::vector<std::string>& args, std::ostream& out, std::ostre
   return 0;
 }
 
+int cli_main(const std::vector<std::string>& args, std::ostream& out, std::ostream& err, Mode mode) {
+  CLI::App app{kAppDescription, "miner"};
+  build_app(app, out, mode);
+  return parse_line(app, args, out, err);
+}
+
 }  // namespace
+
+struct ArgumentChecker::Impl {
+  std::ostringstream unused;  // what a command would print: none runs in this mode
+  CLI::App app{kAppDescription, "miner"};
+  Impl() { build_app(app, unused, Mode::kParseOnly); }
+};
+
+ArgumentChecker::ArgumentChecker() : impl_(std::make_unique<Impl>()) {}
+ArgumentChecker::~ArgumentChecker() = default;
+
+int ArgumentChecker::check(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+  return parse_line(impl_->app, args, out, err);
+}
 
 std::ostream* progress_stream() { return g_quiet ? nullptr : terminal_stream(); }
 

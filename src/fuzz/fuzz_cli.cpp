@@ -21,8 +21,11 @@ void parse(const std::string& text) {
     args.push_back(text.substr(begin, end - begin));
     begin = end + 1;
   }
+  // One app for every input: building its ~170 options per input was ~80 % of the time
+  // (~120 inputs/s under the sanitizers); ArgumentChecker answers each line as a fresh app.
+  static miner::cli::ArgumentChecker checker;
   std::ostringstream out, err;
-  const int code = miner::cli::check_cli_arguments(args, out, err);
+  const int code = checker.check(args, out, err);
   // run_cli's last-resort message begins the output; an argument echoed inside a refusal may
   // contain any text, so only the start counts.
   if (err.str().rfind("miner: internal error", 0) == 0) std::abort();

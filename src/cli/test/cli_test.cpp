@@ -516,6 +516,57 @@ TEST_CASE("The argument layer alone: refusals as run_cli gives them, and no comm
   CHECK(check({"bench", "merge", "a.json", "b.json"}).code == 0);  // the files are read by the command, not the parser
 }
 
+TEST_CASE("An argument checker built once answers every line as a fresh one", "[REQ-CLI-002][REQ-HARNESS-006]") {
+  // The fuzz target parses millions of lines on one app: a line's answer must not depend on
+  // the lines before it (options, counts, chosen subcommands, help), so each line below is
+  // checked right after lines that set other options of the same command.
+  const std::string run = dir() + "/checker-run";
+  const std::vector<std::vector<std::string>> lines = {
+      {"fly", "--out", run, "--seed", "3"},
+      {"fly", "--out", run},
+      {"fly", "--seed", "3", "--seed", "4", "--out", run},
+      {"plan", "--map", "m.json", "--planner", "miner", "--strict-bridge"},
+      {"plan", "--map", "m.json", "--region", "astar", "--strict-bridge"},
+      {"plan", "--map", "m.json"},
+      {"plan"},
+      {"region", "astar", "--dims", "1", "2"},
+      {"region", "astar", "--map", "m.json", "--start", "1", "1", "1", "--goal", "2", "2", "2", "--out", "r.json"},
+      {"region", "astar", "--map", "m.json", "--start", "1", "1", "1", "--goal", "2", "2", "2", "--out", "r.json", "--dims", "8", "8", "8"},
+      {"plna"},
+      {"plan", "--help"},
+      {"--help"},
+      {"bench", "frontend", "--help"},
+      {"bench", "merge"},
+      {"bench", "merge", "a.json", "b.json"},
+      {"bench", "merge", "a.json"},
+      {"astar", "--map", "m.json", "--radius", "-1"},
+      {"astar", "--map", "m.json", "--start", "-1", "5", "5", "--goal", "9", "-5", "5", "--out", "m.json"},
+      {"astar", "--map", "m.json", "--start", "-1", "5", "5", "--goal", "9", "-5", "5"},
+      {},
+      {"--version"},
+      {"plan", "--seed", "-1", "--map", "x.json"},
+      {"plan", "--seed", "18446744073709551615", "--map", "x.json"},
+  };
+  miner::cli::ArgumentChecker reused;
+  int refused = 0;
+  for (int pass = 0; pass < 2; ++pass)  // the second pass follows every line once more
+    for (const auto& line : lines) {
+      std::ostringstream fresh_out, fresh_err, out, err;
+      const int fresh = miner::cli::check_cli_arguments(line, fresh_out, fresh_err);
+      const int code = reused.check(line, out, err);
+      std::string joined;
+      for (const auto& a : line) joined += a + " ";
+      INFO(joined << "\n" << fresh_err.str());
+      CHECK(code == fresh);
+      CHECK(out.str() == fresh_out.str());
+      CHECK(err.str() == fresh_err.str());
+      refused += fresh != 0;
+    }
+  CHECK(refused >= 12);  // the list holds refusals and acceptances alike (16 of 48 today)
+  CHECK(refused <= 36);
+  CHECK_FALSE(std::filesystem::exists(run));
+}
+
 TEST_CASE("Seeds are refused, not wrapped or clamped, when negative or above 2^64 - 1", "[REQ-CLI-002]") {
   const std::string out = dir() + "/seed-map.json";
   for (const char* bad : {"-1", "18446744073709551616", "99999999999999999999999", "1e3", "0x10", ""}) {

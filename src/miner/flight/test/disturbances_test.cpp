@@ -478,3 +478,25 @@ TEST_CASE("The flight log's header names every column with its unit", "[REQ-FLIG
     CHECK(header.find(c) != std::string::npos);
   CHECK(flight::flight_log_units().size() == flight::flight_log_columns().size());
 }
+
+TEST_CASE("Drag acts along the body axes of a tilted vehicle: R D_w R^T v_air", "[REQ-FLIGHT-012]") {
+  flight::VehicleParams v;
+  v.rotor_drag = 1e-4;
+  const flight::Mixer mixer(v);
+  flight::QuadState s = flight::hover_state(v, Eigen::Vector3d(1, 2, 3), 0.7);
+  s.q = s.q * Eigen::Quaterniond(Eigen::AngleAxisd(0.5, Eigen::Vector3d(1, 0.3, 0).normalized()));
+  const Eigen::Matrix3d r = s.q.toRotationMatrix();
+  const Eigen::Vector3d wind(2.0, -1.0, 0.5);
+  Eigen::Vector3d d = v.linear_drag;
+  d.head<2>().array() += v.rotor_drag * s.rotor.sum();
+  // Body frame: the drag on each body axis is that axis's coefficient times the body air speed.
+  const Eigen::Vector3d body_air = r.transpose() * wind;  // at rest, v_air = -wind; the force is +D w
+  const Eigen::Vector3d expected = r * d.cwiseProduct(body_air) / v.mass;
+  const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
+  const Eigen::Vector3d a = flight::acceleration(v, mixer, s, zero, wind) - flight::acceleration(v, mixer, s, zero, zero);
+  CHECK((a - expected).norm() < 1e-12);
+  // and the z body axis (no rotor drag) sees only D_z: a wind along the body z axis
+  const Eigen::Vector3d wz = r.col(2);
+  CHECK((flight::acceleration(v, mixer, s, zero, wz) - flight::acceleration(v, mixer, s, zero, zero) -
+         v.linear_drag.z() * wz / v.mass).norm() < 1e-12);
+}

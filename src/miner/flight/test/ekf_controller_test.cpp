@@ -8,6 +8,7 @@
 #include "miner/pipeline/scenario.hpp"
 #include "miner/flight/controller.hpp"
 #include "miner/flight/ekf.hpp"
+#include "miner/flight/sensors.hpp"
 #include "miner/flight/flatness.hpp"
 #include "miner/testing/flight_scenarios.hpp"
 
@@ -176,4 +177,18 @@ TEST_CASE("The controller flies on the EKF estimate, not silently on the truth",
   const auto quiet_truth = run(0.01, true), noisy_truth = run(0.10, true);
   CHECK(noisy_truth.position_rmse == quiet_truth.position_rmse);  // the truth ignores the sensor
   CHECK(noisy_truth.summary["controller_reads"] == "ground-truth");
+}
+
+TEST_CASE("The strapdown step integrates a constant acceleration exactly", "[REQ-FLIGHT-005]") {
+  flight::NavState x;                      // at rest at the origin, level
+  x.v = Eigen::Vector3d(0.5, 0.0, 0.0);
+  flight::ImuSample s;
+  s.accel = Eigen::Vector3d(1.0, -2.0, flight::kGravity + 0.5);  // specific force: world accel (1, -2, 0.5)
+  const double dt = 0.0025;
+  const int n = 400;
+  for (int i = 0; i < n; ++i) flight::strapdown(x, s, dt);
+  const double t = n * dt;
+  const Eigen::Vector3d a(1.0, -2.0, 0.5);
+  CHECK((x.p - (Eigen::Vector3d(0.5, 0, 0) * t + 0.5 * a * t * t)).norm() < 1e-9);
+  CHECK((x.v - (Eigen::Vector3d(0.5, 0, 0) + a * t)).norm() < 1e-9);
 }

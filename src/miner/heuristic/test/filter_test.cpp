@@ -101,3 +101,17 @@ TEST_CASE("On generated maps the filtered sGAN region is connected and safe for 
     CHECK(raw.probabilities == h.probabilities);
   }
 }
+
+TEST_CASE("The bridge takes the chain the generator rates higher when lengths tie", "[REQ-HEUR-007]") {
+  Grid g;
+  // A solid wall at x = 4 with two holes, both adjacent to start (3,1,1) and goal (5,1,1).
+  for (int j = 0; j < 4; ++j)
+    for (int k = 0; k < 4; ++k)
+      if (!(j == 0 && k == 0) && !(j == 2 && k == 2)) g.solid(4, j, k);
+  g.set_p(4, 2, 2, 0.4f);  // below the threshold, but rated higher than the other hole (p = 0)
+  const auto f = heuristic::filter_region(g.p, g.env, kDims, {3, 1, 1}, {5, 1, 1}, 0.5);
+  REQUIRE(f.report.connected);
+  CHECK(g.in(f, 4, 2, 2));         // the cheaper chain: cost 1 + (1 - 0.4)
+  CHECK_FALSE(g.in(f, 4, 0, 0));   // not the hole of cost 2 (lower index: the tie-break pick)
+  CHECK(f.report.safe);
+}

@@ -133,3 +133,18 @@ TEST_CASE("Allocation requests in problem files are checked", "[REQ-TRAJ-011]") 
   CHECK_THROWS_WITH(request_from_json(bad, "p.json"), Contains("rho: must be in [1e-09, 1e+09], got -1"));
   CHECK_THROWS_WITH(request_from_json(doc, "p.json", "", -2.0), Contains("--rho: must be positive"));
 }
+
+TEST_CASE("sampled_extremes agrees with the trajectory's own derivatives", "[REQ-TRAJ-011]") {
+  const auto t = solve_minco(rest_to_rest(3, zigzag(), trapezoidal_allocation(zigzag(), Limits{2, 1})));
+  const auto [v, a] = sampled_extremes(t, 64);
+  const auto [v_ref, a_ref] = trajectory_extremes(t, 1e-4);  // evaluate_segment(i, tau, 1 / 2), dense
+  CHECK(v == Approx(v_ref).epsilon(1e-5));
+  CHECK(a == Approx(a_ref).epsilon(1e-5));
+  // A hand-made cubic: x(t) = t^3 on [0, 1] has peak speed 3 and peak acceleration 6.
+  Eigen::MatrixX3d c = Eigen::MatrixX3d::Zero(6, 3);
+  c(3, 0) = 1.0;
+  const PolynomialTrajectory cubic(3, {1.0}, c);
+  const auto [vc, ac] = sampled_extremes(cubic, 8);
+  CHECK(vc == Approx(3.0));
+  CHECK(ac == Approx(6.0));
+}

@@ -62,3 +62,14 @@ TEST_CASE("A resolution that would need too many cells is refused by name", "[RE
   CHECK(miner::world::grid_dims(Box{{0, 0, 0}, {10, 10, 10}}, 0.1) == I(100, 100, 100));
   CHECK(VoxelGrid(Map(Box{{0, 0, 0}, {10, 10, 10}}, 0.1, {}), 0.0).dims() == I(100, 100, 100));
 }
+
+TEST_CASE("A box ending exactly on a rounded grid edge does not occupy the cell beyond it", "[REQ-WORLD-006]") {
+  const double e1 = 1 * 0.1, e3 = 3 * 0.1;  // the grid's own edges: origin + i * res
+  const Map map(Box{{0, 0, 0}, {1, 1, 1}}, 0.1, {Box{{e1, e1, e1}, {e3, e3, e3}}});
+  const VoxelGrid grid(map, 0.0);
+  REQUIRE(grid.dims() == I(10, 10, 10));
+  CHECK(grid.occupied_count() == 2 * 2 * 2);  // cells 1..2 on each axis
+  CHECK(grid.occupied(I(2, 2, 2)));
+  CHECK_FALSE(grid.occupied(I(3, 2, 2)));     // shares the face x = 0.3 only
+  CHECK_FALSE(grid.occupied(I(2, 2, 3)));
+}

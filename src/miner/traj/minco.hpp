@@ -11,7 +11,8 @@
 /// waypoint and the head/tail states are given, so the only unknowns are the
 /// derivatives 1..s-1 at the M - 1 interior waypoints. dJ/dz_j = 0 couples z_j only
 /// with z_{j-1} and z_{j+1}: a symmetric positive definite block-tridiagonal system with
-/// (s-1) x (s-1) blocks, solved by block Cholesky (block Thomas) in O(M (s-1)^3).
+/// (s-1) x (s-1) blocks, solved by block Cholesky (s = 4) or block Thomas with explicit 2 x 2
+/// inverses (s = 3, written out in scalars) in O(M (s-1)^3).
 /// Stationarity in z_j is exactly continuity of derivatives s..2s-2 at waypoint j, so
 /// the result satisfies the optimality condition of the paper (A c = b) with
 /// derivatives 0..2s-2 continuous; the coefficients follow as c_i = diag(T^-j) G D x_i

@@ -7,6 +7,9 @@
 #   bash docs/sgan-training/families.sh cube    [cuda]    -> the same with the cube's 48 symmetries
 #        (--augment 2) and a width-4 network beside them: session 18's experiment, not shipped
 #        (docs/heuristic.md); one H200, all nine runs at once, 421 s
+#   bash docs/sgan-training/families.sh longer  [cuda]    -> runs-longer/all (20 epochs), runs-longer/without-F
+#        (12 epochs): the shipped recipe trained longer, session 20's experiment, not shipped
+#        (docs/heuristic.md); one H200, all eight runs at once, 490 s
 #   bash docs/sgan-training/families.sh grid16  [cuda]    -> runs-grid16/all, runs-grid16/without-F: the 16^3
 #        network (train.py --pool 2, fixtures/sgan/grid16 at threshold 0.2); one H200, all eight
 #        runs at once, 178 s (session 19)
@@ -25,12 +28,12 @@ train_bg() {
   python3 "$here/src/python/sgan/train.py" --data "$@" --device "$device" --threads "${threads:-1}" --width "$width" \
     $options --epochs "$epochs" --val-samples 280 --out "$out" > "$log" &
 }
-# lofo_bg PREFIX OPTIONS: the seven leave-one-family-out runs (width 8, 8 epochs).
+# lofo_bg PREFIX OPTIONS [EPOCHS]: the seven leave-one-family-out runs (width 8, 8 epochs).
 lofo_bg() {
   local held f rest
   for held in "${families[@]}"; do
     rest=(); for f in "${families[@]}"; do [ "$f" != "$held" ] && rest+=("fam-$f"); done
-    train_bg "$1/without-$held" "$1-without-$held.log" 8 8 "$2" "${rest[@]}"
+    train_bg "$1/without-$held" "$1-without-$held.log" 8 "${3:-8}" "$2" "${rest[@]}"
   done
 }
 # set_threshold T REASON RUN...: RUN/sgan-T.bin, each RUN's weights with threshold T.
@@ -60,6 +63,12 @@ case "${1:-}" in
     for w in 8 4; do train_bg "runs-cube/all-w$w" "runs-cube-all-w$w.log" "$w" 16 "--augment 2" "${all[@]}"; done
     lofo_bg runs-cube "--augment 2"
     wait ;;
+  longer)
+    device=${2:-cuda}
+    threads=3 train_bg runs-longer/all runs-longer-all.log 8 20 "" "${all[@]}"
+    lofo_bg runs-longer "" 12
+    wait
+    set_threshold 0.1 "as the shipped threshold" runs-longer/all runs-longer/without-* ;;
   grid16)
     device=${2:-cuda}
     threads=2 train_bg runs-grid16/all runs-grid16-all.log 8 16 "--pool 2" "${all[@]}"
@@ -69,5 +78,5 @@ case "${1:-}" in
     # + safety (docs/figures/threshold_sweep.sh with SPLIT=test PREFIX=s16-; docs/heuristic.md):
     set_threshold 0.2 "chosen on held-back 16^3 maps (seed 2000003) by strict connectivity + safety" \
       runs-grid16/all runs-grid16/without-* ;;
-  *) echo "usage: $0 data [miner] | train [cuda] | cube [cuda] | grid16 [cuda]" >&2; exit 2 ;;
+  *) echo "usage: $0 data [miner] | train [cuda] | cube [cuda] | longer [cuda] | grid16 [cuda]" >&2; exit 2 ;;
 esac

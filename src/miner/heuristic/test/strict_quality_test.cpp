@@ -1,6 +1,5 @@
 #include <catch2/catch.hpp>
 
-#include <cstdint>
 #include <cstdlib>
 #include <functional>
 #include <string>
@@ -83,21 +82,21 @@ TEST_CASE("Strict connectivity searches A*'s graph: diagonal steps, never cuttin
             .connected);
 }
 
-TEST_CASE("The A* path's own cells are strictly connected on every family", "[REQ-HEUR-011]") {
+TEST_CASE("The A* path's own cells are strictly connected on generated maps", "[REQ-HEUR-011]") {
   // The region T holds at least (REQ-HEUR-001) is connected by the planner that defines the
-  // ground truth; a search stricter than A* would call its own answer disconnected.
-  for (const std::string family : {"sim", "indoor", "cluttered", "rooms", "forest", "multilevel"}) {
+  // ground truth; a search stricter than A* would call its own answer disconnected (a
+  // face-to-face search does on each of these three maps). Three families, one map each: the
+  // generator's solvability checks make every map cost ~10 s under the CI's sanitizers.
+  for (const std::string family : {"sim", "indoor", "forest"}) {
     const miner::world::GeneratorPreset preset = miner::world::generator_preset(family);
-    for (std::uint64_t seed = 1; seed <= 2; ++seed) {
-      const miner::world::Map map = miner::world::generate_map(preset, seed);
-      const miner::world::VoxelGrid grid(map, preset.robot_radius);
-      const auto query = map.query();
-      REQUIRE(query);
-      const miner::world::GridPath path = miner::world::astar(map, grid, query->start, query->goal);
-      const auto own = HeuristicRegion::from_path(map.bounds(), I(32, 32, 32), path.points, 0, "astar");
-      INFO(family << " seed " << seed);
-      CHECK(strict_quality(map, grid, own, query->start, query->goal).connected);
-    }
+    const miner::world::Map map = miner::world::generate_map(preset, 1);
+    const miner::world::VoxelGrid grid(map, preset.robot_radius);
+    const auto query = map.query();
+    REQUIRE(query);
+    const miner::world::GridPath path = miner::world::astar(map, grid, query->start, query->goal);
+    const auto own = HeuristicRegion::from_path(map.bounds(), I(32, 32, 32), path.points, 0, "astar");
+    INFO(family);
+    CHECK(strict_quality(map, grid, own, query->start, query->goal).connected);
   }
 }
 

@@ -82,12 +82,9 @@ StrictQuality strict_quality(const world::Map& map, const world::VoxelGrid& grid
     for (const world::GridMove& m : moves) {
       const int x = cx + m.dx, y = cy + m.dy, z = cz + m.dz;
       if (x < 0 || y < 0 || z < 0 || x >= dim[0] || y >= dim[1] || z >= dim[2]) continue;
-      const auto at = [cur](std::ptrdiff_t offset) { return static_cast<std::size_t>(static_cast<std::ptrdiff_t>(cur) + offset); };
-      const std::size_t v = at(m.offset);
+      const std::size_t v = static_cast<std::size_t>(static_cast<std::ptrdiff_t>(cur) + m.offset);
       if (passable[v] != 1) continue;
-      bool block_free = true;
-      for (int w = 0; w < m.n_between && block_free; ++w) block_free = !grid.occupied(at(m.between[static_cast<std::size_t>(w)]));
-      if (!block_free) continue;
+      if (!world::block_free(grid, cur, m)) continue;
       passable[v] = 2;
       if (v == to) q.connected = true;
       queue.push_back(v);

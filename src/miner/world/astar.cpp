@@ -117,9 +117,7 @@ GridPath astar(const Map& map, const VoxelGrid& grid, const Eigen::Vector3d& sta
       if (x < 0 || y < 0 || z < 0 || x >= dims[0] || y >= dims[1] || z >= dims[2]) continue;
       const std::size_t ni = at(m.offset);
       if (closed[ni] || grid.occupied(ni)) continue;
-      bool block_free = true;  // the cells the step passes between: no corner cutting
-      for (int b = 0; b < m.n_between && block_free; ++b) block_free = !grid.occupied(at(m.between[static_cast<std::size_t>(b)]));
-      if (!block_free) continue;
+      if (!block_free(grid, cur, m)) continue;  // the cells the step passes between
       const double tentative = cost_to_come[cur] + m.length;
       if (tentative < cost_to_come[ni]) {
         cost_to_come[ni] = tentative;

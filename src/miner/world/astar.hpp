@@ -41,6 +41,16 @@ struct GridMove {
 /// The 26 moves of the grid graph (the caller checks that the neighbour is inside the grid).
 std::array<GridMove, 26> grid_moves(const Eigen::Vector3i& dims);
 
+/// Whether every cell of the block step `m` crosses from cell index `from` (its ends aside) is
+/// free in `grid` (a VoxelGrid; a template so this header needs none): no corner cutting.
+template <class Grid>
+inline bool block_free(const Grid& grid, std::size_t from, const GridMove& m) {
+  for (int b = 0; b < m.n_between; ++b)
+    if (grid.occupied(static_cast<std::size_t>(static_cast<std::ptrdiff_t>(from) + m.between[static_cast<std::size_t>(b)])))
+      return false;
+  return true;
+}
+
 /// Shortest path on the grid's 26-neighbour graph between the cells of `start` and
 /// `goal`, with edge length = distance between cell centres. A diagonal move is allowed
 /// only if every cell of the 2x2 (or 2x2x2) block it crosses is free, so no move cuts a

@@ -192,3 +192,49 @@ TEST_CASE("The strapdown step integrates a constant acceleration exactly", "[REQ
   CHECK((x.p - (Eigen::Vector3d(0.5, 0, 0) * t + 0.5 * a * t * t)).norm() < 1e-9);
   CHECK((x.v - (Eigen::Vector3d(0.5, 0, 0) + a * t)).norm() < 1e-9);
 }
+
+TEST_CASE("One EKF prediction propagates the covariance as F P F^T + Q, F from the documented blocks", "[REQ-FLIGHT-005]") {
+  // A tilted, spinning, biased state, a full (non-diagonal) P and a long step, so every block
+  // of E = F - I and every term of F P F^T = P + EP + (EP)^T + E P E^T is large; F is built
+  // here densely from ekf.hpp's formulas (rotation by Eigen's angle-axis, not the filter's
+  // quaternion exponential) and multiplied out in full.
+  flight::EkfParams params;
+  const double dt = 0.1;
+  flight::NavState x;
+  x.q = Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, -2, 0.5).normalized()));
+  x.v = Eigen::Vector3d(1.0, -0.5, 0.2);
+  x.b_a = Eigen::Vector3d(0.1, -0.2, 0.05);
+  x.b_g = Eigen::Vector3d(0.01, 0.02, -0.03);
+  miner::Rng rng(7, 0);
+  Eigen::Matrix<double, 15, 15> g;
+  for (int i = 0; i < 15; ++i)
+    for (int j = 0; j < 15; ++j) g(i, j) = rng.uniform(-0.1, 0.1);
+  const flight::Matrix15 p0 = g * g.transpose() + 1e-3 * flight::Matrix15::Identity();
+  flight::Ekf ekf(params, dt, 0, x, p0);
+  flight::ImuSample s;
+  s.accel = Eigen::Vector3d(3.0, -2.0, 12.0);
+  s.gyro = Eigen::Vector3d(0.8, -1.1, 0.5);
+  ekf.push_imu(0, s);
+  ekf.push_imu(1, s);  // the horizon steps from tick 0 to 1 with tick 0's sample
+  REQUIRE(ekf.horizon_tick() == 1);
+  const Eigen::Matrix3d r = x.q.toRotationMatrix();
+  const Eigen::Vector3d a = s.accel - x.b_a, w = (s.gyro - x.b_g) * dt;
+  Eigen::Matrix3d ax;
+  ax << 0, -a.z(), a.y(), a.z(), 0, -a.x(), -a.y(), a.x(), 0;
+  flight::Matrix15 f = flight::Matrix15::Identity();
+  f.block<3, 3>(0, 3) = Eigen::Matrix3d::Identity() * dt;
+  f.block<3, 3>(3, 6) = -r * ax * dt;
+  f.block<3, 3>(3, 9) = -r * dt;
+  f.block<3, 3>(6, 6) = Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix().transpose();
+  f.block<3, 3>(6, 12) = -Eigen::Matrix3d::Identity() * dt;
+  const auto& n = params.imu;
+  flight::Vector15 q = flight::Vector15::Zero();
+  q.segment<3>(3).setConstant(n.accel_noise_density * n.accel_noise_density * dt);
+  q.segment<3>(6).setConstant(n.gyro_noise_density * n.gyro_noise_density * dt);
+  q.segment<3>(9).setConstant(n.accel_bias_random_walk * n.accel_bias_random_walk * dt);
+  q.segment<3>(12).setConstant(n.gyro_bias_random_walk * n.gyro_bias_random_walk * dt);
+  const flight::Matrix15 expected = f * p0 * f.transpose() + flight::Matrix15(q.asDiagonal());
+  // Round-off of 15-term sums of products of O(1) entries: a few 1e-16 of ||P||.
+  constexpr double kRoundOff = 1e-12;
+  CHECK((ekf.covariance() - expected).norm() <= kRoundOff * expected.norm());
+}

@@ -1,5 +1,7 @@
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+
 #include "miner/core/error.hpp"
 #include "miner/traj/collision_repair.hpp"
 #include "miner/world/astar.hpp"
@@ -68,4 +70,33 @@ TEST_CASE("An A* path on an indoor map is repaired into a collision-free snap tr
   o.robot_radius = 0.2;
   const RepairResult r = repair_collisions(map, uniq.topRows(n), o);
   CHECK(colliding_segments(r.trajectory, map, 0.2, 0.01).empty());
+}
+
+TEST_CASE("A segment is reported wherever along it the curve meets an obstacle, bends included", "[REQ-TRAJ-008]") {
+  // The corner trajectory curves through (5, 0): a chord from a segment's start cuts inside the
+  // bend, so only the chain of short chords between consecutive samples follows the curve. A
+  // 2 cm cube on the outside of the bend, 39 places per segment, covers the curve point at tau
+  // by kDepth on the inside: each must be reported for the segment that holds it (the chords,
+  // <= 5 cm long, stay within ~1 mm of the curve, less than kDepth).
+  RepairOptions o;
+  o.limits = Limits{2.0, 1.0};
+  const auto t = solve_minco(rest_to_rest(4, corner_path(), trapezoidal_allocation(corner_path(), o.limits)));
+  constexpr double kHalf = 0.01, kDepth = 0.003;
+  for (int i = 0; i < t.segments(); ++i)
+    for (int j = 1; j < 40; ++j) {
+      const double tau = t.durations()[static_cast<std::size_t>(i)] * j / 40.0;
+      const Eigen::Vector3d c = t.evaluate_segment(i, tau), v = t.evaluate_segment(i, tau, 1),
+                            a = t.evaluate_segment(i, tau, 2);
+      // The unit normal toward the centre of curvature (the part of a across v); the cube sits
+      // on the other side.
+      const Eigen::Vector3d across = a - a.dot(v) / v.squaredNorm() * v;
+      const Eigen::Vector3d inward = across.norm() > 1e-9 ? Eigen::Vector3d(across.normalized()) : Eigen::Vector3d::Zero();
+      const Eigen::Vector3d centre = c - (kHalf - kDepth) * inward;
+      const Map map(Box{{-1, -1, 0}, {7, 7, 2}}, 0.1,
+                    {Box{centre - Eigen::Vector3d::Constant(kHalf), centre + Eigen::Vector3d::Constant(kHalf)}});
+      INFO("segment " << i << ", tau " << tau << ", curve at " << c.transpose());
+      REQUIRE(map.point_collision(c, 0.0).has_value());  // the premise: the curve passes through the cube
+      const auto hits = colliding_segments(t, map, 0.0, 0.05);
+      CHECK(std::find(hits.begin(), hits.end(), i) != hits.end());
+    }
 }

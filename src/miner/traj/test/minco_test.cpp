@@ -240,3 +240,39 @@ TEST_CASE("The answer check refuses a wrong, non-finite or inaccurate answer", "
   moved.head.row(3) << 1e-3, 0, 0;
   CHECK_THROWS_WITH(check_answer(moved, good), Contains("a constraint"));
 }
+
+TEST_CASE("Each optimality condition is checked: a jump in any one derivative s..2s-2 alone is refused",
+          "[REQ-TRAJ-010]") {
+  // The dense system A c = b (optimality_system) with one continuity row's right-hand side set
+  // to delta: its solution meets every other condition (waypoints, head, tail, the other
+  // continuity orders) and has a jump of delta in exactly that derivative at that waypoint.
+  Eigen::MatrixX3d pts(4, 3);
+  pts << 0, 0, 0, 1, 2, 0, 3, 1, 1, 4, 4, 2;
+  const std::vector<double> durations{1.0, 2.0, 0.5};
+  for (int s : {3, 4}) {
+    const auto p = rest_to_rest(s, pts, durations);
+    const auto sys = optimality_system(p);
+    const auto lu = sys.A.partialPivLu();
+    const PolynomialTrajectory exact(s, durations, lu.solve(sys.b));
+    REQUIRE_NOTHROW(check_answer(p, exact));
+    for (int i = 0; i + 1 < static_cast<int>(durations.size()); ++i)
+      for (int k = 0; k <= 2 * s - 2; ++k) {
+        INFO("s = " << s << ", waypoint " << i + 1 << ", derivative " << k);
+        // A jump of 1e-3 of the derivative's size there: 1e3 x kAnswerOptimality and above
+        // kAnswerConstraint's 1e-9 by far, so the check must see it whichever bound applies.
+        const double size = exact.evaluate_segment(i, durations[static_cast<std::size_t>(i)], k).cwiseAbs().maxCoeff();
+        auto b = sys.b;
+        b(s + i * 2 * s + 1 + k, 1) = 1e-3 * (size + 1.0);
+        const PolynomialTrajectory jump(s, durations, lu.solve(b));
+        const AnswerCheck c = measure_answer(p, jump);
+        if (k < s) {
+          CHECK(c.constraint > kAnswerConstraint);
+          CHECK_THROWS_WITH(check_answer(p, jump), Contains("a constraint"));
+        } else {
+          CHECK(c.constraint < kAnswerConstraint);  // only the optimality condition is broken
+          CHECK(c.optimality > kAnswerOptimality);
+          CHECK_THROWS_WITH(check_answer(p, jump), Contains("the optimality conditions"));
+        }
+      }
+  }
+}

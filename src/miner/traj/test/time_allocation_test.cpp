@@ -148,3 +148,42 @@ TEST_CASE("sampled_extremes agrees with the trajectory's own derivatives", "[REQ
   CHECK(vc == Approx(3.0));
   CHECK(ac == Approx(6.0));
 }
+
+TEST_CASE("Where a limit is active, the feasible time scale lands on it: k = max(v/v_max, sqrt(a/a_max))",
+          "[REQ-TRAJ-011]") {
+  // Stretching time by k divides speeds by k and accelerations by k^2 (scale_time), so the
+  // smallest scale that meets both limits is max(1, v/v_max, sqrt(a/a_max)); a larger one gives
+  // away time, a smaller one breaks a limit. One minimum-jerk segment of length d over T peaks at
+  // v = 15/8 d/T and a = 10/sqrt(3) d/T^2 (x = d (10 u^3 - 15 u^4 + 6 u^5), u = t/T).
+  Eigen::MatrixX3d pts(2, 3);
+  pts << 0, 0, 0, 1, 0, 0;
+  const double d = 1.0, T = 0.1;
+  // Relative error of the scale: kStretchSlack (1e-9) plus sampled_extremes' golden-section
+  // search (1e-9 of the sample step), far below any wrong rule (a scale off by a square root).
+  constexpr double kScaleTolerance = 1e-6;
+  AllocationOptions o;
+  SECTION("acceleration active") {
+    o.limits = Limits{1e3, 1.0};
+    const double k = feasible_objective(rest_to_rest(3, pts, {}), {T}, o).second;
+    CHECK(k == Approx(std::sqrt(10.0 / std::sqrt(3.0) * d / (T * T) / o.limits.a_max)).epsilon(kScaleTolerance));
+  }
+  SECTION("speed active") {
+    o.limits = Limits{1.0, 1e6};
+    const double k = feasible_objective(rest_to_rest(3, pts, {}), {T}, o).second;
+    CHECK(k == Approx(15.0 / 8.0 * d / T / o.limits.v_max).epsilon(kScaleTolerance));
+  }
+  SECTION("several segments, snap: the stretched peaks sit on the binding limit") {
+    for (const Limits lim : {Limits{0.5, 100.0}, Limits{100.0, 0.2}}) {
+      o.limits = lim;
+      const std::vector<double> durations{0.5, 0.8, 0.3, 1.0, 0.6};
+      const auto [F, k] = feasible_objective(rest_to_rest(4, zigzag(), {}), durations, o);
+      std::vector<double> stretched = durations;
+      for (double& t : stretched) t *= k;
+      const auto [v, a] = sampled_extremes(solve_minco(rest_to_rest(4, zigzag(), stretched)), 2000);
+      INFO("v_max " << lim.v_max << ", a_max " << lim.a_max << ", k " << k);
+      CHECK(k > 1.0);
+      CHECK(std::max(v / lim.v_max, a / lim.a_max) == Approx(1.0).epsilon(kScaleTolerance));
+      CHECK(F > 0.0);
+    }
+  }
+}

@@ -1,8 +1,11 @@
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "miner/core/error.hpp"
+#include "miner/core/rng.hpp"
 #include "miner/world/astar.hpp"
 #include "miner/world/map.hpp"
 #include "miner/world/voxel_grid.hpp"
@@ -19,6 +22,15 @@ using I = Eigen::Vector3i;
 namespace {
 // Path lengths are sums of at most a few hundred terms of size <= sqrt(3) res.
 constexpr double kSumTolerance = 1e-12;
+
+/// The 26-connected distance between two cells at resolution 1, in closed form: with the
+/// coordinate differences sorted d0 >= d1 >= d2, d2 3D diagonals, d1 - d2 2D diagonals and
+/// d0 - d1 straight moves.
+double octile_closed_form(const I& a, const I& b) {
+  std::array<int, 3> d{std::abs(a.x() - b.x()), std::abs(a.y() - b.y()), std::abs(a.z() - b.z())};
+  std::sort(d.begin(), d.end(), std::greater<>());
+  return std::sqrt(3.0) * d[2] + std::sqrt(2.0) * (d[1] - d[2]) + (d[0] - d[1]);
+}
 }  // namespace
 
 TEST_CASE("In free space A* follows the octile distance between cell centres", "[REQ-WORLD-007]") {
@@ -35,6 +47,56 @@ TEST_CASE("In free space A* follows the octile distance between cell centres", "
   CHECK(path.points.front() == V(0.5, 0.5, 0.5));
   CHECK(path.points.back() == V(9.5, 5.5, 2.5));
   CHECK(miner::world::octile_distance(I(0, 0, 0), I(9, 5, 2), 1.0) == Approx(expected));
+}
+
+TEST_CASE("On a grid with three different side lengths A* follows the octile distance in neighbour steps",
+          "[REQ-WORLD-007]") {
+  // nx, ny and nz all differ (in every order of the axes), so each axis has its own index
+  // stride; a step computed with a wrong stride lands in a cell that is not a neighbour, and the
+  // path is then no chain of neighbours or not the shortest one.
+  miner::Rng rng(7);
+  for (const I& dims : {I(10, 6, 3), I(3, 10, 6), I(6, 3, 10)}) {
+    const Map map(Box{{0, 0, 0}, dims.cast<double>()}, 1.0, {});
+    const VoxelGrid grid(map, 0.0);
+    REQUIRE(grid.dims() == dims);
+    const I last = dims - I::Ones();
+    std::vector<std::pair<I, I>> queries = {
+        {I(0, 0, 0), last},                             // moves along all three axes
+        {last, I(0, 0, 0)},
+        {I(0, last.y(), 0), I(last.x(), 0, last.z())},
+        {I(1, 1, 0), I(1, 1, last.z())},                // vertical only, up and down
+        {I(last.x(), last.y(), last.z()), I(last.x(), last.y(), 0)},
+        {I(0, 0, 0), I(0, last.y(), 0)},                // along y only
+    };
+    for (int q = 0; q < 20; ++q) {  // and random pairs of cells
+      std::pair<I, I> ab;
+      for (int k = 0; k < 3; ++k) {
+        ab.first[k] = static_cast<int>(rng.uniform_index(static_cast<std::uint64_t>(dims[k])));
+        ab.second[k] = static_cast<int>(rng.uniform_index(static_cast<std::uint64_t>(dims[k])));
+      }
+      queries.push_back(ab);
+    }
+    const auto centre = [](const I& c) { return V(c.cast<double>().array() + 0.5); };
+    for (const auto& [a, b] : queries) {
+      INFO("grid " << dims.transpose() << ": cell " << a.transpose() << " -> " << b.transpose());
+      const auto path = astar(map, grid, centre(a), centre(b));
+      const double expected = octile_closed_form(a, b);
+      CHECK(path.grid_cost == Approx(expected).margin(kSumTolerance));
+      CHECK(path.cost == Approx(expected).margin(kSumTolerance));
+      REQUIRE_FALSE(path.cells.empty());
+      CHECK(path.cells.front() == a);
+      CHECK(path.cells.back() == b);
+      double length = 0.0;  // of the chain of cell centres
+      for (std::size_t i = 1; i < path.cells.size(); ++i) {
+        const I step = path.cells[i] - path.cells[i - 1];
+        INFO("step " << i << ": " << step.transpose());
+        CHECK(step.cwiseAbs().maxCoeff() == 1);  // a neighbour, not the same cell
+        CHECK(grid.contains(path.cells[i]));
+        length += step.cast<double>().norm();
+      }
+      CHECK(length == Approx(expected).margin(kSumTolerance));
+    }
+  }
 }
 
 TEST_CASE("Start and goal in one cell: the straight segment; start == goal costs 0", "[REQ-WORLD-007]") {

@@ -1,7 +1,9 @@
 #include <catch2/catch.hpp>
 
+#include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <iomanip>
 #include <sstream>
 
 #include "miner/core/error.hpp"
@@ -72,6 +74,57 @@ std::string pcd(const std::vector<V>& pts, bool binary) {
   return s;
 }
 
+/// One PCD field: FIELDS name, SIZE bytes, TYPE F/I/U, COUNT values per point.
+struct PcdField {
+  std::string name;
+  int size;
+  char type;
+  int count;
+};
+
+/// A PCD file of `pts` with the given field layout, ASCII or binary. x, y and z hold the
+/// coordinates; every other field holds per-point filler values. The ASCII file prints the
+/// exact values the binary one stores (a SIZE 4 coordinate as its float), so both describe
+/// the same points bit for bit.
+std::string pcd_layout(const std::vector<V>& pts, const std::vector<PcdField>& layout, bool binary) {
+  std::ostringstream h;
+  h << "VERSION 0.7\nFIELDS";
+  for (const auto& f : layout) h << " " << f.name;
+  h << "\nSIZE";
+  for (const auto& f : layout) h << " " << f.size;
+  h << "\nTYPE";
+  for (const auto& f : layout) h << " " << f.type;
+  h << "\nCOUNT";
+  for (const auto& f : layout) h << " " << f.count;
+  h << "\nWIDTH " << pts.size() << "\nHEIGHT 1\nVIEWPOINT 0 0 0.5 1 0 0 0\nPOINTS " << pts.size() << "\nDATA "
+    << (binary ? "binary" : "ascii") << "\n";
+  std::string s = h.str();
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    std::ostringstream line;
+    line << std::setprecision(17);
+    for (const auto& f : layout) {
+      for (int c = 0; c < f.count; ++c) {
+        const int axis = f.name == "x" ? 0 : f.name == "y" ? 1 : f.name == "z" ? 2 : -1;
+        if (f.type == 'F') {
+          double v = axis >= 0 ? pts[i][axis] : 0.25 * static_cast<double>((i + 3 * c) % 97) - 7.0;
+          if (f.size == 4) v = static_cast<double>(static_cast<float>(v));
+          if (binary && f.size == 4) put(s, static_cast<float>(v), false);
+          else if (binary) put(s, v, false);
+          else line << v << " ";
+        } else {
+          const long long v = static_cast<long long>((i + 5 * c) % 100) * (f.type == 'I' ? -1 : 1);
+          if (!binary) line << v << " ";
+          else if (f.size == 1) put(s, static_cast<std::int8_t>(v), false);
+          else if (f.size == 2) put(s, static_cast<std::int16_t>(v), false);
+          else put(s, static_cast<std::int32_t>(v), false);
+        }
+      }
+    }
+    if (!binary) s += line.str() + "\n";
+  }
+  return s;
+}
+
 }  // namespace
 
 TEST_CASE("PLY and PCD clouds, ASCII and binary, read the same points", "[REQ-WORLD-018]") {
@@ -91,6 +144,36 @@ TEST_CASE("PLY and PCD clouds, ASCII and binary, read the same points", "[REQ-WO
   }
   CHECK(clouds[3].second.viewpoint == V(0, 0, 0.5));
   CHECK_FALSE(clouds[0].second.viewpoint.has_value());
+}
+
+TEST_CASE("Binary PCD records with fields of COUNT > 1 read the same points as ASCII", "[REQ-WORLD-018]") {
+  // A field with COUNT n takes n x SIZE bytes of each binary record: before x, y or z it moves
+  // their offsets, anywhere it lengthens the record. Normals, colour channels and descriptors
+  // (PCL's normal_x.., rgba, FPFH histograms) are such fields.
+  const std::vector<V> pts = wall_points();
+  const std::vector<std::pair<std::string, std::vector<PcdField>>> layouts = {
+      {"normal before x y z", {{"normal", 4, 'F', 3}, {"x", 4, 'F', 1}, {"y", 4, 'F', 1}, {"z", 4, 'F', 1}}},
+      {"histogram after x y z", {{"x", 4, 'F', 1}, {"y", 4, 'F', 1}, {"z", 4, 'F', 1}, {"fpfh", 4, 'F', 33}}},
+      {"counts between x, y and z",
+       {{"x", 8, 'F', 1}, {"rgb", 1, 'U', 3}, {"y", 4, 'F', 1}, {"offset", 2, 'I', 2}, {"z", 8, 'F', 1},
+        {"intensity", 4, 'U', 1}}},
+  };
+  for (const auto& [name, layout] : layouts) {
+    INFO(name);
+    const PointCloud ascii = parse_point_cloud(pcd_layout(pts, layout, false), false, "a.pcd");
+    REQUIRE(ascii.points.size() == pts.size());
+    try {
+      const PointCloud binary = parse_point_cloud(pcd_layout(pts, layout, true), false, "b.pcd");
+      REQUIRE(binary.points.size() == ascii.points.size());
+      std::size_t differ = 0;  // the same stored numbers: equal, not merely close
+      for (std::size_t i = 0; i < pts.size(); ++i) differ += binary.points[i] != ascii.points[i];
+      CHECK(differ == 0);
+      CHECK(binary.skipped == 0);
+      CHECK(binary.viewpoint == ascii.viewpoint);
+    } catch (const miner::Error& e) {
+      FAIL_CHECK("the binary file is refused: " << e.what());
+    }
+  }
 }
 
 TEST_CASE("A cloud becomes free space along its rays, occupied at its points, unknown behind", "[REQ-WORLD-018]") {

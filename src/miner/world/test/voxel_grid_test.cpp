@@ -1,6 +1,10 @@
 #include <catch2/catch.hpp>
 
+#include <iomanip>
+#include <iterator>
+
 #include "miner/core/error.hpp"
+#include "miner/core/rng.hpp"
 #include "miner/world/map.hpp"
 #include "miner/world/voxel_grid.hpp"
 #include "test_maps.hpp"
@@ -72,4 +76,48 @@ TEST_CASE("A box ending exactly on a rounded grid edge does not occupy the cell 
   CHECK(grid.occupied(I(2, 2, 2)));
   CHECK_FALSE(grid.occupied(I(3, 2, 2)));     // shares the face x = 0.3 only
   CHECK_FALSE(grid.occupied(I(2, 2, 3)));
+}
+
+TEST_CASE("Cells that only touch a box face on a rounded grid edge stay free at any origin and resolution",
+          "[REQ-WORLD-006]") {
+  // The faces lie on the grid's own edges origin + j * res, but with a non-dyadic resolution and
+  // an arbitrary origin that sum rounds, and (face - origin) / res lands just below or above j.
+  // Whatever the rounding, the cells j - 1 below a lower face and j above an upper face only
+  // touch the box and stay free, and the cells just inside are occupied. A given (origin, res, j)
+  // rounds the awkward way only now and then, hence several hundred draws of 6 faces each.
+  constexpr int kCells = 6;  // per axis: faces on interior edges 1..5
+  constexpr int kDraws = 500;
+  const double resolutions[] = {0.1, 0.15, 0.3, 0.35, 0.7, 1.3};
+  miner::Rng rng(6);
+  for (int draw = 0; draw < kDraws; ++draw) {
+    const double res = resolutions[rng.uniform_index(std::size(resolutions))];
+    V origin;
+    I lo, hi;
+    for (int k = 0; k < 3; ++k) {
+      origin[k] = rng.uniform(-10.0, 10.0);
+      lo[k] = 1 + static_cast<int>(rng.uniform_index(kCells - 2));                  // 1 .. kCells - 2
+      hi[k] = lo[k] + 1 + static_cast<int>(rng.uniform_index(kCells - 1 - lo[k]));  // lo + 1 .. kCells - 1
+    }
+    const auto edges = [&](const I& j) {  // the grid's edges, computed as it computes them
+      V e;
+      for (int k = 0; k < 3; ++k) e[k] = origin[k] + j[k] * res;
+      return e;
+    };
+    const Map map(Box{origin, edges(I::Constant(kCells))}, res, {Box{edges(lo), edges(hi)}});
+    const VoxelGrid grid(map, 0.0);
+    INFO("draw " << draw << ": origin " << std::setprecision(17) << origin.transpose() << ", res " << res
+                 << ", box cells " << lo.transpose() << " .. " << (hi - I::Ones()).transpose());
+    REQUIRE(grid.dims() == I::Constant(kCells));
+    CHECK(grid.occupied_count() == static_cast<std::size_t>((hi - lo).prod()));
+    CHECK(grid.occupied(lo));                 // the box's first cell on every axis
+    CHECK(grid.occupied(hi - I::Ones()));     // and its last
+    for (int k = 0; k < 3; ++k) {
+      INFO("axis " << k);
+      I below = lo, above = hi - I::Ones();
+      below[k] = lo[k] - 1;  // shares only the lower face
+      above[k] = hi[k];      // shares only the upper face
+      CHECK_FALSE(grid.occupied(below));
+      CHECK_FALSE(grid.occupied(above));
+    }
+  }
 }

@@ -219,7 +219,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
       ->check(integer_in(1, 256));
   pc->add_option("--out,--results", p->results, "the Markdown report to write (--results: its former name)")->capture_default_str()->check(kOutputFileNewFolder);
   pc->add_option("--figures", p->figures, "folder for the box plots (default: <--out's folder>/results)")
-      ->check(kOutputFolder);
+      ->check(output_folder_for("", {".svg"}));
   pc->add_flag("--json", p->json, "print every figure as JSON");
   pc->add_flag("--quiet", p->quiet, "no progress on stderr");
   pc->callback([p, &out] {
@@ -273,7 +273,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   sc->add_option("--weights", su->bench.weights, "sGAN weights (default: the shipped ones)");
   sc->add_option("--out,--results", su->results, "the Markdown report to write (--results: its former name)")->capture_default_str()->check(kOutputFileNewFolder);
   sc->add_option("--figures", su->figures, "folder for the box plots (default: <--out's folder>/suite)")
-      ->check(kOutputFolder);
+      ->check(output_folder_for("", {".svg"}));
   sc->add_flag("--json", su->json, "print every figure as JSON");
   sc->add_flag("--quiet", su->quiet, "no progress on stderr");
   sc->callback([su, &out] {

@@ -92,6 +92,24 @@ std::filesystem::path nearest_existing(std::filesystem::path p) {
   return p;
 }
 
+/// What makes an output file path unusable whatever its folder: a name over the file-system
+/// limit (checked before the work, not when the write fails after it), or an existing thing
+/// that is not a regular file (a device, FIFO or socket would be replaced by the write's
+/// rename; issue 20). A symbolic link is judged by what it points to (the write goes through
+/// it). Empty when usable.
+std::string output_file_problem(const std::string& text) {
+  namespace fs = std::filesystem;
+  const fs::path p(text);
+  if (p.filename().string().size() > kMaxFileName)
+    return text.substr(0, 40) + "...: the file name is longer than " + std::to_string(kMaxFileName) + " bytes";
+  std::error_code ec;
+  const auto st = fs::status(p, ec);
+  if (fs::exists(st) && !fs::is_regular_file(st) && !fs::is_directory(st))
+    return text + " exists and is not a regular file (a device, FIFO or socket): outputs are written as regular files, "
+                  "which would replace it";
+  return {};
+}
+
 }  // namespace
 
 const CLI::Validator kOutputFile(
@@ -101,6 +119,7 @@ const CLI::Validator kOutputFile(
       const fs::path p(text);
       std::error_code ec;
       if (fs::is_directory(p, ec)) return text + " is a folder, not a file";
+      if (std::string problem = output_file_problem(text); !problem.empty()) return problem;
       const fs::path parent = p.parent_path().empty() ? fs::path(".") : p.parent_path();
       if (!fs::is_directory(parent, ec)) return "the folder " + parent.string() + " does not exist";
       return probe_writable(parent);
@@ -122,12 +141,41 @@ const CLI::Validator kOutputFolder(
     },
     "OUTPUT FOLDER");
 
+CLI::Validator output_folder_for(const std::string& marker, const std::vector<std::string>& extensions) {
+  return CLI::Validator(
+      [marker, extensions](std::string& text) -> std::string {
+        namespace fs = std::filesystem;
+        if (std::string problem = kOutputFolder(text); !problem.empty()) return problem;
+        std::error_code ec;
+        const fs::path p(text);
+        if (!fs::is_directory(p, ec) || fs::is_empty(p, ec)) return {};
+        // The command's own rule (write_folder_atomic) needs the names it writes, known only
+        // after the work; this is its part that can be told now, so that a user's folder is
+        // refused before the work rather than after it (issue 20).
+        const std::string refused = text + " exists and holds ";
+        const std::string not_ours = "it is not an earlier output of this command, so it is not replaced (remove it "
+                                     "or choose another folder)";
+        const std::string why = ", which this command does not write: " + not_ours;
+        for (const auto& entry : fs::directory_iterator(p, ec)) {
+          const std::string name = entry.path().filename().string();
+          if (!entry.is_regular_file(ec) ||
+              std::find(extensions.begin(), extensions.end(), entry.path().extension().string()) == extensions.end())
+            return refused + "\"" + name + "\"" + why;
+        }
+        if (!marker.empty() && !fs::is_regular_file(p / marker, ec))
+          return text + " exists and holds no " + marker + ": " + not_ours;
+        return {};
+      },
+      "OUTPUT FOLDER");
+}
+
 const CLI::Validator kOutputFileNewFolder(
     [](std::string& text) -> std::string {
       namespace fs = std::filesystem;
       if (text.empty()) return "an output file needs a name";
       std::error_code ec;
       if (fs::is_directory(fs::path(text), ec)) return text + " is a folder, not a file";
+      if (std::string problem = output_file_problem(text); !problem.empty()) return problem;
       const fs::path folder = fs::absolute(fs::path(text), ec).parent_path();
       if (fs::exists(folder, ec) && !fs::is_directory(folder, ec)) return folder.string() + " is a file, not a folder";
       const fs::path ancestor = nearest_existing(folder);

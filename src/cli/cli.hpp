@@ -111,6 +111,12 @@ extern const CLI::Validator kRunsRange;
 /// created). REQ-CLI-003.
 extern const CLI::Validator kOutputFile;
 extern const CLI::Validator kOutputFolder;
+/// kOutputFolder for a folder a command replaces as a whole (run folders, datasets, figure
+/// folders): an existing, non-empty one must look like an earlier output of the command, i.e.
+/// hold only regular files with one of `extensions` and, if `marker` is not empty, that file.
+CLI::Validator output_folder_for(const std::string& marker, const std::vector<std::string>& extensions);
+/// The longest file name an output may have (Linux NAME_MAX).
+inline constexpr std::size_t kMaxFileName = 255;
 /// A file whose missing folders the command creates (bench paper/suite --results): the
 /// path is not a folder and the nearest existing ancestor of its folder is writable.
 extern const CLI::Validator kOutputFileNewFolder;

@@ -7,6 +7,7 @@
 #include <initializer_list>
 #include <sstream>
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "bench/ompl_planners.hpp"
@@ -280,6 +281,61 @@ TEST_CASE("Output paths are checked before any work", "[REQ-CLI-003]") {
   const Run file_as_folder = miner_cli({"fly", "--out", map});
   CHECK(file_as_folder.code == 2);
   CHECK_THAT(file_as_folder.err, Contains("is a file, not a folder"));
+}
+
+TEST_CASE("Outputs never replace a FIFO, device or a user's folder, go through links, and long names are refused first",
+          "[REQ-CLI-003]") {
+  namespace fs = std::filesystem;
+  const std::string map = write("pillar-fifo.json", kPillarMap);
+  const std::vector<std::string> astar{"astar", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5"};
+  const auto with_out = [&](const std::string& out) {
+    auto a = astar;
+    a.insert(a.end(), {"--out", out});
+    return a;
+  };
+  // A FIFO (as a device would be) is refused when the line is parsed, and is still a FIFO.
+  const std::string fifo = dir() + "/out.fifo";
+  fs::remove(fifo);
+  REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
+  const Run r = miner_cli(with_out(fifo));
+  CHECK(r.code == 2);
+  CHECK_THAT(r.err, Contains("--out") && Contains("not a regular file"));
+  CHECK(fs::is_fifo(fs::status(fifo)));
+  // A symbolic link is written through: the link stays, its target gets the output.
+  const std::string target = dir() + "/out-target.json", link = dir() + "/out-link.json";
+  fs::remove(link);
+  write("out-target.json", "{}");
+  fs::create_symlink(target, link);
+  REQUIRE(miner_cli(with_out(link)).code == 0);
+  CHECK(fs::is_symlink(fs::symlink_status(link)));
+  CHECK_THAT(read(target), Contains("\"cost\""));
+  // A 250-byte name is a legal name and is written; 256 bytes is refused before the work.
+  const std::string legal = dir() + "/" + std::string(245, 'n') + ".json";
+  CHECK(miner_cli(with_out(legal)).code == 0);
+  CHECK(fs::is_regular_file(legal));
+  const Run longer = miner_cli(with_out(dir() + "/" + std::string(251, 'n') + ".json"));
+  CHECK(longer.code == 2);
+  CHECK_THAT(longer.err, Contains("longer than 255 bytes"));
+  // A folder holding a user's files is refused when the line is parsed (exit 2), not after the
+  // work; one that holds only what the command writes, but not its own marker, too.
+  const std::string user = dir() + "/user-folder";
+  fs::create_directories(user);
+  write("user-folder/notes.txt", "mine");
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"fly", "--out", user}, {"dataset", "--preset", "sim", "--count", "2", "--out", user},
+        {"bench", "paper", "--maps", map, "--figures", user}}) {
+    const Run u = miner_cli(args);
+    INFO(args[0] << ": " << u.err);
+    CHECK(u.code == 2);
+    CHECK_THAT(u.err, Contains("notes.txt") && Contains("not an earlier output of this command"));
+  }
+  const std::string other = dir() + "/json-folder";
+  fs::create_directories(other);
+  write("json-folder/a.json", "{}");
+  const Run no_marker = miner_cli({"fly", "--out", other});
+  CHECK(no_marker.code == 2);
+  CHECK_THAT(no_marker.err, Contains("holds no summary.json"));
+  CHECK(read(user + "/notes.txt") == "mine");
 }
 
 TEST_CASE("Resource bounds: counts, budgets and tolerances outside their range are usage errors", "[REQ-CLI-002]") {

@@ -250,6 +250,16 @@ Eigen::Vector3d JsonField::vec3() const {
 
 Json vec3_json(const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); }
 
+namespace {
+/// The name of a temporary beside `target`: "." + the first kTemporaryStem bytes of its name +
+/// "." + kind + "." + pid. Capped so that a legal name (up to 255 bytes) keeps a legal
+/// temporary (issue 20: a 250-byte output name could never be written).
+constexpr std::size_t kTemporaryStem = 64;
+std::string temporary_name(const std::filesystem::path& target, const char* kind) {
+  return "." + target.filename().string().substr(0, kTemporaryStem) + "." + kind + "." + std::to_string(::getpid());
+}
+}  // namespace
+
 void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& files) {
   namespace fs = std::filesystem;
   std::vector<std::pair<fs::path, fs::path>> moves;  // (temporary, target)
@@ -269,13 +279,23 @@ void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& 
       discard();
       throw Error(path + ": is a folder, not a file");
     }
-    const fs::path tmp = dir / ("." + target.filename().string() + ".tmp." + std::to_string(::getpid()));
+    // A rename replaces whatever has the name: a device, FIFO or socket there is refused
+    // (issue 20: `--out /dev/null` as root replaced the device with a plain file), and a
+    // symbolic link is written through (its target is replaced, the link kept).
+    fs::path final_target = target;
+    if (fs::is_symlink(fs::symlink_status(target, ec))) final_target = fs::weakly_canonical(target, ec);
+    if (const auto st = fs::status(final_target, ec); fs::exists(st) && !fs::is_regular_file(st)) {
+      discard();
+      throw Error(path + ": exists and is not a regular file (a device, FIFO or socket); outputs are written as "
+                         "regular files, which would replace it");
+    }
+    const fs::path tmp = final_target.parent_path() / temporary_name(final_target, "tmp");
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     if (!out) {
       discard();
       throw Error(path + ": cannot write (temporary file " + tmp.string() + ")");
     }
-    moves.emplace_back(tmp, target);
+    moves.emplace_back(tmp, final_target);
     out << content;
     out.flush();
     if (!out) {
@@ -327,9 +347,8 @@ void write_folder_atomic(const std::string& path, const std::vector<std::pair<st
       throw Error(path + ": the folder exists and holds none of the files this command writes: it is not an earlier "
                   "output of this command, so it is not replaced (remove it or choose another folder)");
   }
-  const std::string pid = std::to_string(::getpid());
-  const fs::path partial = parent / ("." + target.filename().string() + ".partial." + pid);
-  const fs::path old = parent / ("." + target.filename().string() + ".old." + pid);
+  const fs::path partial = parent / temporary_name(target, "partial");
+  const fs::path old = parent / temporary_name(target, "old");
   fs::remove_all(partial, ec);
   if (!fs::create_directory(partial, ec)) throw Error(path + ": cannot create " + partial.string());
   try {

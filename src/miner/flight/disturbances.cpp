@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <utility>
+#include <vector>
 
 #include <unsupported/Eigen/MatrixFunctions>
 
@@ -17,6 +20,9 @@ namespace {
 constexpr double kMaxWindSpeed = 30.0;   // m/s
 constexpr double kMaxTurbulence = 10.0;  // m/s
 constexpr double kMaxScaleLength = 1000.0;  // m
+/// Gusts a scenario may hold: each tick sums every gust (bounded work per tick; issue 20: 10^6
+/// gusts ran for ever), and 1000 is one a second for a 1000 s flight.
+constexpr std::size_t kMaxGusts = 1000;
 
 }  // namespace
 
@@ -37,6 +43,8 @@ WindParams wind_params_from_json(const JsonField& f) {
   if (!(w.length_vertical > 0.0)) f.at("length_vertical_m").fail("must be positive");
   if (f.has("gusts")) {
     const JsonField g = f.at("gusts");
+    if (g.array_size() > kMaxGusts)
+      g.fail("holds " + std::to_string(g.array_size()) + " gusts; at most " + std::to_string(kMaxGusts));
     for (std::size_t i = 0; i < g.array_size(); ++i) {
       const JsonField e = g.at(i);
       e.only_keys({"start_s", "duration_s", "peak_m_s"});
@@ -47,6 +55,28 @@ WindParams wind_params_from_json(const JsonField& f) {
       gust.peak = e.at("peak_m_s").vec3();
       if (gust.peak.norm() > kMaxWindSpeed) e.at("peak_m_s").fail("a gust above 30 m/s is beyond any multirotor");
       w.gusts.push_back(gust);
+    }
+    // Gusts add up where they overlap: the 30 m/s bound holds for the wind they make together
+    // with the mean (bounded by the sum of the speeds; a sweep over the gusts' start and end).
+    std::vector<std::pair<double, double>> events;  // (time, +speed at a start / -speed after an end)
+    for (const Gust& e : w.gusts) {
+      events.emplace_back(e.start_s, e.peak.norm());
+      events.emplace_back(e.start_s + e.duration_s, -e.peak.norm());
+    }
+    std::sort(events.begin(), events.end(), [](const auto& a, const auto& b) {
+      return a.first < b.first || (a.first == b.first && a.second > b.second);  // closed intervals
+    });
+    double speed = w.mean.norm();
+    for (const auto& [t, dv] : events) {
+      speed += dv;
+      if (speed > kMaxWindSpeed * (1.0 + 1e-12)) {
+        char text[160];
+        std::snprintf(text, sizeof text,
+                      "the gusts overlapping at t = %g s add up, with the mean wind, to up to %.4g m/s, above 30 m/s "
+                      "(beyond any multirotor)",
+                      t, speed);
+        g.fail(text);
+      }
     }
   }
   return w;

@@ -452,6 +452,25 @@ TEST_CASE("Scenario disturbance sections are strict and named in their errors", 
   refused("wind", {{"sigma_horizontl_m_s", 1.0}}, "sigma_horizontal_m_s");  // did you mean
   refused("wind", {{"sigma_horizontal_m_s", -1.0}}, "wind.sigma_horizontal_m_s");
   refused("wind", {{"gusts", {{{"start_s", 1}, {"duration_s", 0}, {"peak_m_s", {1, 0, 0}}}}}}, "duration_s");
+  // Bounded work and the 30 m/s bound on the wind gusts make together (issue 20): more than
+  // 1000 gusts, and overlapping ones adding up past 30 m/s with the mean, are refused; the same
+  // gusts one after the other are not.
+  nlohmann::json many = nlohmann::json::array();
+  for (int i = 0; i < 1001; ++i) many.push_back({{"start_s", i}, {"duration_s", 0.5}, {"peak_m_s", {1, 0, 0}}});
+  refused("wind", {{"gusts", many}}, "wind.gusts");
+  refused("wind", {{"gusts", many}}, "at most 1000");
+  nlohmann::json stacked = nlohmann::json::array();
+  for (int i = 0; i < 4; ++i) stacked.push_back({{"start_s", 1.0 + 0.1 * i}, {"duration_s", 2}, {"peak_m_s", {0, 8, 0}}});
+  refused("wind", {{"gusts", stacked}, {"mean_m_s", {0, 0, 0}}}, "add up");
+  nlohmann::json apart = nlohmann::json::array();
+  for (int i = 0; i < 4; ++i) apart.push_back({{"start_s", 1.0 + 3.0 * i}, {"duration_s", 2}, {"peak_m_s", {0, 8, 0}}});
+  nlohmann::json ok = base;
+  ok["wind"] = {{"gusts", apart}};
+  CHECK_NOTHROW(pipeline::scenario_from_json(ok, "ok.json", ""));
+  nlohmann::json three = base;  // 3 x 8 = 24 m/s overlapping, with a 5 m/s mean: 29 m/s
+  three["wind"] = {{"gusts", {stacked[0], stacked[1], stacked[2]}}, {"mean_m_s", {5, 0, 0}}};
+  CHECK_NOTHROW(pipeline::scenario_from_json(three, "ok.json", ""));
+  refused("wind", {{"gusts", {stacked[0], stacked[1], stacked[2]}}, {"mean_m_s", {7, 0, 0}}}, "add up");
   refused("mismatch", {{"mass", 3.0}}, "mismatch.mass");
   refused("mismatch", {{"mass", 1.9}, {"thrust_coefficient", 0.5}}, "mismatch");
   refused("battery", {{"empty_voltage_v", 20.0}}, "battery");

@@ -688,7 +688,15 @@ std::vector<float> Sgan::predict(const std::vector<std::uint8_t>& environment, c
     g.set_input(x, y, z, v, scale * static_cast<float>(environment[v]), static_cast<float>(state[v]),
                 static_cast<float>(rng.normal_ziggurat()));
   });
-  return g.run();
+  std::vector<float> r = g.run();
+  // A probability outside [0, 1] or not a number means weights the network cannot carry (e.g.
+  // entries near FLT_MAX overflow a layer); the threshold would drop such cells silently and
+  // leave a 2-cell region (issue 20), so the answer is checked before it is returned.
+  for (std::size_t v = 0; v < r.size(); ++v)
+    if (!(r[v] >= 0.0F && r[v] <= 1.0F))
+      throw Error(g.path + ": the network's output at cell " + std::to_string(v) + " is " + std::to_string(r[v]) +
+                  ", not a probability: the weights overflow a layer (check the file's tensors)");
+  return r;
 }
 
 std::vector<double> reference_errors(const Sgan& sgan, const std::string& reference_path) {

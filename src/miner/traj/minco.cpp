@@ -758,6 +758,9 @@ void check_answer(const MincoProblem& p, const PolynomialTrajectory& tr) {
   if (!c.finite)
     throw Error("traj: the answer is not finite: the problem is beyond double precision (" + cause +
                 "); give durations in proportion to the segment lengths, or limits a trajectory can be flown at");
+  if (!std::isfinite(tr.cost()))
+    throw Error("traj: the answer's cost J is not finite (the squared derivatives overflow a double: " + cause +
+                "); give waypoints and durations at flight scales");
   if (c.constraint > kAnswerConstraint)
     throw Error("traj: the answer cannot be trusted: a constraint (waypoint, head, tail or continuity of derivatives "
                 "0..s-1) holds only to " + sci(c.constraint) + " relative (bound " + sci(kAnswerConstraint) + "; " +

@@ -14,10 +14,19 @@ constexpr double kMaxLimitValue = 1e6;
 }  // namespace
 
 namespace {
+/// The largest |value| of a waypoint coordinate (m) or a head/tail derivative (m/s^k) a
+/// problem file may give: 1000 km, far beyond any flight, while the cost (derivatives
+/// squared, integrated) stays finite; 1e155 overflowed it to a "null" cost (issue 20).
+constexpr double kMaxProblemValue = 1e6;
+
 Eigen::MatrixX3d rows_of(const JsonField& f) {
   const std::size_t n = f.array_size();
   Eigen::MatrixX3d m(static_cast<Eigen::Index>(n), 3);
-  for (std::size_t i = 0; i < n; ++i) m.row(static_cast<Eigen::Index>(i)) = f.at(i).vec3().transpose();
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d v = f.at(i).vec3();
+    if (!(v.cwiseAbs().maxCoeff() <= kMaxProblemValue)) f.at(i).fail("a value beyond +-1e6 (m, m/s, ...)");
+    m.row(static_cast<Eigen::Index>(i)) = v.transpose();
+  }
   return m;
 }
 }  // namespace

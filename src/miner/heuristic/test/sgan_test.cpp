@@ -104,6 +104,42 @@ TEST_CASE("A reference whose outputs are not finite is refused, never agreed wit
                     Contains("0.output[17]") && Contains("not a finite comparison"));
 }
 
+TEST_CASE("Weights that overflow a layer give an error naming the file, never a silently empty region",
+          "[REQ-HEUR-006]") {
+  // The shipped weights with enc1's kernel set to 3e38 (finite, so the reader accepts them) and
+  // the checksum redone: the first layer overflows to inf and the output to NaN, which the
+  // threshold used to drop, leaving a 2-cell region with exit 0 (issue 20).
+  std::string blob = miner::read_file_bytes(kFixtures + "sgan.bin");
+  std::uint32_t header_bytes = 0;
+  std::memcpy(&header_bytes, blob.data() + 8, 4);
+  miner::Json header = miner::parse_json(blob.substr(12, header_bytes), "weights header");
+  std::string data = blob.substr(12 + header_bytes);
+  bool found = false;
+  for (const auto& t : header["tensors"])
+    if (t["name"] == "enc1.weight") {
+      const float huge = 3e38f;
+      for (std::size_t i = 0; i < t["count"].get<std::size_t>(); ++i)
+        std::memcpy(&data[t["offset"].get<std::size_t>() + 4 * i], &huge, 4);
+      found = true;
+    }
+  REQUIRE(found);
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx",
+                static_cast<unsigned long long>(heuristic::fnv1a64(reinterpret_cast<const std::uint8_t*>(data.data()), data.size())));
+  header["data_fnv1a64"] = hex;
+  const std::string h = header.dump();
+  const auto n = static_cast<std::uint32_t>(h.size());
+  const heuristic::Sgan g = heuristic::Sgan::from_bytes(
+      blob.substr(0, 8) + std::string(reinterpret_cast<const char*>(&n), 4) + h + data, "huge.bin");
+  const std::size_t cells = static_cast<std::size_t>(g.architecture().dims.prod());
+  std::vector<std::uint8_t> env(cells, 0), state(cells, 0);
+  env[5] = 1;
+  state[0] = state[cells - 1] = 1;
+  miner::Rng rng(1);
+  CHECK_THROWS_WITH(g.predict(env, state, miner::world::Box{{0, 0, 0}, {10, 10, 5}}, 0.2, rng),
+                    Contains("huge.bin") && Contains("not a probability"));
+}
+
 TEST_CASE("MINER's own kernels and oneDNN's agree with each other and with PyTorch", "[REQ-HEUR-005]") {
   const std::string blob = miner::read_file_bytes(kFixtures + "sgan.bin");
   const heuristic::Sgan fast = heuristic::Sgan::from_bytes(blob, "fast");

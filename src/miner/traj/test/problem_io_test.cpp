@@ -1,5 +1,7 @@
 #include <catch2/catch.hpp>
 
+#include <string>
+
 #include "miner/core/error.hpp"
 #include "miner/traj/problem_io.hpp"
 
@@ -50,6 +52,25 @@ TEST_CASE("Problem file errors name the file and the field", "[REQ-TRAJ-007]") {
   doc.erase("limits");
   doc["durations"] = {1.0, 0.0};
   CHECK_THROWS_WITH(problem_from_json(doc, "p.json"), Contains("p.json: durations[1]: must be positive and finite"));
+  // Issue 20: a waypoint at 1e155 m overflowed the cost to "null" with exit 0; values beyond
+  // 1e6 (m, m/s, ...) are refused, naming the row.
+  for (const char* key : {"points", "head", "tail"}) {
+    doc = problem();
+    doc[key][1] = {0.0, 1e155, 0.0};
+    INFO(key);
+    CHECK_THROWS_WITH(problem_from_json(doc, "p.json"), Contains(std::string("p.json: ") + key + "[1]") && Contains("1e6"));
+  }
+  // Inside the bound, the answer check still refuses a cost that overflows.
+  {
+    MincoProblem far = problem_from_json(problem(), "p.json");
+    far.points *= 1e160;
+    far.head.row(0) = far.points.row(0);
+    far.tail.row(0) = far.points.row(far.points.rows() - 1);
+    CHECK_THROWS_WITH(solve_minco(far), Contains("not finite"));
+  }
+  doc = problem();
+  doc.erase("limits");
+  doc["durations"] = {1.0, 0.0};
   // Both: the limits would not be applied to given durations (issue 20: exceeded silently).
   doc["durations"] = {1.0, 1.0};
   doc["limits"] = {{"v_max", 1.0}, {"a_max", 1.0}};

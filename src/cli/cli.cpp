@@ -308,6 +308,29 @@ void decimal_integers(CLI::App* app) {
   for (CLI::App* sub : app->get_subcommands([](CLI::App*) { return true; })) decimal_integers(sub);
 }
 
+/// The voxel file a map file (JSON) references, resolved as Map::from_json resolves it; empty
+/// when `path` is not such a map (or not readable: the command itself says why). Only files
+/// that mention "voxels" are parsed, and none above kMaxMapFileBytes.
+std::string referenced_voxel_file(const std::string& path) {
+  namespace fs = std::filesystem;
+  constexpr std::uintmax_t kMaxMapFileBytes = 64u << 20;
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec) || fs::file_size(path, ec) > kMaxMapFileBytes) return {};
+  try {
+    const std::string text = read_file_bytes(path);
+    if (text.find("\"voxels\"") == std::string::npos) return {};
+    const Json doc = parse_json(text, path);
+    if (!doc.is_object() || !doc.contains("voxels") || !doc["voxels"].is_object() ||
+        !doc["voxels"].contains("file") || !doc["voxels"]["file"].is_string())
+      return {};
+    fs::path file = doc["voxels"]["file"].get<std::string>();
+    if (file.is_relative()) file = fs::path(path).parent_path() / file;
+    return fs::absolute(file).lexically_normal().string();
+  } catch (const std::exception&) {
+    return {};
+  }
+}
+
 /// No output may be, or hold, one of the command's inputs (issue 20: `astar --map m.json --out
 /// m.json` replaced the map with the answer; `dataset --merge d/a d/b --out d` deleted the
 /// parts). Outputs are the options checked by kOutputFile/kOutputFolder/kOutputFileNewFolder;
@@ -325,8 +348,15 @@ void check_outputs_against_inputs(CLI::App* app) {
       const bool output = o->get_type_name().find("OUTPUT") != std::string::npos;
       for (const std::string& value : o->results()) {
         if (value.empty()) continue;
-        if (output) outputs.emplace_back(o->get_name(), value);
-        else if (fs::exists(fs::path(value), ec)) inputs.emplace_back(o->get_name(), value);
+        if (output) {
+          outputs.emplace_back(o->get_name(), value);
+        } else if (fs::exists(fs::path(value), ec)) {
+          inputs.emplace_back(o->get_name(), value);
+          // A map file reads its voxels from the file it references (issue 20: `astar --map m.json
+          // --out m.bt` replaced m.json's voxels, and the map no longer loaded).
+          const std::string voxels = referenced_voxel_file(value);
+          if (!voxels.empty()) inputs.emplace_back(o->get_name() + " (its voxels.file)", voxels);
+        }
       }
     }
   // Two outputs of one command on one path: the second write would replace the first (issue

@@ -38,6 +38,18 @@ const CLI::Validator kMapOutput(
     },
     "MAP FILE");
 
+/// An output that must have one suffix (checked when the line is parsed, exit 2: issue 20 found
+/// `--map-out x.bt` given JSON that every reader then refused, and `.bt` checked after parsing).
+CLI::Validator suffix_output(const std::string& suffix, const std::string& what) {
+  return CLI::Validator(
+      [suffix, what](std::string& text) -> std::string {
+        if (text.size() >= suffix.size() && text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0)
+          return "";
+        return text + " must end in " + suffix + " (" + what + ")";
+      },
+      "FILE" + suffix);
+}
+
 
 using world::Map;
 
@@ -391,9 +403,11 @@ void add_map_commands(CLI::App& app, std::ostream& out) {
   sc->add_option("--resolution", scan->scan.resolution, "voxel size in m (default: the map's)")
       ->check(finite_in(world::kMinResolution, world::kMaxResolution));
   sc->add_option("--seed", scan->scan.seed, "random seed (range noise, dropouts)")->capture_default_str()->check(kUnsigned64);
-  sc->add_option("--out", scan->out, "the scan as an OctoMap binary tree (.bt)")->required()->check(kOutputFile);
+  sc->add_option("--out", scan->out, "the scan as an OctoMap binary tree (.bt)")
+      ->required()
+      ->check(kOutputFile & suffix_output(".bt", "the scan is an OctoMap binary tree"));
   sc->add_option("--map-out", scan->map_out, "also a map file (.json) referencing the scan, with the query")
-      ->check(kOutputFile);
+      ->check(kOutputFile & suffix_output(".json", "a map file referencing the scan"));
   sc->add_flag("--json", scan->json, "print the summary as JSON");
   sc->callback([scan, &out] { run_scan(*scan, out); });
 
@@ -407,7 +421,9 @@ void add_map_commands(CLI::App& app, std::ostream& out) {
       ->check(finite_in(world::kMinResolution, world::kMaxResolution));
   im->add_option("--range", import->range, "longest ray in m; farther points only free the ray up to it (default: no limit)")
       ->check(finite_in(0.01, 1e4));
-  im->add_option("--out", import->out, "the map as an OctoMap binary tree (.bt)")->required()->check(kOutputFile);
+  im->add_option("--out", import->out, "the map as an OctoMap binary tree (.bt)")
+      ->required()
+      ->check(kOutputFile & suffix_output(".bt", "the map is an OctoMap binary tree"));
   im->add_flag("--json", import->json, "print the summary as JSON");
   im->callback([import, &out] { run_import(*import, out); });
 

@@ -499,6 +499,7 @@ TEST_CASE("No output replaces an input, and outputs are probed for writing befor
   std::filesystem::create_directories(holder);
   const std::string scenario = holder + "/s.json";
   std::ofstream(scenario) << "{}\n";  // refused before it is read
+  std::ofstream(holder + "/summary.json") << "{}\n";  // an earlier run folder, or the folder rule answers first
   const Run inside = miner_cli({"fly", "--scenario", scenario, "--out", holder});
   CHECK(inside.code == 2);
   CHECK_THAT(inside.err, Contains("is, or holds, the input"));
@@ -509,6 +510,7 @@ TEST_CASE("No output replaces an input, and outputs are probed for writing befor
   std::filesystem::create_directories(data);
   std::filesystem::copy_file(std::string(MINER_SOURCE_DIR) + "/fixtures/maps/indoor-1.json", data + "/path.json",
                              std::filesystem::copy_options::overwrite_existing);
+  std::ofstream(data + "/summary.json") << "{}\n";
   miner::Json sc = miner::read_json_file(std::string(MINER_SOURCE_DIR) + "/fixtures/scenarios/default.json");
   sc["map"] = "fly-data/path.json";
   sc["vehicle"] = std::string(MINER_SOURCE_DIR) + "/fixtures/vehicles/n3-1500g.json";
@@ -1368,6 +1370,21 @@ TEST_CASE("miner map scan writes a deterministic OctoMap and a map that referenc
   CHECK_THAT(miner_cli({"map", "scan", "--map", src, "--fov", "400", "60", "--out", bt}).err,
              Contains("--fov: must be a finite decimal number in [0, 360], got 400"));
   CHECK_THAT(miner_cli({"map", "info", "--map", json, "--unknown", "maybe"}).err, Contains("--unknown"));
+  // Suffixes are usage errors told when the line is parsed (issue 20: --map-out x.bt got JSON
+  // that every reader refused).
+  const Run map_out_bt = miner_cli({"map", "scan", "--map", src, "--out", bt, "--map-out", dir() + "/scan-map.bt"});
+  CHECK(map_out_bt.code == 2);
+  CHECK_THAT(map_out_bt.err, Contains("--map-out") && Contains("must end in .json"));
+  CHECK(miner_cli({"map", "scan", "--map", src, "--out", dir() + "/scan.json"}).code == 2);
+  // An output that is the voxel file an input map references is refused, and the map still
+  // loads (issue 20: astar --out scan.bt replaced the voxels the map points to).
+  const std::string bt_before = read(bt);
+  const Run over_voxels = miner_cli({"astar", "--map", json, "--out", bt});
+  CHECK(over_voxels.code == 2);
+  CHECK_THAT(over_voxels.err, Contains("its voxels.file") && Contains("would replace its own input"));
+  CHECK(read(bt) == bt_before);
+  CHECK(miner_cli({"map", "convert", "--in", json, "--out", bt}).code == 2);
+  CHECK(miner_cli({"map", "info", "--map", json}).code == 0);
 }
 
 TEST_CASE("miner bench voxels reports load time, memory, query rates and encoding time", "[REQ-WORLD-017]") {

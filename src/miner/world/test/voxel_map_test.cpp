@@ -86,3 +86,25 @@ TEST_CASE("A map file references its voxels by path and SHA-256", "[REQ-WORLD-01
   CHECK(both.point_collision(V(2.5, 2.5, 2.5)));
   CHECK(both.point_collision(V(1.5, 1.5, 1.5)));  // unknown: occupied by default
 }
+
+TEST_CASE("Segments reaching far beyond a voxel map get the answer of their part over it", "[REQ-WORLD-005][REQ-WORLD-013]") {
+  // The walk along a segment is clipped to the layer's bounds grown by the radius (issue 20: 10
+  // km segments over a 4 m map were walked voxel by voxel); the answers are those of the part
+  // over the map, the radius reaching across the clip included.
+  const Map map = Map::from_voxels({small_layer(), UnknownPolicy::kOccupied, "", ""});
+  const double far = 1e4;
+  CHECK(map.segment_collision(V(2.5, 2.5, -far), V(2.5, 2.5, far)));                      // through (2, 2, 2)
+  CHECK_FALSE(map.segment_collision(V(-far, 3.5, 0.5), V(far, 3.5, 0.5)));                // a free row
+  CHECK(map.segment_collision(V(0.5, 0.5, 0.5), V(0.5, 0.5, 0.5) + far * V(1, 1, 1).normalized()));  // unknown (1,1,1)
+  // Passing 1.3 m above the occupied voxel's top face (z = 3), outside the map's z range: the
+  // radius decides, as it does for the short segment over the map.
+  for (double radius : {1.0, 1.5}) {
+    INFO("radius " << radius);
+    const bool near = map.segment_collision(V(2.5, 2.5, 4.3) - far * V(1, 0, 0), V(2.5, 2.5, 4.3) + far * V(1, 0, 0), radius).has_value();
+    const bool over = map.segment_collision(V(-1, 2.5, 4.3), V(5, 2.5, 4.3), radius).has_value();
+    CHECK(near == over);
+    CHECK(near == (radius > 1.3));
+  }
+  // Entirely beside the map, beyond the radius: free.
+  CHECK_FALSE(map.segment_collision(V(-far, -5, -5), V(far, -5, -5), 1.0));
+}

@@ -436,7 +436,7 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
       try {
         runs.push_back(run_from(parts[p]["run_records"][k]));
       } catch (const nlohmann::json::exception& e) {
-        r.fail(std::string("malformed run record: ") + e.what());
+        r.fail("malformed run record: " + json_error_text(e));
       }
     }
   }

@@ -605,7 +605,7 @@ int parse_line(CLI::App& app, const std::vector<std::string>& args, std::ostream
     err << "miner: error: out of memory\n";
     return static_cast<int>(ExitCode::kInvalidInput);
   } catch (const std::exception& e) {
-    err << "miner: internal error: " << e.what() << "\n";
+    err << "miner: internal error: " << json_error_text(e) << "\n";
     return static_cast<int>(ExitCode::kInvalidInput);
   }
   return 0;

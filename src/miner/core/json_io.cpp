@@ -31,6 +31,17 @@ std::string read_file_bytes(const std::string& path, const std::string& what) {
 
 Json read_json_file(const std::string& path) { return parse_json(read_file_bytes(path), path); }
 
+std::string json_error_text(const std::exception& e) {
+  std::string text = e.what();
+  // "[json.exception.parse_error.101] parse error at ...": the bracket names the library's
+  // internals, not the user's file (issue 20); the rest says what is wrong.
+  if (text.rfind("[json.exception.", 0) == 0) {
+    const std::size_t close = text.find("] ");
+    if (close != std::string::npos) text.erase(0, close + 2);
+  }
+  return text;
+}
+
 Json parse_json(const std::string& text, const std::string& origin) {
   // Nesting deeper than any MINER document needs is refused before parsing: the JSON library
   // frees and prints nested values recursively, so 10^6 brackets would overflow the stack.
@@ -115,9 +126,9 @@ Json parse_json(const std::string& text, const std::string& origin) {
   try {
     return Json::parse(text, no_duplicates);
   } catch (const Json::parse_error& e) {
-    throw Error(origin + ": malformed JSON at byte " + std::to_string(e.byte) + ": " + e.what());
+    throw Error(origin + ": malformed JSON at byte " + std::to_string(e.byte) + ": " + json_error_text(e));
   } catch (const Json::exception& e) {  // e.g. out_of_range.406: a number like 1e999
-    throw Error(origin + ": invalid JSON: " + e.what());
+    throw Error(origin + ": invalid JSON: " + json_error_text(e));
   }
 }
 

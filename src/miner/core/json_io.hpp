@@ -20,6 +20,9 @@ using Json = nlohmann::json;
 Json read_json_file(const std::string& path);
 /// The whole file as bytes; throws miner::Error "<path>: cannot open <what>" when it cannot
 /// be opened.
+/// The message of a JSON library exception without the library's "[json.exception.kind.N] "
+/// prefix (what users see names their file and field, not the library's internals).
+std::string json_error_text(const std::exception& e);
 std::string read_file_bytes(const std::string& path, const std::string& what = "file");
 
 /// Parses JSON text; `origin` names it in messages (a path, or "<stdin>").

@@ -59,7 +59,7 @@ TensorFile parse_tensor_file(const std::string& blob, const std::string& path, c
   try {
     header = Json::parse(blob.substr(12, header_bytes));
   } catch (const std::exception& e) {
-    throw Error(path + ": the header is not valid JSON (" + e.what() + ")");
+    throw Error(path + ": the header is not valid JSON (" + json_error_text(e) + ")");
   }
   const JsonField root(header, "", path);
   if (!header.is_object()) root.fail("the header is not a JSON object");

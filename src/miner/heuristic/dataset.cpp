@@ -70,6 +70,14 @@ struct SplitLayout {
   std::vector<ShardRecord> shards;  // those in this folder
   std::size_t samples_here = 0;     // their sum
 };
+/// A sample's map bounds {"min": [x, y, z], "max": [x, y, z]}, min < max on every axis.
+world::Box index_bounds(const JsonField& f) {
+  f.only_keys({"min", "max"});
+  const world::Box b{f.at("min").vec3(), f.at("max").vec3()};
+  if (!(b.min.array() < b.max.array()).all()) f.fail("min must be below max on every axis");
+  return b;
+}
+
 /// What dataset.json says, checked: the one place its structure is read (REQ-HEUR-001).
 struct DatasetLayout {
   Eigen::Vector3i dims;
@@ -77,7 +85,19 @@ struct DatasetLayout {
   SplitLayout splits[3];
   bool is_part = false;
   int part_index = 0, part_count = 1;
+  std::uint64_t seed = 0;
 };
+
+/// The fields of dataset.json that describe the format itself: written as they are, and a file
+/// that says otherwise is refused (issue 20: a dtype "float32" or reordered channels were read as
+/// uint8 E, S, T without a word).
+Json format_fields() {
+  return {{"channels", {"environment", "state", "target"}},
+          {"environment_levels", {{"free", 0}, {"partial", 1}, {"solid", 2}}},
+          {"dtype", "uint8"},
+          {"layout", "sample, channel, z, y, x (x fastest)"},
+          {"map_seed_rule", "splitmix64(seed ^ k); train and val: k < count, test: k >= count"}};
+}
 
 DatasetLayout read_layout(const Json& doc, const std::string& origin) {
   const JsonField root(doc, "", origin);
@@ -86,6 +106,30 @@ DatasetLayout read_layout(const Json& doc, const std::string& origin) {
   if (root.at("format").string() != kDatasetFormat)
     root.at("format").fail(std::string("not a dataset folder (expected \"") + kDatasetFormat + "\")");
   DatasetLayout L;
+  const Json format = format_fields();
+  for (const auto& [key, value] : format.items())
+    if (root.at(key).value() != value) root.at(key).fail("must be " + value.dump() + " (the miner-dataset-v1 format)");
+  // The preset fixes the robot radius and the nominal bounds; a file that says otherwise was
+  // edited (issue 20: robot_radius -1 was planned with, a changed preset measured as another).
+  const JsonField preset_field = root.at("preset");
+  world::GeneratorPreset preset;
+  try {
+    preset = world::generator_preset(preset_field.string());
+  } catch (const Error& e) {
+    preset_field.fail(e.what());
+  }
+  if (root.at("robot_radius").number() != preset.robot_radius)
+    root.at("robot_radius").fail("must be the preset's robot radius " + Json(preset.robot_radius).dump());
+  const world::Box bounds = index_bounds(root.at("bounds"));
+  if (bounds.min != preset.bounds.min || bounds.max != preset.bounds.max)
+    root.at("bounds").fail("must be the preset's bounds");
+  const int dilation = root.at("dilation").integer();
+  if (dilation < 0 || dilation > plan::HeuristicRegion::kMaxDilation)
+    root.at("dilation").fail("must be in [0, " + std::to_string(plan::HeuristicRegion::kMaxDilation) + "]");
+  const double separation = root.at("min_separation").number();
+  if (!(separation >= 0.0 && separation < 1.0)) root.at("min_separation").fail("must be in [0, 1)");
+  if (!root.at("seed").value().is_number_unsigned()) root.at("seed").fail("expected an integer in [0, 2^64 - 1]");
+  L.seed = root.at("seed").value().get<std::uint64_t>();
   const JsonField dims = root.at("dims");
   if (dims.array_size() != 3) dims.fail("expected [nx, ny, nz]");
   for (int a = 0; a < 3; ++a) {
@@ -141,16 +185,8 @@ std::string read_shard(const std::string& dir, const ShardRecord& r, std::size_t
   return bytes;
 }
 
-/// A sample's map bounds {"min": [x, y, z], "max": [x, y, z]}, min < max on every axis.
-world::Box index_bounds(const JsonField& f) {
-  f.only_keys({"min", "max"});
-  const world::Box b{f.at("min").vec3(), f.at("max").vec3()};
-  if (!(b.min.array() < b.max.array()).all()) f.fail("min must be below max on every axis");
-  return b;
-}
-
 /// A split's index entries, checked: one per sample of the folder's shards, each with its k.
-std::vector<Json> read_index(const std::string& dir, const SplitLayout& S) {
+std::vector<Json> read_index(const std::string& dir, const SplitLayout& S, std::uint64_t seed) {
   const std::string path = dir + "/" + S.index;
   const Json index = read_json_file(path);
   const JsonField f(index, "", path);
@@ -158,11 +194,16 @@ std::vector<Json> read_index(const std::string& dir, const SplitLayout& S) {
     f.fail("has " + std::to_string(f.array_size()) + " entries, the shards " + std::to_string(S.samples_here) +
            " samples");
   std::vector<Json> out;
+  std::set<std::uint64_t> ks;
   for (std::size_t i = 0; i < f.array_size(); ++i) {
     const JsonField e = f.at(i);
     e.only_keys({"k", "map_seed", "bounds", "start", "goal", "astar_cost"});
     for (const char* key : {"k", "map_seed"})
       if (!e.at(key).value().is_number_unsigned()) e.at(key).fail("expected an integer in [0, 2^64 - 1]");
+    const auto k = e.at("k").value().get<std::uint64_t>();
+    if (!ks.insert(k).second) e.at("k").fail("sample k = " + std::to_string(k) + " appears twice");
+    if (e.at("map_seed").value().get<std::uint64_t>() != splitmix64(seed ^ k))
+      e.at("map_seed").fail("is not splitmix64(seed ^ k) for the dataset's seed: not this sample's map");
     const Eigen::Vector3d start = e.at("start").vec3(), goal = e.at("goal").vec3();
     const world::Box bounds = index_bounds(e.at("bounds"));
     if (!bounds.contains(start)) e.at("start").fail("lies outside the sample's bounds");
@@ -170,9 +211,15 @@ std::vector<Json> read_index(const std::string& dir, const SplitLayout& S) {
     // A path is never shorter than the straight line (issue 20: a cost of -5 merged); the
     // tolerance allows the cost's own rounding.
     constexpr double kCostRounding = 1e-9;
+    if (!((goal - start).norm() > 0.0)) e.at("goal").fail("is the start: a sample needs two places");
     const double cost = e.at("astar_cost").number();
     if (cost < (goal - start).norm() * (1.0 - kCostRounding))
       e.at("astar_cost").fail("is " + e.at("astar_cost").value().dump() + ", shorter than the straight line from start to goal");
+    // An A* path on these maps is a few bounds diagonals at most; 1e3 of them refuses a cost
+    // nothing could have measured (issue 20: 1e300 was averaged into the figures).
+    constexpr double kMaxCostDiagonals = 1e3;
+    if (!(cost <= kMaxCostDiagonals * (bounds.max - bounds.min).norm()))
+      e.at("astar_cost").fail("is " + e.at("astar_cost").value().dump() + ", over 1000 times the bounds' diagonal");
     out.push_back(e.value());
   }
   return out;
@@ -330,15 +377,11 @@ Json write_dataset(const DatasetOptions& o, const std::string& dir, std::ostream
               {"seed", o.seed},
               {"dims", {o.dims.x(), o.dims.y(), o.dims.z()}},
               {"bounds", {{"min", vec3_json(preset.bounds.min)}, {"max", vec3_json(preset.bounds.max)}}},
-              {"channels", {"environment", "state", "target"}},
-              {"environment_levels", {{"free", 0}, {"partial", 1}, {"solid", 2}}},
-              {"dtype", "uint8"},
-              {"layout", "sample, channel, z, y, x (x fastest)"},
               {"robot_radius", preset.robot_radius},
               {"dilation", o.dilation},
               {"min_separation", o.min_separation},
-              {"map_seed_rule", "splitmix64(seed ^ k); train and val: k < count, test: k >= count"},
               {"splits", splits}};
+  doc.update(format_fields());
   if (o.shard_count > 1) doc["part"] = {{"index", o.shard_index}, {"count", o.shard_count}};
   files.emplace_back("dataset.json", dump_json(doc));
   write_folder_atomic(dir, files);
@@ -392,7 +435,7 @@ Json merge_dataset_parts(const std::vector<std::string>& parts, const std::strin
         files.emplace_back(r.file, read_shard(parts[p], r, layouts[p].cells));
         shards.emplace_back(r.file, docs[p]["splits"][split]["shards"][i]);
       }
-      for (Json& e : read_index(parts[p], S)) {
+      for (Json& e : read_index(parts[p], S, layouts[p].seed)) {
         if (!ks.insert(e["k"].get<std::uint64_t>()).second)
           throw Error(parts[p] + "/" + S.index + ": sample k = " + e["k"].dump() + " appears in two parts");
         index.push_back(std::move(e));
@@ -429,7 +472,7 @@ std::vector<Sample> read_split(const std::string& dir, const std::string& split)
   if (sp == 3) throw Error("dataset: no split \"" + split + "\" (train, val, test)");
   const DatasetLayout L = read_layout(read_json_file(dir + "/dataset.json"), dir + "/dataset.json");
   const SplitLayout& S = L.splits[sp];
-  const std::vector<Json> index = read_index(dir, S);
+  const std::vector<Json> index = read_index(dir, S, L.seed);
   std::vector<Sample> out;
   for (const ShardRecord& r : S.shards) {
     const std::string bytes = read_shard(dir, r, L.cells);

@@ -1,5 +1,7 @@
 #include <catch2/catch.hpp>
 
+#include <functional>
+
 #include <deque>
 #include <filesystem>
 #include <fstream>
@@ -286,12 +288,36 @@ TEST_CASE("A dataset folder that contradicts itself is refused naming the file a
         edit_json(q0 + "/dataset.json", [](miner::Json& d) { d["splits"]["val"]["shard"] = miner::Json::array(); });
       },
       "did you mean \"shards\"");
-  // The same sample claimed by both parts.
+  // The same sample claimed by both parts (k and its map seed copied from part 0).
+  const miner::Json first = miner::read_json_file(p0 + "/train-index.json")[0];
   refused(
       [&](const std::string&, const std::string& q1) {
-        edit_json(q1 + "/train-index.json", [](miner::Json& d) { d[0]["k"] = 0; });
+        edit_json(q1 + "/train-index.json", [&](miner::Json& d) {
+          d[0]["k"] = first["k"];
+          d[0]["map_seed"] = first["map_seed"];
+        });
       },
-      "sample k = 0 appears in two parts");
+      "sample k = " + first["k"].dump() + " appears in two parts");
+  // Values the writer never writes (issue 20: each was read, and bench heuristic measured with
+  // it): the format's own fields, the preset's radius, a sample twice in one index, a wrong map
+  // seed, goal = start, a cost nothing could have measured.
+  const std::vector<std::pair<std::function<void(miner::Json&)>, std::string>> layout_lies{
+      {[](miner::Json& d) { d["dtype"] = "float32"; }, "dtype: must be \"uint8\""},
+      {[](miner::Json& d) { d["channels"] = {"state", "environment", "target"}; }, "channels: must be"},
+      {[](miner::Json& d) { d["robot_radius"] = -1; }, "robot_radius: must be the preset's robot radius"},
+      {[](miner::Json& d) { d["preset"] = "forest"; }, "must be the preset's"},
+      {[](miner::Json& d) { d["preset"] = "nowhere"; }, "preset:"},
+      {[](miner::Json& d) { d["dilation"] = 9; }, "dilation: must be in [0, "},
+      {[](miner::Json& d) { d["min_separation"] = -5; }, "min_separation: must be in [0, 1)"}};
+  for (const auto& [lie, what] : layout_lies)
+    refused([&](const std::string& q0, const std::string&) { edit_json(q0 + "/dataset.json", lie); }, what);
+  const std::vector<std::pair<std::function<void(miner::Json&)>, std::string>> index_lies{
+      {[](miner::Json& d) { d[1] = d[0]; }, "appears twice"},
+      {[](miner::Json& d) { d[0]["map_seed"] = d[0]["map_seed"].get<std::uint64_t>() ^ 1u; }, "map_seed: is not splitmix64"},
+      {[](miner::Json& d) { d[0]["goal"] = d[0]["start"]; }, "goal: is the start"},
+      {[](miner::Json& d) { d[0]["astar_cost"] = 1e300; }, "over 1000 times the bounds' diagonal"}};
+  for (const auto& [lie, what] : index_lies)
+    refused([&](const std::string& q0, const std::string&) { edit_json(q0 + "/train-index.json", lie); }, what);
   // An index that does not match its shards.
   refused(
       [&](const std::string& q0, const std::string&) {

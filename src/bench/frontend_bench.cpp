@@ -335,6 +335,40 @@ nlohmann::json run_json(const RunRecord& r) {
           {"first", stage_json(r.result.first)},
           {"target", stage_json(r.result.target)}};
 }
+/// A count a record may hold: null (not known) or a non-negative integer (issue 20: -3 nodes
+/// wrapped to 2^64 - 3 and 99.5 iterations were read).
+void check_count(const JsonField& f) {
+  if (!f.value().is_null() && !f.value().is_number_unsigned()) f.fail("expected null or an integer >= 0");
+}
+
+/// What a run record can say, checked beyond its types (issue 20: impossible records merged
+/// into the figures): counts are integers >= 0, a stage (first solution, target) comes no later
+/// than the run's last iteration and costs no less than the lower bound, its time is finite and
+/// >= 0, and an unsolved run has no cost and no stages.
+void check_run_record(const JsonField& r, double lower_bound) {
+  constexpr double kRoundoff = 1e-9;
+  constexpr double kMaxStageMs = 1e9;  // 11 days: far beyond any campaign's time limit
+  check_count(r.at("iterations"));
+  if (!r.at("solved").value().is_boolean()) r.at("solved").fail("expected true or false");
+  const bool solved = r.at("solved").value().get<bool>();
+  if (!solved)
+    for (const char* k : {"cost", "first", "target"})
+      if (!r.at(k).value().is_null()) r.at(k).fail("an unsolved run has no " + std::string(k));
+  for (const char* stage : {"first", "target"}) {
+    const JsonField st = r.at(stage);
+    if (st.value().is_null()) continue;
+    st.only_keys({"iteration", "nodes", "cost", "time_ms"});
+    check_count(st.at("iteration"));
+    check_count(st.at("nodes"));
+    const double t = st.at("time_ms").number();
+    if (!(t >= 0.0 && t <= kMaxStageMs)) st.at("time_ms").fail("a time must be in [0, 1e9] ms");
+    if (st.at("cost").number() < lower_bound * (1.0 - kRoundoff)) st.at("cost").fail("below the campaign's lower bound");
+    if (st.at("iteration").value().is_number_unsigned() && r.at("iterations").value().is_number_unsigned() &&
+        st.at("iteration").value().get<std::uint64_t>() > r.at("iterations").value().get<std::uint64_t>())
+      st.at("iteration").fail("comes after the run's last iteration " + r.at("iterations").value().dump());
+  }
+}
+
 RunRecord run_from(const nlohmann::json& j) {
   RunRecord r;
   r.planner = j.at("planner").get<std::string>();
@@ -402,11 +436,20 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
     const JsonField shard = root.at("shard");
     (void)shard.at("index").integer();
     (void)shard.at("count").integer();
-    (void)root.at("total_s").number();
+    if (!(root.at("total_s").number() >= 0.0)) root.at("total_s").fail("a duration must be >= 0");
     (void)root.at("map").string();
-    for (const char* k : {"throughput", "region"}) (void)root.at(k);
+    (void)root.at("region");
+    // The summaries and the throughput block have exactly the keys a campaign writes (issue 20:
+    // unknown keys there were carried into the merge).
+    root.at("throughput").only_keys({"iterations", "rrtstar_iterations_per_s", "ompl_rrtstar_iterations_per_s"});
+    const nlohmann::json summary_keys = summary_json(PlannerSummary{});
+    std::vector<std::string> keys;
+    for (const auto& item : summary_keys.items()) keys.push_back(item.key());
     const JsonField planners = root.at("planners");
-    for (std::size_t i = 0; i < planners.array_size(); ++i) (void)planners.at(i).at("planner").string();
+    for (std::size_t i = 0; i < planners.array_size(); ++i) {
+      planners.at(i).only_keys(keys);
+      (void)planners.at(i).at("planner").string();
+    }
     const double lower = root.at("lower_bound").number(), budget = root.at("max_iterations").number();
     constexpr double kRoundoff = 1e-9;  // relative: the bound and the costs are sums of lengths
     const JsonField records = root.at("run_records");
@@ -433,6 +476,7 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
           r.at("iterations").number() > budget)
         r.at("iterations").fail("ran " + r.at("iterations").value().dump() + " iterations, more than the campaign's budget " +
                                 root.at("max_iterations").value().dump());
+      check_run_record(r, lower);
       try {
         runs.push_back(run_from(parts[p]["run_records"][k]));
       } catch (const nlohmann::json::exception& e) {

@@ -915,6 +915,7 @@ TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[RE
     return a;
   };
   const Run full = miner_cli(campaign);
+  INFO(full.err);
   REQUIRE(full.code == 0);
   std::vector<std::string> parts;
   for (const char* shard : {"2/3", "0/3", "1/3"}) {
@@ -973,6 +974,20 @@ TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[RE
     doctor([&](miner::Json& d) { solved(d)["cost"] = 0.5 * d["lower_bound"].get<double>(); }, "below the campaign's lower bound");
     doctor([&](miner::Json& d) { auto& r = solved(d); r["cost"] = 2.0 * r["first"]["cost"].get<double>(); }, "costs only fall");
     doctor([&](miner::Json& d) { solved(d)["iterations"] = 1e9; }, "more than the campaign's budget");
+    // Third campaign: counts that wrap or are not whole, times below zero or absurd, a stage after
+    // the run's end, an unsolved run with a cost, unknown keys in the summaries and throughput.
+    doctor([&](miner::Json& d) { solved(d)["first"]["nodes"] = -3; }, "first.nodes: expected null or an integer >= 0");
+    doctor([&](miner::Json& d) { solved(d)["iterations"] = 99.5; }, "iterations: expected null or an integer >= 0");
+    doctor([&](miner::Json& d) { solved(d)["first"]["time_ms"] = -1.0; }, "time_ms: a time must be in [0, 1e9] ms");
+    doctor([&](miner::Json& d) { solved(d)["first"]["time_ms"] = 1e300; }, "time_ms: a time must be in [0, 1e9] ms");
+    doctor([&](miner::Json& d) {
+      auto& r = solved(d);
+      r["first"]["iteration"] = r["iterations"].get<std::uint64_t>() + 1;
+    }, "comes after the run's last iteration");
+    doctor([&](miner::Json& d) { solved(d)["solved"] = false; }, "an unsolved run has no cost");
+    doctor([](miner::Json& d) { d["total_s"] = -5.0; }, "total_s: a duration must be >= 0");
+    doctor([](miner::Json& d) { d["throughput"]["foo"] = 1; }, "throughput");
+    doctor([](miner::Json& d) { d["planners"][0]["foo"] = 1; }, "planners[0]");
     doctor([](miner::Json& d) { d["foo"] = 1; }, "foo: unknown key");
     doctor([](miner::Json& d) { d["sed"] = d["seed"]; d.erase("seed"); }, "did you mean \"seed\"");
     doctor([](miner::Json& d) { d["steer_step"] = 123.0; }, "\"steer_step\" is 123.0 in the one");

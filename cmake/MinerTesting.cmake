@@ -14,8 +14,11 @@ function(miner_add_catch_test target)
   endif()
   add_executable(${target} ${ARG_SOURCES})
   target_link_libraries(${target} PRIVATE miner_test_main miner_flags ${ARG_LIBS})
+  # --warn NoTests: a test whose filter matches no TEST_CASE fails instead of passing with
+  # "No tests ran" (a ';' in a name cut CTest's filter short, and seven tests never ran).
   catch_discover_tests(${target} DISCOVERY_MODE PRE_TEST
     TEST_PREFIX "${target}: "
+    EXTRA_ARGS --warn NoTests
     PROPERTIES LABELS "${ARG_LABEL}"
                ENVIRONMENT "MINER_SOURCE_DIR=${MINER_SOURCE_DIR}")
   set_property(GLOBAL APPEND PROPERTY MINER_TEST_TARGETS ${target})

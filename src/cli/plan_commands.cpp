@@ -249,6 +249,18 @@ void add_plan_commands(CLI::App& app, std::ostream& out) {
           throw CLI::ValidationError(name, std::string("applies to --planner miner only, not ") + po->planner);
     if (po->strict_bridge && po->region != "sgan")
       throw CLI::ValidationError("--strict-bridge", "is a step of the sGAN region's filter, not of --region " + po->region);
+    // Each region source reads only its own options (issue 20, third campaign: `--dims` with the
+    // sGAN, whose grid is its weights', and `--weights` with the A* region were ignored).
+    const auto given = [&](const char* name) { return p->get_option(name)->count() > 0; };
+    if (po->region != "astar")
+      for (const char* name : {"--dims", "--dilation"})
+        if (given(name))
+          throw CLI::ValidationError(name, "applies to --region astar only (the sGAN's grid is its weights'; a region "
+                                           "file has its own), not --region " + po->region);
+    if (po->region != "sgan" && given("--weights"))
+      throw CLI::ValidationError("--weights", "applies to --region sgan only, not --region " + po->region);
+    if (!po->planner_options.safeguard && given("--safeguard-iterations"))
+      throw CLI::ValidationError("--safeguard-iterations", "tunes the safeguard, which --no-safeguard turns off");
     po->planner_options.record_tree = po->tree;
     run_plan(*po, out);
   });

@@ -441,7 +441,7 @@ TEST_CASE("Every command takes --quiet, and commands that write a file summarise
   CHECK(region["astar_cost"].get<double>() >= 8.0);
 }
 
-TEST_CASE("Unknown options are named with the nearest one; duplicates, exclusive and misplaced options are refused",
+TEST_CASE("Unknown options are named with the nearest one: duplicates, exclusive and misplaced options are refused",
           "[REQ-CLI-002]") {
   const std::string map = write("pillar-unknown.json", kPillarMap);
   const std::vector<std::pair<std::vector<std::string>, std::string>> cases{
@@ -460,7 +460,13 @@ TEST_CASE("Unknown options are named with the nearest one; duplicates, exclusive
       {{"map", "gen", "--preset", "cluttered", "--size", "0x10", "10", "10", "--out", dir() + "/h.json"}, "--size: must be a finite decimal number"},
       {{"astar", "--map", map, "--radius", "0x1p-2"}, "--radius: must be a finite decimal number"},
       // Two outputs in one place: the second would replace the first.
-      {{"map", "scan", "--map", map, "--out", dir() + "/same.bt", "--map-out", dir() + "/same.bt"}, "two outputs of one command need two places"}};
+      {{"bench", "paper", "--maps", map, "--out", dir() + "/same/r.md", "--figures", dir() + "/same/r.md"},
+       "two outputs of one command need two places"},
+      // Each region source reads only its own options (third campaign: they were ignored).
+      {{"plan", "--map", map, "--dims", "8", "8", "8"}, "--dims: applies to --region astar only"},
+      {{"plan", "--map", map, "--dilation", "2"}, "--dilation: applies to --region astar only"},
+      {{"plan", "--map", map, "--region", "astar", "--weights", dir() + "/missing.bin"}, "--weights: applies to --region sgan only"},
+      {{"plan", "--map", map, "--no-safeguard", "--safeguard-iterations", "5"}, "--safeguard-iterations: tunes the safeguard"}};
   for (const auto& [args, message] : cases) {
     const Run r = miner_cli(args);
     INFO(r.err);

@@ -51,7 +51,7 @@ TEST_CASE("The embedded default scenario is the fixture file and flies to its go
   CHECK(r.summary["position_mse"].size() == 3);
 }
 
-TEST_CASE("Same scenario and seed give the same flight log bytes; another seed does not", "[REQ-FLIGHT-009]") {
+TEST_CASE("Same scenario and seed give the same flight log bytes: another seed does not", "[REQ-FLIGHT-009]") {
   Eigen::MatrixX3d points(3, 3);
   points << 5, 5, 3, 8, 7, 4, 11, 6, 3;
   const auto s = miner::testing::open_room_scenario(points, 1.0, 1.0, 9);

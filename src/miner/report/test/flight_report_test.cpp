@@ -138,7 +138,7 @@ TEST_CASE("the viewer's flight data: the log every 0.05 s by column name, to 1 m
   CHECK((timeline.find("saturation") != std::string::npos) == (column_index("saturated") >= 0));
 }
 
-TEST_CASE("the report plots every axis, attitude, EKF error, rotors; optional columns only when logged",
+TEST_CASE("the report plots every axis, attitude, EKF error, rotors: optional columns only when logged",
           "[REQ-REPORT-011]") {
   const auto& f = fixture();
   const std::string html = report::render_flight_report({f.scenario, f.reference, f.result, {}});

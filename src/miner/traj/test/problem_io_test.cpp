@@ -16,7 +16,7 @@ const char* kProblem = R"({"order": 3,
 miner::Json problem() { return miner::parse_json(kProblem, "p.json"); }
 }  // namespace
 
-TEST_CASE("A problem without durations gets trapezoidal ones; the answer has the contract's fields", "[REQ-TRAJ-006][REQ-TRAJ-001]") {
+TEST_CASE("A problem without durations gets trapezoidal ones: the answer has the contract's fields", "[REQ-TRAJ-006][REQ-TRAJ-001]") {
   const MincoProblem p = problem_from_json(problem(), "p.json");
   REQUIRE(p.durations.size() == 2);
   CHECK(p.durations[0] == Approx(trapezoidal_duration(std::sqrt(5.0), Limits{2, 1})));

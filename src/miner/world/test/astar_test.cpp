@@ -99,7 +99,7 @@ TEST_CASE("On a grid with three different side lengths A* follows the octile dis
   }
 }
 
-TEST_CASE("Start and goal in one cell: the straight segment; start == goal costs 0", "[REQ-WORLD-007]") {
+TEST_CASE("Start and goal in one cell: the straight segment: start == goal costs 0", "[REQ-WORLD-007]") {
   const Map map(Box{{0, 0, 0}, {10, 10, 10}}, 1.0, {});
   const VoxelGrid grid(map, 0.0);
   const auto same = astar(map, grid, V(3.2, 4.7, 5.1), V(3.2, 4.7, 5.1));

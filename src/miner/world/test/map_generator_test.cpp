@@ -151,7 +151,7 @@ TEST_CASE("Family shapes: rooms are flat with walls and doors, multilevel spans 
   CHECK(trunks <= 9.0 * area / 100.0 + 1);
 }
 
-TEST_CASE("Family overrides: size, resolution and count; bad overrides are refused", "[REQ-WORLD-011]") {
+TEST_CASE("Family overrides: size, resolution and count: bad overrides are refused", "[REQ-WORLD-011]") {
   GeneratorOverrides o;
   o.size = Eigen::Vector3d(40, 40, 20);
   o.obstacles = 80;

@@ -308,7 +308,7 @@ void decimal_integers(CLI::App* app) {
   for (CLI::App* sub : app->get_subcommands([](CLI::App*) { return true; })) decimal_integers(sub);
 }
 
-/// The voxel file a map file (JSON) references, resolved as Map::from_json resolves it; empty
+/// The voxel file a map file (JSON) references (Map::voxel_file_path, as the map reads it); empty
 /// when `path` is not such a map (or not readable: the command itself says why). Only files
 /// that mention "voxels" are parsed, and none above kMaxMapFileBytes.
 std::string referenced_voxel_file(const std::string& path) {
@@ -323,9 +323,7 @@ std::string referenced_voxel_file(const std::string& path) {
     if (!doc.is_object() || !doc.contains("voxels") || !doc["voxels"].is_object() ||
         !doc["voxels"].contains("file") || !doc["voxels"]["file"].is_string())
       return {};
-    fs::path file = doc["voxels"]["file"].get<std::string>();
-    if (file.is_relative()) file = fs::path(path).parent_path() / file;
-    return fs::absolute(file).lexically_normal().string();
+    return world::Map::voxel_file_path(path, doc["voxels"]["file"].get<std::string>());
   } catch (const std::exception&) {
     return {};
   }

@@ -249,8 +249,6 @@ struct ScanCliOptions {
 };
 
 void run_scan(const ScanCliOptions& o, std::ostream& out) {
-  if (o.out.size() < 3 || o.out.compare(o.out.size() - 3, 3, ".bt") != 0)
-    throw Error("--out: " + o.out + " must end in .bt (the scan is an OctoMap binary tree)");
   const ResolvedQuery q = resolve_query(o.query);
   world::ScanOptions options = o.scan;
   options.h_fov_deg = o.fov[0];
@@ -305,8 +303,6 @@ struct ImportOptions {
 };
 
 void run_import(const ImportOptions& o, std::ostream& out) {
-  if (o.out.size() < 3 || o.out.compare(o.out.size() - 3, 3, ".bt") != 0)
-    throw Error("--out: " + o.out + " must end in .bt (the map is an OctoMap binary tree)");
   std::vector<world::CloudScan> scans;
   std::size_t points = 0, skipped = 0;
   for (const std::string& path : o.clouds) {

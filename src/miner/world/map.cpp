@@ -212,6 +212,13 @@ std::optional<std::size_t> Map::query_index(const Box& region, double r2, const 
   return best;
 }
 
+std::string Map::voxel_file_path(const std::string& map_path, const std::string& file) {
+  namespace fs = std::filesystem;
+  fs::path p = file;
+  if (p.is_relative()) p = fs::path(map_path).parent_path() / p;
+  return fs::absolute(p).lexically_normal().string();
+}
+
 Map Map::from_json(const Json& doc, const std::string& origin) {
   const JsonField root(doc, "", origin);
   root.require_format(kMapFormat);
@@ -220,14 +227,11 @@ Map Map::from_json(const Json& doc, const std::string& origin) {
   if (root.has("voxels")) {
     const JsonField jv = root.at("voxels");
     jv.only_keys({"file", "sha256", "unknown"});
-    namespace fs = std::filesystem;
-    fs::path file = jv.at("file").string();
-    if (file.is_relative()) file = fs::path(origin).parent_path() / file;
-    file = fs::absolute(file).lexically_normal();
-    const std::string bytes = read_file_bytes(file.string(), "voxel file");
-    VoxelSource source{nullptr, UnknownPolicy::kOccupied, file.string(), sha256_hex(bytes)};
+    const std::string file = voxel_file_path(origin, jv.at("file").string());
+    const std::string bytes = read_file_bytes(file, "voxel file");
+    VoxelSource source{nullptr, UnknownPolicy::kOccupied, file, sha256_hex(bytes)};
     if (jv.has("sha256") && jv.at("sha256").string() != source.sha256) {
-      jv.at("sha256").fail("the voxel file " + file.string() + " has SHA-256 " + source.sha256 +
+      jv.at("sha256").fail("the voxel file " + file + " has SHA-256 " + source.sha256 +
                            ", not the recorded one: the file changed since the map was written");
     }
     if (jv.has("unknown")) {
@@ -237,7 +241,7 @@ Map Map::from_json(const Json& doc, const std::string& origin) {
         jv.at("unknown").fail(e.what());
       }
     }
-    source.layer = parse_octree(bytes, file.string());
+    source.layer = parse_octree(bytes, file);
     voxels = std::move(source);
   }
   Box bounds = voxels ? voxels->layer->bounds() : Box{};

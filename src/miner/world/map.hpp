@@ -96,6 +96,9 @@ class Map {
   /// Parses a `miner-map-v1` document; `origin` names it in error messages and its folder
   /// anchors a relative voxel file.
   static Map from_json(const Json& doc, const std::string& origin);
+  /// Where a map file's "voxels.file" lies: relative names are taken from the map file's folder
+  /// (`map_path` is the map file), the result absolute and normalised.
+  static std::string voxel_file_path(const std::string& map_path, const std::string& file);
   /// An OctoMap file as a voxel map (world::read_octree), bounded by its known leaves.
   static Map load_octomap(const std::string& path);
 

@@ -59,6 +59,31 @@ std::string tensor_blob(miner::Json header, const std::vector<float>& data) {
   return out + text + bytes;
 }
 
+/// `blob` (a miner-tensors-v1 file) with the tensor `name`'s floats changed by `edit(data,
+/// offset, count)` and the data checksum redone, so the reader accepts it and what is under test
+/// is what the values do. Fails the test if the file has no such tensor.
+std::string with_tensor_edited(const std::string& blob, const std::string& name,
+                               const std::function<void(std::string&, std::size_t, std::size_t)>& edit) {
+  std::uint32_t header_bytes = 0;
+  std::memcpy(&header_bytes, blob.data() + 8, 4);
+  miner::Json header = miner::parse_json(blob.substr(12, header_bytes), "tensor header");
+  std::string data = blob.substr(12 + header_bytes);
+  bool found = false;
+  for (const auto& t : header["tensors"])
+    if (t["name"] == name) {
+      edit(data, t["offset"].get<std::size_t>(), t["count"].get<std::size_t>());
+      found = true;
+    }
+  REQUIRE(found);
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx",
+                static_cast<unsigned long long>(heuristic::fnv1a64(reinterpret_cast<const std::uint8_t*>(data.data()), data.size())));
+  header["data_fnv1a64"] = hex;
+  const std::string h = header.dump();
+  const auto n = static_cast<std::uint32_t>(h.size());
+  return blob.substr(0, 8) + std::string(reinterpret_cast<const char*>(&n), 4) + h + data;
+}
+
 }  // namespace
 
 TEST_CASE("The shipped generator agrees with the PyTorch reference tensors to 1e-4", "[REQ-HEUR-005]") {
@@ -79,27 +104,14 @@ TEST_CASE("The shipped generator agrees with the PyTorch reference tensors to 1e
 TEST_CASE("A reference whose outputs are not finite is refused, never agreed with", "[REQ-HEUR-005]") {
   // The shipped reference with one output cell set to NaN and its checksum redone: a NaN
   // difference used to be skipped by std::max, and an all-NaN reference "agreed" with 0 error.
-  std::string blob = miner::read_file_bytes(kFixtures + "reference.bin");
-  std::uint32_t header_bytes = 0;
-  std::memcpy(&header_bytes, blob.data() + 8, 4);
-  miner::Json header = miner::parse_json(blob.substr(12, header_bytes), "reference header");
-  std::string data = blob.substr(12 + header_bytes);
-  bool found = false;
-  for (const auto& t : header["tensors"])
-    if (t["name"] == "0.output") {
-      const float nan = std::numeric_limits<float>::quiet_NaN();
-      std::memcpy(&data[t["offset"].get<std::size_t>() + 4 * 17], &nan, 4);  // cell 17
-      found = true;
-    }
-  REQUIRE(found);
-  char hex[17];
-  std::snprintf(hex, sizeof hex, "%016llx",
-                static_cast<unsigned long long>(heuristic::fnv1a64(reinterpret_cast<const std::uint8_t*>(data.data()), data.size())));
-  header["data_fnv1a64"] = hex;
-  const std::string h = header.dump();
-  const auto n = static_cast<std::uint32_t>(h.size());
+  const std::string blob = with_tensor_edited(
+      miner::read_file_bytes(kFixtures + "reference.bin"), "0.output",
+      [](std::string& data, std::size_t offset, std::size_t) {
+        const float nan = std::numeric_limits<float>::quiet_NaN();
+        std::memcpy(&data[offset + 4 * 17], &nan, 4);  // cell 17
+      });
   const std::string path = (std::filesystem::temp_directory_path() / "miner_sgan_test_nan_reference.bin").string();
-  miner::write_file_atomic(path, blob.substr(0, 8) + std::string(reinterpret_cast<const char*>(&n), 4) + h + data);
+  miner::write_file_atomic(path, blob);
   CHECK_THROWS_WITH(heuristic::reference_errors(heuristic::Sgan::builtin(), path),
                     Contains("0.output[17]") && Contains("not a finite comparison"));
 }
@@ -109,28 +121,13 @@ TEST_CASE("Weights that overflow a layer give an error naming the file, never a 
   // The shipped weights with enc1's kernel set to 3e38 (finite, so the reader accepts them) and
   // the checksum redone: the first layer overflows to inf and the output to NaN, which the
   // threshold used to drop, leaving a 2-cell region with exit 0 (issue 20).
-  std::string blob = miner::read_file_bytes(kFixtures + "sgan.bin");
-  std::uint32_t header_bytes = 0;
-  std::memcpy(&header_bytes, blob.data() + 8, 4);
-  miner::Json header = miner::parse_json(blob.substr(12, header_bytes), "weights header");
-  std::string data = blob.substr(12 + header_bytes);
-  bool found = false;
-  for (const auto& t : header["tensors"])
-    if (t["name"] == "enc1.weight") {
-      const float huge = 3e38f;
-      for (std::size_t i = 0; i < t["count"].get<std::size_t>(); ++i)
-        std::memcpy(&data[t["offset"].get<std::size_t>() + 4 * i], &huge, 4);
-      found = true;
-    }
-  REQUIRE(found);
-  char hex[17];
-  std::snprintf(hex, sizeof hex, "%016llx",
-                static_cast<unsigned long long>(heuristic::fnv1a64(reinterpret_cast<const std::uint8_t*>(data.data()), data.size())));
-  header["data_fnv1a64"] = hex;
-  const std::string h = header.dump();
-  const auto n = static_cast<std::uint32_t>(h.size());
   const heuristic::Sgan g = heuristic::Sgan::from_bytes(
-      blob.substr(0, 8) + std::string(reinterpret_cast<const char*>(&n), 4) + h + data, "huge.bin");
+      with_tensor_edited(miner::read_file_bytes(kFixtures + "sgan.bin"), "enc1.weight",
+                         [](std::string& data, std::size_t offset, std::size_t count) {
+                           const float huge = 3e38f;
+                           for (std::size_t i = 0; i < count; ++i) std::memcpy(&data[offset + 4 * i], &huge, 4);
+                         }),
+      "huge.bin");
   const std::size_t cells = static_cast<std::size_t>(g.architecture().dims.prod());
   std::vector<std::uint8_t> env(cells, 0), state(cells, 0);
   env[5] = 1;

@@ -132,8 +132,24 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
       ->check(kShard);
   fc->add_flag("--quiet", f->quiet, "no progress bar on stderr");
   add_output_options(fc, f->output);
-  fc->callback([f, &out] {
+  fc->callback([f, fc, &out] {
     require_distinct("--planners", f->bench.planners);
+    // Options that only miner or miner-sgan read are refused when --planners leaves them out
+    // (issue 20, third campaign: they were ignored without a word).
+    const std::vector<std::string>& names = f->bench.planners;
+    const auto runs = [&](const std::string& planner) {
+      return names.empty() || std::find(names.begin(), names.end(), planner) != names.end();
+    };
+    const auto given = [&](const char* name) { return fc->get_option(name)->count() > 0; };
+    for (const char* name : {"--region", "--dims"})
+      if (given(name) && !runs("miner"))
+        throw CLI::ValidationError(name, "applies to the miner planner, which --planners leaves out");
+    if (given("--region") && given("--dims"))
+      throw CLI::ValidationError("--dims", "sets the A*-dilated region's grid, which --region replaces");
+    if (given("--weights") && !runs(bench::kMinerSgan))
+      throw CLI::ValidationError("--weights", "applies to the miner-sgan planner, which --planners leaves out");
+    if (given("--no-safeguard") && !runs("miner") && !runs(bench::kMinerSgan))
+      throw CLI::ValidationError("--no-safeguard", "applies to miner and miner-sgan, which --planners leaves out");
     run_frontend(*f, out);
   });
 
@@ -161,7 +177,12 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   hc->add_flag("--strict-bridge", h->bench.strict_bridge,
                "filter step 5 too: the strict bridge on the continuous map (REQ-HEUR-014)");
   add_output_options(hc, h->output);
-  hc->callback([h, &out] {
+  hc->callback([h, hc, &out] {
+    // With --no-planners no planner runs: their budget and target would be ignored (issue 20).
+    if (!h->bench.planners)
+      for (const char* name : {"--iterations", "--target-factor"})
+        if (hc->get_option(name)->count() > 0)
+          throw CLI::ValidationError(name, "sets the planners' runs, which --no-planners turns off");
     const bench::HeuristicBenchResult r = bench::run_heuristic_bench(h->bench, progress_stream());
     emit(h->output, bench::to_json(r), bench::to_text(r), out);
   });

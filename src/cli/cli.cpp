@@ -333,12 +333,18 @@ std::string referenced_voxel_file(const std::string& path) {
 /// m.json` replaced the map with the answer; `dataset --merge d/a d/b --out d` deleted the
 /// parts). Outputs are the options checked by kOutputFile/kOutputFolder/kOutputFileNewFolder;
 /// inputs are the values of every other option that name an existing file or folder.
-void check_outputs_against_inputs(CLI::App* app) {
-  namespace fs = std::filesystem;
-  std::vector<std::pair<std::string, std::string>> outputs, inputs;  // (option, path)
+/// `app` and the subcommands this command line chose, outermost first.
+std::vector<CLI::App*> parsed_commands(CLI::App* app) {
   std::vector<CLI::App*> chain{app};
   for (std::size_t i = 0; i < chain.size(); ++i)
     for (CLI::App* sub : chain[i]->get_subcommands()) chain.push_back(sub);
+  return chain;
+}
+
+void check_outputs_against_inputs(CLI::App* app) {
+  namespace fs = std::filesystem;
+  std::vector<std::pair<std::string, std::string>> outputs, inputs;  // (option, path)
+  const std::vector<CLI::App*> chain = parsed_commands(app);
   std::error_code ec;
   for (CLI::App* cmd : chain)
     for (const CLI::Option* o : cmd->get_options()) {
@@ -369,6 +375,29 @@ void check_outputs_against_inputs(CLI::App* app) {
       if (is_same_or_inside(out, in))
         throw CLI::ValidationError(out_name, out + " is, or holds, the input " + in + " (" + in_name +
                                                  "): the command would replace its own input");
+    }
+}
+
+/// A list option names each value once (issue 20, third campaign: `map import --cloud a a`
+/// fused one scan twice, `bench paper --maps m,m` ran a map twice). Options of a fixed count
+/// (coordinates, grid dims: `--size 10 10 3`) are tuples, not lists, and may repeat a value;
+/// two spellings of one existing file (`m.json`, `./m.json`) are one value.
+void check_list_values_distinct(CLI::App* app) {
+  namespace fs = std::filesystem;
+  const std::vector<CLI::App*> chain = parsed_commands(app);
+  std::error_code ec;
+  for (CLI::App* cmd : chain)
+    for (const CLI::Option* o : cmd->get_options()) {
+      if (o->count() == 0 || o->get_items_expected_max() <= o->get_items_expected_min()) continue;
+      const std::vector<std::string>& values = o->results();
+      for (std::size_t i = 0; i < values.size(); ++i)
+        for (std::size_t j = 0; j < i; ++j) {
+          if (values[i] == values[j])
+            throw CLI::ValidationError(o->get_name(), "lists " + values[i] + " twice (each value once)");
+          if (fs::exists(values[i], ec) && fs::exists(values[j], ec) && fs::equivalent(values[i], values[j], ec))
+            throw CLI::ValidationError(o->get_name(), "lists " + values[j] + " and " + values[i] +
+                                                          ", one file twice (each value once)");
+        }
     }
 }
 
@@ -544,6 +573,7 @@ constexpr const char* kAppDescription = "miner — MINER-RRT* quadrotor planning
 void build_app(CLI::App& app, std::ostream& out, Mode mode) {
   add_commands(app, out);
   app.parse_complete_callback([&app, mode] {
+    check_list_values_distinct(&app);
     check_outputs_against_inputs(&app);
     if (mode == Mode::kParseOnly) throw ParsedOnly{};
   });

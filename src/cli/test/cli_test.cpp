@@ -444,6 +444,8 @@ TEST_CASE("Every command takes --quiet, and commands that write a file summarise
 TEST_CASE("Unknown options are named with the nearest one: duplicates, exclusive and misplaced options are refused",
           "[REQ-CLI-002]") {
   const std::string map = write("pillar-unknown.json", kPillarMap);
+  const std::string cloud = write("dup-cloud.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"
+                                                   "property float y\nproperty float z\nend_header\n1 1 1\n");
   const std::vector<std::pair<std::vector<std::string>, std::string>> cases{
       {{"astar", "--mapp", map}, "unknown option --mapp for `miner astar`, did you mean --map?"},
       {{"plan", "--planer", "rrtstar", "--map", map}, "unknown option --planer for `miner plan`, did you mean --planner?"},
@@ -466,7 +468,30 @@ TEST_CASE("Unknown options are named with the nearest one: duplicates, exclusive
       {{"plan", "--map", map, "--dims", "8", "8", "8"}, "--dims: applies to --region astar only"},
       {{"plan", "--map", map, "--dilation", "2"}, "--dilation: applies to --region astar only"},
       {{"plan", "--map", map, "--region", "astar", "--weights", dir() + "/missing.bin"}, "--weights: applies to --region sgan only"},
-      {{"plan", "--map", map, "--no-safeguard", "--safeguard-iterations", "5"}, "--safeguard-iterations: tunes the safeguard"}};
+      {{"plan", "--map", map, "--no-safeguard", "--safeguard-iterations", "5"}, "--safeguard-iterations: tunes the safeguard"},
+      // bench frontend: options of planners that --planners leaves out, and bench heuristic's
+      // planner options with --no-planners (third campaign: ignored).
+      {{"bench", "frontend", "--map", map, "--planners", "rrtstar,guided", "--dims", "8", "8", "8"},
+       "--dims: applies to the miner planner, which --planners leaves out"},
+      {{"bench", "frontend", "--map", map, "--planners", "miner-sgan", "--region", dir() + "/r.json"},
+       "--region: applies to the miner planner, which --planners leaves out"},
+      {{"bench", "frontend", "--map", map, "--planners", "miner", "--region", dir() + "/r.json", "--dims", "8", "8", "8"},
+       "--dims: sets the A*-dilated region's grid, which --region replaces"},
+      {{"bench", "frontend", "--map", map, "--planners", "miner,rrtstar", "--weights", dir() + "/w.bin"},
+       "--weights: applies to the miner-sgan planner, which --planners leaves out"},
+      {{"bench", "frontend", "--map", map, "--planners", "ompl:RRTstar", "--no-safeguard"},
+       "--no-safeguard: applies to miner and miner-sgan"},
+      {{"bench", "heuristic", "--data", dir() + "/nodata", "--no-planners", "--iterations", "100"},
+       "--iterations: sets the planners' runs, which --no-planners turns off"},
+      {{"bench", "heuristic", "--data", dir() + "/nodata", "--no-planners", "--target-factor", "1.5"},
+       "--target-factor: sets the planners' runs"},
+      // A list names each value once (third campaign: `map import --cloud a a` fused the cloud
+      // twice, `bench paper --maps m,m` ran the map twice); the same file by two spellings too.
+      {{"map", "import", "--cloud", cloud, "--cloud", dir() + "/./dup-cloud.ply", "--resolution", "0.5", "--out",
+        dir() + "/dup.bt"}, "--cloud: lists " + cloud + " and " + dir() + "/./dup-cloud.ply, one file twice"},
+      {{"bench", "paper", "--maps", map + "," + dir() + "/../" + std::filesystem::path(dir()).filename().string() + "/pillar-unknown.json",
+        "--out", dir() + "/dup/r.md"}, "--maps: lists"},
+      {{"bench", "frontend", "--map", map, "--planners", "rrtstar,informed,rrtstar"}, "--planners: lists rrtstar twice"}};
   for (const auto& [args, message] : cases) {
     const Run r = miner_cli(args);
     INFO(r.err);
@@ -1001,8 +1026,13 @@ TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[RE
   // Missing, repeated and foreign parts, and malformed shards, are refused.
   CHECK(miner_cli({"bench", "merge", parts[0], parts[1]}).code == 1);
   const Run twice = miner_cli({"bench", "merge", parts[0], parts[0], parts[1]});
-  CHECK(twice.code == 1);
-  CHECK_THAT(twice.err, Contains("appears twice"));
+  CHECK(twice.code == 2);  // one file named twice: a usage error (REQ-CLI-002)
+  CHECK_THAT(twice.err, Contains("parts: lists " + parts[0] + " twice"));
+  const std::string copy = dir() + "/shard-copy.json";
+  std::filesystem::copy_file(parts[0], copy, std::filesystem::copy_options::overwrite_existing);
+  const Run same_shard = miner_cli({"bench", "merge", parts[0], copy, parts[1]});
+  CHECK(same_shard.code == 1);  // two files holding one shard
+  CHECK_THAT(same_shard.err, Contains("appears twice"));
   const std::string other = dir() + "/other-seed.json";
   REQUIRE(miner_cli(with({"--shard", "1/3", "--seed", "9", "--out", other})).code == 0);
   CHECK_THAT(miner_cli({"bench", "merge", parts[0], parts[1], other}).err, Contains("different campaign"));
@@ -1252,9 +1282,9 @@ TEST_CASE("miner bench heuristic measures raw and filtered quality and the plann
   const double sim_rate = both["families"]["sim"]["connectivity_rate_raw"].get<double>();
   const double indoor_rate = both["families"]["indoor"]["connectivity_rate_raw"].get<double>();
   CHECK(both["connectivity_rate_raw"].get<double>() == Approx(0.5 * (sim_rate + indoor_rate)));
-  const Run twice = miner_cli({"bench", "heuristic", "--data", data, data, "--no-planners"});
-  CHECK(twice.code == 1);
-  CHECK_THAT(twice.err, Contains("already measured"));
+  const Run twice = miner_cli({"bench", "heuristic", "--data", data, data + "/.", "--no-planners"});
+  CHECK(twice.code == 2);  // one folder by two spellings: a usage error (REQ-CLI-002)
+  CHECK_THAT(twice.err, Contains("--data: lists " + data + " and " + data + "/., one file twice"));
   const Run text = miner_cli({"bench", "heuristic", "--data", data, "--samples", "1", "--no-planners"});
   REQUIRE(text.code == 0);
   CHECK_THAT(text.out, Contains("connectivity: raw") && !Contains("rrtstar"));

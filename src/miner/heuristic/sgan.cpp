@@ -332,6 +332,9 @@ struct Sgan::Impl {
 void Sgan::Impl::build(const TensorFile& f, Sgan::Kernels which) {
   const JsonField a(f.meta, "meta", f.path);
   a.only_keys({"architecture", "final", "training"});
+  // The training record is free-form provenance, but a record: an object (issue 20, S7).
+  for (const char* key : {"final", "training"})
+    if (a.has(key) && !a.at(key).value().is_object()) a.at(key).fail("must be an object (the training record)");
   const JsonField ar = a.at("architecture");
   ar.only_keys({"name", "width", "dims", "environment_scale", "threshold", "layers", "scale_channels", "scale_divisor"});
   if (ar.at("name").string() != "sgan-unet4") ar.at("name").fail("unknown architecture (expected sgan-unet4)");

@@ -88,8 +88,23 @@ Scenario scenario_from_json(const Json& doc, const std::string& origin, const st
   s.map->require_free(s.start, s.vehicle.radius, origin + ": start");
   s.map->require_free(s.goal, s.vehicle.radius, origin + ": goal");
 
+  // The route comes from exactly one source; the keys of the others would be read and then
+  // ignored without a word (issue 20, third campaign: an empty "waypoints" flew a straight
+  // line through the map, a planner block beside waypoints was never used).
+  const bool trajectory_file = root.has("trajectory") && root.at("trajectory").has("file");
+  if (trajectory_file) {
+    for (const char* key : {"waypoints", "planner"})
+      if (root.has(key)) root.at(key).fail("unused: the route is the trajectory file's (trajectory.file)");
+    const JsonField t = root.at("trajectory");
+    for (const char* key : {"order", "allocation", "rho"})
+      if (t.has(key)) t.at(key).fail("unused: the trajectory file fixes the order and the durations");
+  }
+  if (root.has("waypoints") && root.has("planner"))
+    root.at("planner").fail("unused: the route is given by \"waypoints\" (leave them out to plan with MINER RRT*)");
   if (root.has("waypoints")) {
     const JsonField w = root.at("waypoints");
+    if (w.array_size() == 0)
+      w.fail("empty: give at least one interior point, or leave the key out to plan with MINER RRT*");
     Eigen::MatrixX3d m(static_cast<Eigen::Index>(w.array_size()), 3);
     for (std::size_t i = 0; i < w.array_size(); ++i) {
       m.row(static_cast<Eigen::Index>(i)) = w.at(i).vec3().transpose();
@@ -101,7 +116,7 @@ Scenario scenario_from_json(const Json& doc, const std::string& origin, const st
   // The route start, waypoints..., goal has no repeated point: a zero-length leg has no
   // trajectory (issue 20: the refusal came later, naming the pipeline's "points[0]"). A given
   // trajectory file replaces the route.
-  if (!(root.has("trajectory") && root.at("trajectory").has("file"))) {
+  if (!trajectory_file) {
     std::vector<std::pair<Eigen::Vector3d, std::string>> route{{s.start, "start"}};
     if (s.waypoints)
       for (Eigen::Index i = 0; i < s.waypoints->rows(); ++i)
@@ -143,7 +158,10 @@ Scenario scenario_from_json(const Json& doc, const std::string& origin, const st
       s.region = p.at("region").string();
       if (s.region != "sgan" && s.region != "astar") p.at("region").fail("must be \"sgan\" or \"astar\"");
     }
-    if (p.has("weights")) s.weights = resolve(base_dir, p.at("weights").string());
+    if (p.has("weights")) {
+      if (s.region != "sgan") p.at("weights").fail("applies to \"region\": \"sgan\" only, not \"" + s.region + "\"");
+      s.weights = resolve(base_dir, p.at("weights").string());
+    }
     if (p.has("iterations")) {
       const long long n = p.at("iterations").integer();
       if (n < 1 || n > kMaxPlannerIterations)

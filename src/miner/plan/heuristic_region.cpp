@@ -87,6 +87,11 @@ HeuristicRegion HeuristicRegion::from_json(const Json& doc, const std::string& o
   for (std::size_t i = 0; i < n; ++i) probabilities[i] = jp.at(i).number();
   const double threshold = root.has("threshold") ? root.at("threshold").number() : 0.5;
   const std::string source = root.has("source") ? root.at("source").string() : "";
+  // Provenance shown in reports and run folders: one printable line (issue 20, S7).
+  constexpr std::size_t kMaxSourceBytes = 512;
+  if (source.size() > kMaxSourceBytes ||
+      std::any_of(source.begin(), source.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; }))
+    root.at("source").fail("must be one line of at most 512 bytes without control characters");
   try {
     return HeuristicRegion(bounds, dims, std::move(probabilities), threshold, source);
   } catch (const Error& e) {

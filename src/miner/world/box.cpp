@@ -5,6 +5,23 @@
 
 namespace miner::world {
 
+std::optional<std::pair<double, double>> ray_interval(const Box& box, const Eigen::Vector3d& origin,
+                                                      const Eigen::Vector3d& dir, double t_max) {
+  double t0 = 0.0, t1 = t_max;
+  for (int k = 0; k < 3; ++k) {
+    if (dir[k] == 0.0) {
+      if (origin[k] < box.min[k] || origin[k] > box.max[k]) return std::nullopt;
+      continue;
+    }
+    double ta = (box.min[k] - origin[k]) / dir[k], tb = (box.max[k] - origin[k]) / dir[k];
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+    if (t0 > t1) return std::nullopt;
+  }
+  return std::pair{t0, t1};
+}
+
 double squared_distance(const Eigen::Vector3d& p, const Box& box) {
   double d2 = 0.0;
   for (int k = 0; k < 3; ++k) {

@@ -7,6 +7,9 @@
 /// Minkowski sum of B and the closed ball of radius r (a rounded box), so queries
 /// with a radius are exact, not a box-inflated approximation.
 
+#include <optional>
+#include <utility>
+
 #include <Eigen/Core>
 
 namespace miner::world {
@@ -28,6 +31,13 @@ struct Box {
   Eigen::Vector3d extent() const { return max - min; }
   double volume() const { return extent().prod(); }
 };
+
+/// Slab test: the interval [t0, t1] within [0, t_max] on which the ray origin + t dir lies in
+/// the closed box, or nullopt when there is none. An axis with dir_k = 0 keeps the ray in
+/// the box's slab or misses it; the arithmetic is monotone in the box's faces, so a box
+/// inside another is entered no earlier and left no later.
+std::optional<std::pair<double, double>> ray_interval(const Box& box, const Eigen::Vector3d& origin,
+                                                      const Eigen::Vector3d& dir, double t_max);
 
 /// dist(p, B)^2 = sum_k max(min_k - p_k, 0, p_k - max_k)^2.
 double squared_distance(const Eigen::Vector3d& p, const Box& box);

@@ -1,6 +1,7 @@
 #include "miner/world/map.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -31,6 +32,14 @@ void validate_box(const Box& b, const std::string& what) {
   }
 }
 
+
+/// Below this many boxes a ray tests them all: the bucket walk costs more than it saves.
+constexpr std::size_t kRayWalkMinObstacles = 64;
+/// At most this many pieces per ray (a diagonal of the 32-bucket grid is ~56 buckets long).
+constexpr int kMaxRayPieces = 256;
+/// A ray piece's bounding box is widened by this fraction of the map's extent, far above
+/// the rounding of origin + t dir (~1e-16 relative) and far below a bucket (1/32).
+constexpr double kRayPieceSlack = 1e-9;
 
 std::string box_name(std::size_t i, const Box& b) {
   return "obstacle " + std::to_string(i) + " [" + format_point(b.min) + " - " +
@@ -155,19 +164,36 @@ std::string Map::obstacle_name(std::size_t index) const {
 }
 
 void Map::build_index() {
-  // About 32 buckets along the longest side: a few obstacles per bucket for the paper's
-  // maps; fine enough that a short RRT edge visits few buckets.
-  constexpr int kBucketsPerSide = 32;
+  // About 32^3 cubic buckets over the bounds: a few obstacles per bucket for the paper's maps;
+  // fine enough that a short RRT edge visits few buckets. On a flat or thin map (a 1 km x 1 km
+  // x 3 m forest) the buckets stay cubic and the budget goes to the long axes: an axis shorter
+  // than a bucket gets one, and the others share the count (32 along the longest side only
+  // left 31 m buckets there, each holding hundreds of trunks).
+  constexpr double kBuckets = 32.0 * 32.0 * 32.0;
   index_.origin = bounds_.min;
-  index_.cell = bounds_.extent().maxCoeff() / kBucketsPerSide;
+  const Eigen::Vector3d extent = bounds_.extent();
+  std::array<bool, 3> single{false, false, false};
+  for (int pass = 0; pass < 3; ++pass) {
+    double product = 1.0;
+    int axes = 0;
+    for (int k = 0; k < 3; ++k)
+      if (!single[k]) product *= extent[k], ++axes;
+    index_.cell = std::pow(product / kBuckets, 1.0 / axes);
+    bool changed = false;
+    for (int k = 0; k < 3; ++k)
+      if (!single[k] && extent[k] < index_.cell && axes > 1) single[k] = changed = true;
+    if (!changed) break;
+  }
   for (int k = 0; k < 3; ++k) {
     index_.dims[k] = std::max(1, static_cast<int>(std::ceil(bounds_.extent()[k] / index_.cell)));
   }
   index_.buckets.assign(static_cast<std::size_t>(index_.dims.prod()), {});
   index_.large.clear();
+  index_.beyond.clear();
   // A box over more buckets than this is listed once (index_.large): the index stays O(n).
   constexpr long kMaxBucketsPerObstacle = 512;
   for (std::size_t i = 0; i < obstacles_.size(); ++i) {
+    if (!bounds_.contains(obstacles_[i].min) || !bounds_.contains(obstacles_[i].max)) index_.beyond.push_back(static_cast<std::uint32_t>(i));
     Eigen::Vector3i lo, hi;
     index_.span(obstacles_[i], lo, hi);
     if (static_cast<long>(hi.x() - lo.x() + 1) * (hi.y() - lo.y() + 1) * (hi.z() - lo.z() + 1) > kMaxBucketsPerObstacle) {
@@ -275,7 +301,20 @@ Map Map::from_json(const Json& doc, const std::string& origin) {
     query = Query{q.at("start").vec3(), q.at("goal").vec3(), q.at("robot_radius").number()};
   }
   try {
-    return Map(bounds, resolution, std::move(obstacles), query, std::move(voxels));
+    Map map(bounds, resolution, std::move(obstacles), query, std::move(voxels));
+    // A box farther from the bounds than the largest robot radius can meet no query: in a
+    // file it is a mistake of units or frame, refused rather than ignored (issue 20, S6).
+    const Box reach = map.bounds().inflated(kMaxRobotRadius);
+    for (std::size_t i = 0; i < map.obstacles().size(); ++i)
+      if (!reach.overlaps(map.obstacles()[i])) {
+        std::ostringstream os;
+        os << "obstacles[" << i << "] [" << format_point(map.obstacles()[i].min) << " - "
+           << format_point(map.obstacles()[i].max) << "] lies more than " << kMaxRobotRadius
+           << " m (the largest robot radius) outside the bounds [" << format_point(map.bounds().min) << " - "
+           << format_point(map.bounds().max) << "], where no query can meet it: remove it or grow the bounds";
+        throw Error(os.str());
+      }
+    return map;
   } catch (const Error& e) {
     throw Error(origin + ": " + e.what());
   }
@@ -399,22 +438,42 @@ double Map::clearance(const Eigen::Vector3d& p) const {
 
 std::optional<double> Map::raycast(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double max_range) const {
   std::optional<double> best = voxels_ ? voxels_->raycast(origin, dir, max_range) : std::nullopt;
-  for (const Box& b : obstacles_) {
-    // Slab test: the ray meets the closed box on [t0, t1].
-    double t0 = 0.0, t1 = best ? *best : max_range;
-    bool miss = false;
-    for (int k = 0; k < 3 && !miss; ++k) {
-      if (dir[k] == 0.0) {
-        miss = origin[k] < b.min[k] || origin[k] > b.max[k];
-        continue;
-      }
-      double ta = (b.min[k] - origin[k]) / dir[k], tb = (b.max[k] - origin[k]) / dir[k];
-      if (ta > tb) std::swap(ta, tb);
-      t0 = std::max(t0, ta);
-      t1 = std::min(t1, tb);
-      miss = t0 > t1;
-    }
-    if (!miss) best = t0;
+  const auto consider = [&](std::size_t i) {
+    if (const auto t = ray_interval(obstacles_[i], origin, dir, best ? *best : max_range)) best = t->first;
+  };
+  const auto brute_force = [&] {
+    for (std::size_t i = 0; i < obstacles_.size(); ++i) consider(i);
+    return best;
+  };
+  // The ray's stretch inside the bounds, where every obstacle contained in the bounds is met
+  // (a box inside the bounds is entered inside them; the slab arithmetic is monotone, so the
+  // computed entry of such a box is never before the computed entry of the bounds).
+  const auto inside = ray_interval(bounds_, origin, dir, max_range);
+  if (dir.isZero() || !std::isfinite(max_range) || obstacles_.size() < kRayWalkMinObstacles) return brute_force();
+  for (const std::uint32_t i : index_.large) consider(i);
+  for (const std::uint32_t i : index_.beyond) consider(i);
+  if (!inside) return best;
+  const auto [t_in, t_out] = *inside;
+  // Walk the stretch in pieces about one bucket long, nearest first. Each piece's bounding
+  // box (widened by kRayPieceSlack against rounding of the end points) selects buckets with
+  // the same span() the index was built with, so a box containing a point of the piece is in
+  // one of them; once a piece starts beyond the best hit no later piece can improve it.
+  const double norm = dir.norm();
+  const double length = (t_out - t_in) * norm;
+  const int pieces = static_cast<int>(std::min<double>(kMaxRayPieces, std::ceil(length / index_.cell) + 1.0));
+  const double slack = kRayPieceSlack * bounds_.extent().maxCoeff();
+  for (int p = 0; p < pieces; ++p) {
+    const double ta = t_in + (t_out - t_in) * p / pieces;
+    const double tb = p + 1 == pieces ? t_out : t_in + (t_out - t_in) * (p + 1) / pieces;
+    if (best && ta > *best) break;
+    const Eigen::Vector3d a = origin + ta * dir, b = origin + tb * dir;
+    const Box piece = Box{a.cwiseMin(b), a.cwiseMax(b)}.inflated(slack);
+    Eigen::Vector3i lo, hi;
+    index_.span(piece, lo, hi);
+    for (int z = lo.z(); z <= hi.z(); ++z)
+      for (int y = lo.y(); y <= hi.y(); ++y)
+        for (int x = lo.x(); x <= hi.x(); ++x)
+          for (const std::uint32_t i : index_.buckets[index_.at(x, y, z)]) consider(i);
   }
   return best;
 }

@@ -173,6 +173,9 @@ class Map {
     /// Obstacles spanning more than kMaxBucketsPerObstacle buckets, checked by every query
     /// instead (so n huge boxes cost n entries, not n x 32^3).
     std::vector<std::uint32_t> large;
+    /// Obstacles not contained in the bounds: a ray may meet them outside the bounds, where
+    /// raycast does not walk the buckets, so it checks them all (usually none).
+    std::vector<std::uint32_t> beyond;
     /// Bucket coordinates covering `box` along each axis, clamped to the grid (obstacles
     /// and queries outside the bounds land in the border buckets).
     void span(const Box& box, Eigen::Vector3i& lo, Eigen::Vector3i& hi) const;

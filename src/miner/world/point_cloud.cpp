@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cctype>
 #include <cstring>
 #include <sstream>
+#include <tuple>
 
 #include <octomap/OcTree.h>
 
@@ -97,10 +99,21 @@ double read_scalar(const char* p, const Field& f, bool swap) {
   }
 }
 
+/// A decimal number, or nan / inf (organised clouds mark missing returns so; such points are
+/// skipped and counted). strtod alone also reads hexadecimal floats ("0x1p3" is 8), which no
+/// point cloud writer emits (issue 20, third campaign).
+bool decimal_or_special(const std::string& token) {
+  std::string lower;
+  for (char c : token) lower += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const std::string bare = !lower.empty() && (lower[0] == '-' || lower[0] == '+') ? lower.substr(1) : lower;
+  if (bare == "nan" || bare == "inf" || bare == "infinity") return true;
+  return token.find_first_not_of("0123456789+-.eE") == std::string::npos;
+}
+
 double parse_number(const std::string& token, const std::string& origin, std::size_t point) {
   char* end = nullptr;
   const double v = std::strtod(token.c_str(), &end);
-  if (end == token.c_str() || *end != '\0') {
+  if (end == token.c_str() || *end != '\0' || !decimal_or_special(token)) {
     std::ostringstream os;
     os << "point " << point << ": \"" << token << "\" is not a number";
     fail(origin, os.str());
@@ -113,8 +126,9 @@ void add_point(PointCloud& cloud, const Eigen::Vector3d& p) {
   else ++cloud.skipped;
 }
 
-/// Reads `n` records of `fields` (x, y, z at xyz[0..2]) from ASCII lines or binary bytes.
-void read_records(PointCloud& cloud, const std::string& bytes, std::size_t pos, std::size_t n,
+/// Reads `n` records of `fields` (x, y, z at xyz[0..2]) from ASCII lines or binary bytes;
+/// returns the offset just after them.
+std::size_t read_records(PointCloud& cloud, const std::string& bytes, std::size_t pos, std::size_t n,
                   const std::vector<Field>& fields, const std::array<int, 3>& xyz, bool ascii, bool swap,
                   std::size_t stride, const std::string& origin, bool exact_end) {
   if (ascii) {
@@ -148,7 +162,7 @@ void read_records(PointCloud& cloud, const std::string& bytes, std::size_t pos, 
       os << "data continues after the " << n << " points the header declares";
       fail(origin, os.str());
     }
-    return;
+    return std::min(line_start, bytes.size());
   }
   if ((bytes.size() - pos) / stride < n) {
     std::ostringstream os;
@@ -168,6 +182,86 @@ void read_records(PointCloud& cloud, const std::string& bytes, std::size_t pos, 
     add_point(cloud, {read_scalar(rec + fields[xyz[0]].offset, fields[xyz[0]], swap),
                       read_scalar(rec + fields[xyz[1]].offset, fields[xyz[1]], swap),
                       read_scalar(rec + fields[xyz[2]].offset, fields[xyz[2]], swap)});
+  }
+  return pos + n * stride;
+}
+
+/// A PLY element after the vertices (faces, edges): read only to check that the file holds
+/// exactly what its header declares (issue 20: a face count was never checked).
+struct PlyProperty {
+  bool list = false;
+  Field count;  ///< lists: the type of the item count
+  Field item;   ///< scalars: the value; lists: each item
+};
+struct PlyElement {
+  std::string name;
+  std::size_t count = 0;
+  std::vector<PlyProperty> properties;
+};
+
+/// The PLY scalar type named `type` (size 0 if unknown).
+Field ply_type(const std::string& type) {
+  static const std::vector<std::pair<std::vector<std::string>, std::pair<std::size_t, char>>> kTypes = {
+      {{"char", "int8"}, {1, 'i'}},    {{"uchar", "uint8"}, {1, 'u'}},  {{"short", "int16"}, {2, 'i'}},
+      {{"ushort", "uint16"}, {2, 'u'}}, {{"int", "int32"}, {4, 'i'}},   {{"uint", "uint32"}, {4, 'u'}},
+      {{"float", "float32"}, {4, 'f'}}, {{"double", "float64"}, {8, 'f'}}};
+  Field f;
+  for (const auto& [names, t] : kTypes)
+    if (std::find(names.begin(), names.end(), type) != names.end()) std::tie(f.size, f.kind) = t;
+  return f;
+}
+
+/// Walks the records of `elements` from `pos`; the file must end with the last of them.
+void check_later_elements(const std::string& bytes, std::size_t pos, const std::vector<PlyElement>& elements,
+                          bool ascii, bool swap, const std::string& origin) {
+  const auto record_fail = [&](const PlyElement& e, std::size_t i, const std::string& what) {
+    std::ostringstream os;
+    os << "element " << e.name << " " << i << " of " << e.count << ": " << what;
+    fail(origin, os.str());
+  };
+  for (const PlyElement& e : elements) {
+    for (std::size_t i = 0; i < e.count; ++i) {
+      if (ascii) {
+        std::vector<std::string> w;
+        while (w.empty()) {
+          if (pos >= bytes.size()) record_fail(e, i, "the data ends before it");
+          std::size_t end = bytes.find('\n', pos);
+          if (end == std::string::npos) end = bytes.size();
+          w = words(bytes.substr(pos, end - pos));
+          pos = end + 1;
+        }
+        std::size_t k = 0;
+        for (const PlyProperty& p : e.properties) {
+          std::size_t items = 1;
+          if (p.list) {
+            if (k >= w.size() || w[k].find_first_not_of("0123456789") != std::string::npos || w[k].size() > 9)
+              record_fail(e, i, "a list does not start with its item count");
+            items = std::stoull(w[k++]);
+          }
+          for (std::size_t j = 0; j < items; ++j, ++k)
+            if (k >= w.size() || !decimal_or_special(w[k])) record_fail(e, i, "fewer or other values than the header declares");
+        }
+        if (k != w.size()) record_fail(e, i, "more values than the header declares");
+      } else {
+        for (const PlyProperty& p : e.properties) {
+          std::size_t items = 1;
+          if (p.list) {
+            if (bytes.size() - pos < p.count.size) record_fail(e, i, "the data ends inside it");
+            const double n = read_scalar(bytes.data() + pos, p.count, swap);
+            if (n < 0) record_fail(e, i, "a negative list length");
+            items = static_cast<std::size_t>(n);
+            pos += p.count.size;
+          }
+          if ((bytes.size() - pos) / p.item.size < items) record_fail(e, i, "the data ends inside it");
+          pos += items * p.item.size;
+        }
+      }
+    }
+  }
+  if (pos < bytes.size() && (!ascii || bytes.find_first_not_of(" \t\r\n", pos) != std::string::npos)) {
+    std::ostringstream os;
+    os << "data continues after the elements the header declares (" << bytes.size() - pos << " bytes)";
+    fail(origin, os.str());
   }
 }
 
@@ -193,7 +287,8 @@ PointCloud parse_ply(const std::string& bytes, const std::string& origin) {
   if (lines.next() != "ply") fail(origin, "not a PLY file (the first line is not \"ply\")");
   std::string format;
   std::size_t vertices = 0;
-  bool in_vertex = false, seen_element = false, other_elements = false;
+  bool in_vertex = false, seen_element = false;
+  std::vector<PlyElement> later;
   std::vector<Field> fields;
   std::size_t stride = 0;
   while (true) {
@@ -212,20 +307,31 @@ PointCloud parse_ply(const std::string& bytes, const std::string& origin) {
       if (!seen_element && w[1] != "vertex") fail(origin, "the first element is \"" + w[1] + "\", not \"vertex\"");
       in_vertex = !seen_element;
       if (in_vertex) vertices = count_of(w[2], "element vertex", origin);
-      else other_elements = true;
+      else later.push_back({w[1], count_of(w[2], "element " + w[1], origin), {}});
       seen_element = true;
     } else if (w[0] == "property") {
-      if (!in_vertex) continue;  // properties of later elements are never read
+      if (!seen_element) fail(origin, "a property line before any element");
+      if (!in_vertex) {  // a later element's property: its records are walked, never used
+        PlyProperty p;
+        p.list = w.size() == 5 && w[1] == "list";
+        if (w.size() != (p.list ? 5u : 3u)) fail(origin, "malformed property line of element \"" + later.back().name + "\"");
+        if (p.list) {
+          p.count = ply_type(w[2]);
+          p.item = ply_type(w[3]);
+          if (p.count.size == 0 || p.count.kind == 'f')
+            fail(origin, "element \"" + later.back().name + "\" list \"" + w[4] + "\": count type \"" + w[2] + "\" is not an integer type");
+          if (p.item.size == 0) fail(origin, "element \"" + later.back().name + "\" list \"" + w[4] + "\" has unknown type \"" + w[3] + "\"");
+        } else {
+          p.item = ply_type(w[1]);
+          if (p.item.size == 0) fail(origin, "element \"" + later.back().name + "\" property \"" + w[2] + "\" has unknown type \"" + w[1] + "\"");
+        }
+        later.back().properties.push_back(p);
+        continue;
+      }
       if (w.size() != 3) fail(origin, "vertex property \"" + (w.size() > 1 ? w[1] : std::string()) +
                                           "\": list properties are not supported in the vertex element");
-      static const std::vector<std::pair<std::vector<std::string>, std::pair<std::size_t, char>>> kTypes = {
-          {{"char", "int8"}, {1, 'i'}},    {{"uchar", "uint8"}, {1, 'u'}},  {{"short", "int16"}, {2, 'i'}},
-          {{"ushort", "uint16"}, {2, 'u'}}, {{"int", "int32"}, {4, 'i'}},   {{"uint", "uint32"}, {4, 'u'}},
-          {{"float", "float32"}, {4, 'f'}}, {{"double", "float64"}, {8, 'f'}}};
-      Field f;
+      Field f = ply_type(w[1]);
       f.name = w[2];
-      for (const auto& [names, type] : kTypes)
-        if (std::find(names.begin(), names.end(), w[1]) != names.end()) std::tie(f.size, f.kind) = type;
       if (f.size == 0) fail(origin, "vertex property \"" + w[2] + "\" has unknown type \"" + w[1] + "\"");
       f.offset = stride;
       stride += f.size;
@@ -238,9 +344,12 @@ PointCloud parse_ply(const std::string& bytes, const std::string& origin) {
   if (!seen_element) fail(origin, "the header declares no vertex element");
   const std::array<int, 3> xyz = find_xyz(fields, origin);
   PointCloud cloud;
-  // Later elements (faces, edges) follow the vertices: only a vertex-only file must end with them.
-  read_records(cloud, bytes, lines.pos, vertices, fields, xyz, format == "ascii", format == "binary_big_endian",
-               stride, origin, !other_elements);
+  // Later elements (faces, edges) follow the vertices and are walked to the file's end.
+  for (const PlyElement& e : later)
+    if (e.count > 0 && e.properties.empty()) fail(origin, "element \"" + e.name + "\" has records but no properties");
+  const std::size_t end = read_records(cloud, bytes, lines.pos, vertices, fields, xyz, format == "ascii",
+                                       format == "binary_big_endian", stride, origin, later.empty());
+  if (!later.empty()) check_later_elements(bytes, end, later, format == "ascii", format == "binary_big_endian", origin);
   return cloud;
 }
 

@@ -326,19 +326,10 @@ std::optional<double> VoxelObstacles::raycast(const Eigen::Vector3d& origin, con
   if (blocked_count_ == 0) return std::nullopt;
   const VoxelLayer& L = *layer_;
   const Box box = L.bounds();
-  // Clip the ray to the layer (slab test).
-  double t0 = 0.0, t1 = max_range;
-  for (int k = 0; k < 3; ++k) {
-    if (dir[k] == 0.0) {
-      if (origin[k] < box.min[k] || origin[k] > box.max[k]) return std::nullopt;
-      continue;
-    }
-    double ta = (box.min[k] - origin[k]) / dir[k], tb = (box.max[k] - origin[k]) / dir[k];
-    if (ta > tb) std::swap(ta, tb);
-    t0 = std::max(t0, ta);
-    t1 = std::min(t1, tb);
-  }
-  if (t0 > t1) return std::nullopt;
+  // Clip the ray to the layer.
+  const auto clipped = ray_interval(box, origin, dir, max_range);
+  if (!clipped) return std::nullopt;
+  const auto [t0, t1] = *clipped;
   const double res = L.resolution();
   const Eigen::Vector3d entry = origin + t0 * dir;
   Eigen::Vector3i c = L.clamped_cell(entry);

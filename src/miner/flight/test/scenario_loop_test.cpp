@@ -145,8 +145,18 @@ TEST_CASE("Bad scenarios are refused before flight with the fault named", "[REQ-
   doc = default_doc();
   doc["start"] = start;
   doc["waypoints"] = {start};
+  // Given waypoints are the route: the planner block would go unused (issue 20).
+  expect_scenario_error(doc, "s.json: planner: unused: the route is given by \"waypoints\"");
+  doc.erase("planner");
   expect_scenario_error(doc, "waypoints[0] (");
   expect_scenario_error(doc, "coincides with start");
+  // An empty list is not "no waypoints": it flew a straight line through the map (issue 20).
+  doc["waypoints"] = miner::Json::array();
+  expect_scenario_error(doc, "s.json: waypoints: empty: give at least one interior point");
+  doc = default_doc();
+  doc["planner"]["region"] = "astar";
+  doc["planner"]["weights"] = "w.bin";
+  expect_scenario_error(doc, "s.json: planner.weights: applies to \"region\": \"sgan\" only");
   doc = default_doc();
   doc["vehicle"] = flight::to_json(flight::VehicleParams{});
   doc["vehicle"]["mass_kgg"] = 2;
@@ -191,6 +201,18 @@ TEST_CASE("A trajectory file that exceeds the limits or misses the start is refu
   doc["start"] = {5, 5, 3};
   doc["goal"] = {12, 9, 4};
   doc["trajectory"] = {{"file", path}, {"v_max", 0.5}, {"a_max", 0.5}};
+  // The file is the route: a planner block, waypoints or the order and allocation of a
+  // trajectory the file already fixes would be ignored, so they are refused (issue 20).
+  expect_scenario_error(doc, "s.json: planner: unused: the route is the trajectory file's");
+  doc.erase("planner");
+  doc["waypoints"] = {{8, 7, 3}};
+  expect_scenario_error(doc, "s.json: waypoints: unused: the route is the trajectory file's");
+  doc.erase("waypoints");
+  for (const auto& [key, value] : {std::pair<const char*, miner::Json>{"order", 3}, {"allocation", "optimise"}, {"rho", 2.0}}) {
+    doc["trajectory"][key] = value;
+    expect_scenario_error(doc, std::string("trajectory.") + key + ": unused: the trajectory file fixes the order");
+    doc["trajectory"].erase(key);
+  }
   expect_scenario_error(doc, "exceed the limits");
   doc["trajectory"] = {{"file", path}, {"v_max", 2.0}, {"a_max", 2.0}};
   CHECK(pipeline::build_reference(pipeline::scenario_from_json(doc, "s.json", kScenarios)).source == "file");

@@ -282,6 +282,8 @@ TEST_CASE("A missing, truncated, altered or mismatched weights file is refused n
     CHECK_NOTHROW(heuristic::Sgan::from_bytes(rewritten(header), "same.bin"));
     refuses([](miner::Json& h) { h["foo"] = 1; }, "foo: unknown key");
     refuses([](miner::Json& h) { h["meta"]["architecture"]["foo"] = 1; }, "meta.architecture.foo: unknown key");
+    refuses([](miner::Json& h) { h["meta"]["final"] = "trained well"; }, "meta.final: must be an object");
+    refuses([](miner::Json& h) { h["meta"]["training"] = 3; }, "meta.training: must be an object");
     refuses([](miner::Json& h) { h["meta"]["architecture"]["layers"] = {"enc1"}; }, "layers: must list sgan-unet4's nine layers");
     refuses([](miner::Json& h) { h["tensors"][1]["offset"] = 0; }, "two tensors overlap");
     refuses([](miner::Json& h) { h["tensors"][1]["offset"] = 2593; }, "must be a multiple of 4");

@@ -72,6 +72,15 @@ TEST_CASE("A region round-trips through miner-region-v1 and bad files name the f
   doc = r.to_json();
   doc["probabilities"][2] = "x";
   CHECK_THROWS_WITH(HeuristicRegion::from_json(doc, "r.json"), Contains("probabilities[2]"));
+  // The source is provenance printed in reports: one printable line (issue 20, S7).
+  for (const std::string& bad : {std::string("a\nb"), std::string("tab\there"), std::string(513, 'x')}) {
+    doc = r.to_json();
+    doc["source"] = bad;
+    CHECK_THROWS_WITH(HeuristicRegion::from_json(doc, "r.json"), Contains("r.json: source: must be one line of at most 512 bytes"));
+  }
+  doc = r.to_json();
+  doc["source"] = std::string(512, 'x');
+  CHECK_NOTHROW(HeuristicRegion::from_json(doc, "r.json"));
   CHECK_THROWS_WITH(HeuristicRegion(Box{{0, 0, 0}, {1, 1, 1}}, I(8192, 8192, 1), {}, 0.5),
                     Contains("more than the limit"));
   // Dims whose product wraps 64 bits (2^31 - 1 cubed ~ 2^93; a wrapped product could pass a

@@ -81,6 +81,14 @@ TEST_CASE("Bad map documents are refused with the field named", "[REQ-WORLD-002]
   d = valid_doc();
   d["obstacles"][0]["min"][1] = std::numeric_limits<double>::quiet_NaN();
   CHECK_THAT(error_of(d), Contains("obstacles[0].min[1]"));
+  // A box no query can meet (more than the largest robot radius outside the bounds) is a
+  // mistake of units or frame in a file (issue 20, S6); one within that reach is kept.
+  d = valid_doc();
+  d["obstacles"].push_back({{"type", "box"}, {"min", {1000, 1000, 0}}, {"max", {1001, 1001, 1}}});
+  CHECK_THAT(error_of(d), Contains("m.json: obstacles[1] [(1000, 1000, 0) - (1001, 1001, 1)] lies more than 10 m"));
+  d = valid_doc();
+  d["obstacles"].push_back({{"type", "box"}, {"min", {-9.5, 1, 0}}, {"max", {-9, 2, 1}}});
+  CHECK_NOTHROW(Map::from_json(d, "m.json"));
   d = valid_doc();
   d["obstacles"] = Json::object();
   CHECK_THAT(error_of(d), Contains("obstacles: expected an array, got object"));

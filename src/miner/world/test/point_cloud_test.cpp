@@ -262,6 +262,36 @@ TEST_CASE("Malformed point clouds are refused naming the fault, never crash", "[
                           "float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n1 2 3\n3 0 0 0\n",
                           true, "faces.ply")
             .points.size() == 1);
+  // ... and must be exactly what the header declares (issue 20, third campaign: a face count
+  // was never checked, so faces could be missing or followed by anything).
+  const std::string faces_head = "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+                                 "property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n1 2 3\n";
+  CHECK(parse_point_cloud(faces_head + "3 0 0 0\n4 0 0 0 0\n", true, "faces.ply").points.size() == 1);
+  refuses(faces_head + "3 0 0 0\n", true, "element face 1 of 2: the data ends before it");
+  refuses(faces_head + "3 0 0 0\n3 0 0 0\n3 0 0 0\n", true, "data continues after the elements");
+  refuses(faces_head + "3 0 0 0\n3 0 0\n", true, "element face 1 of 2: fewer or other values");
+  refuses(faces_head + "3 0 0 0\n2 0 0 0\n", true, "element face 1 of 2: more values");
+  refuses(faces_head + "3 0 0 0\nx 0 0 0\n", true, "a list does not start with its item count");
+  refuses("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+          "element face 1\nproperty list float int vertex_indices\nend_header\n1 2 3\n1 0\n",
+          true, "count type \"float\" is not an integer type");
+  {
+    // Binary: one vertex (12 bytes), two faces of 3 uint32 indices behind a uchar count.
+    std::string bin = "ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+                      "property float z\nelement face 2\nproperty list uchar uint vertex_indices\nend_header\n" +
+                      std::string(12, '\0');
+    const std::string face = std::string(1, '\3') + std::string(12, '\0');
+    CHECK(parse_point_cloud(bin + face + face, true, "faces.ply").points.size() == 1);
+    refuses(bin + face, true, "element face 1 of 2: the data ends inside it");
+    refuses(bin + face + face + "x", true, "data continues after the elements the header declares (1 bytes)");
+  }
+  // Numbers are decimal (or nan / inf, which organised clouds use): strtod's hexadecimal
+  // floats are refused, in PCD and PLY alike (third campaign: "0x1p3" read as 8).
+  refuses(pcd_head + "POINTS 1\nDATA ascii\n0x1p3 0 1\n", false, "point 0: \"0x1p3\" is not a number");
+  refuses("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n"
+          "0 0X10 1\n",
+          true, "\"0X10\" is not a number");
+  CHECK(parse_point_cloud(pcd_head + "POINTS 2\nDATA ascii\n-1.5e-3 +2 1E2\nNaN -inf 1\n", false, "ok.pcd").skipped == 1);
   CHECK_THROWS_WITH(integrate_clouds({{parse_point_cloud(pcd(wall_points(), false), false, "w.pcd"), V(0, 0, 0.5)}},
                                      1e300, 0.0),
                     Contains("resolution: 1e+300 m is outside"));

@@ -91,6 +91,10 @@ extern const CLI::Validator kShard;
 CLI::Validator finite_in(double lo, double hi);
 /// An integer in [lo, hi], read after kDecimalInteger. REQ-CLI-002.
 CLI::Validator integer_in(long long lo, long long hi);
+/// One of `names` ("unknown <what> \"x\", did you mean \"y\"? (known: a, b, c)"), a usage error.
+CLI::Validator one_of(const std::string& what, const std::vector<std::string>& names);
+/// A map generator preset (`map gen --preset`, `dataset --preset`).
+extern const CLI::Validator kMapPreset;
 /// Refuses a list option that names a value twice (issue 20: `--segments 5,5` timed the same
 /// case twice), as a usage error naming the option.
 void require_distinct(const std::string& option, const std::vector<std::string>& values);

@@ -64,13 +64,18 @@ struct GenOptions {
   bool json = false;
 };
 
-void run_gen(const GenOptions& o, std::ostream& out) {
-  const auto preset = world::generator_preset(o.preset);
+world::GeneratorOverrides overrides_of(const GenOptions& o) {
   world::GeneratorOverrides overrides;
   if (o.obstacles >= 0) overrides.obstacles = o.obstacles;
   if (!o.size.empty()) overrides.size = Eigen::Vector3d(o.size[0], o.size[1], o.size[2]);
   if (!std::isnan(o.resolution)) overrides.resolution = o.resolution;
   if (!o.base.empty()) overrides.base = o.base;
+  return overrides;
+}
+
+void run_gen(const GenOptions& o, std::ostream& out) {
+  const auto preset = world::generator_preset(o.preset);
+  const world::GeneratorOverrides overrides = overrides_of(o);
   if (preset.name == "scan") {
     const world::ScanMap scan = world::generate_scan_map(preset, o.seed, overrides);
     scan.map.save(o.out);
@@ -347,8 +352,9 @@ void add_map_commands(CLI::App& app, std::ostream& out) {
                 "map preset: sim (100 m, paper Sec. V-B), indoor (10 m site, Sec. V-D), a family drawing its "
                 "size per map: cluttered, rooms, forest, multilevel, or scan: the voxels a simulated mapping run "
                 "leaves over a map of another preset (a .json gets its .bt beside it)")
-      ->capture_default_str();
-  g->add_option("--base", gen->base, "scan: the preset the mapping run flies over (default: drawn per map)");
+      ->capture_default_str()->check(kMapPreset);
+  g->add_option("--base", gen->base, "scan: the preset the mapping run flies over (default: drawn per map)")
+      ->check(one_of("scan base", world::scan_base_names()));
   g->add_option("--seed", gen->seed, "random seed")->capture_default_str()->check(kUnsigned64);
   g->add_option("--obstacles", gen->obstacles, "number of obstacles (default: the preset's range)")
       ->check(CLI::Range(0, kMaxObstacles));
@@ -358,7 +364,16 @@ void add_map_commands(CLI::App& app, std::ostream& out) {
       ->check(finite_in(world::kMinFamilyResolution, world::kMaxFamilyResolution));
   g->add_option("--out", gen->out, "output file (.json, or .bt for OctoMap)")->required()->check(kOutputFile & kMapOutput);
   g->add_flag("--json", gen->json, "print the summary as JSON");
-  g->callback([gen, &out] { run_gen(*gen, out); });
+  g->callback([gen, &out] {
+    // What the preset does not take is a usage error, found before any work (issue 20: exit 1
+    // after the line was accepted). The library names the override as the option, less "--".
+    try {
+      world::check_overrides(world::generator_preset(gen->preset), overrides_of(*gen));
+    } catch (const Error& e) {
+      throw CLI::ValidationError(std::string("--") + e.what());
+    }
+    run_gen(*gen, out);
+  });
 
   auto info = std::make_shared<InfoOptions>();
   CLI::App* i = map->add_subcommand("info", "summarise a map and its occupancy grid");

@@ -121,10 +121,10 @@ TEST_CASE("map gen --preset scan writes the run's voxels beside the map, and pla
   INFO(plan.err);
   CHECK(plan.code == 0);
   const Run self = miner_cli({"map", "gen", "--preset", "scan", "--base", "scan", "--out", dir() + "/x.json"});
-  CHECK(self.code == 1);
+  CHECK(self.code == 2);  // usage errors, before any work
   CHECK_THAT(self.err, Contains("base") && Contains("rooms"));
   const Run other = miner_cli({"map", "gen", "--preset", "sim", "--base", "rooms", "--out", dir() + "/x.json"});
-  CHECK(other.code == 1);
+  CHECK(other.code == 2);
   CHECK_THAT(other.err, Contains("base"));
 }
 
@@ -206,7 +206,21 @@ TEST_CASE("Bad input: each case names what is wrong and exits non-zero", "[REQ-C
       // An unknown planner is a usage error naming every valid one (issue 20: exit 1, after parsing).
       {{"bench", "frontend", "--map", map, "--planners", "rrtstar,foo"}, 2, "unknown planner \"foo\" (planners: rrtstar, informed, guided, miner, miner-sgan, ompl:"},
       {{"astar", "--map", map, "--start", "3.2", "5", "5", "--goal", "9", "9", "9", "--radius", "0.5"}, 1, "lies in an occupied grid cell"},
-      {{"map", "gen", "--preset", "swamp", "--out", dir() + "/x.json"}, 1, "unknown map preset \"swamp\""},
+      // A preset and its overrides are usage errors found before any work (third campaign: exit 1).
+      {{"map", "gen", "--preset", "swamp", "--out", dir() + "/x.json"}, 2, "--preset: unknown map preset \"swamp\""},
+      {{"map", "gen", "--preset", "forrest", "--out", dir() + "/x.json"}, 2, "did you mean \"forest\"?"},
+      {{"dataset", "--preset", "simm", "--out", dir() + "/ds"}, 2, "--preset: unknown map preset \"simm\", did you mean \"sim\"?"},
+      {{"map", "gen", "--preset", "sim", "--size", "10", "10", "10", "--out", dir() + "/x.json"}, 2, "--size: preset \"sim\" has fixed bounds"},
+      {{"map", "gen", "--preset", "scan", "--base", "indoor", "--resolution", "0.5", "--out", dir() + "/x.json"}, 2,
+       "--resolution: preset \"indoor\" has fixed bounds"},
+      {{"map", "gen", "--preset", "scan", "--base", "multilevel", "--obstacles", "4", "--out", dir() + "/x.json"}, 2,
+       "--obstacles: preset \"multilevel\" has no obstacle count"},
+      {{"map", "gen", "--preset", "forest", "--base", "rooms", "--out", dir() + "/x.json"}, 2, "--base: only the scan preset"},
+      {{"map", "gen", "--preset", "scan", "--base", "scan", "--out", dir() + "/x.json"}, 2, "--base: unknown scan base \"scan\""},
+      // CLI11's count messages in plain words.
+      {{"astar", "--map", map, "--radius", "1", "--radius", "2"}, 2, "--radius: given more than once, it takes one value (got 2)"},
+      {{"astar", "--map", map, "--start", "1", "1"}, 2, "--start: takes 3 values, got 2"},
+      {{"bench", "frontend", "--map", map, "--planners"}, 2, "--planners: needs 1 value, got none"},
       {{"map", "info", "--map", write("garbage.bt", "not an octree")}, 1, "not an OctoMap file"},
   };
   for (const auto& c : cases) {

@@ -1,5 +1,6 @@
 #include "miner/world/map_generator.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "miner/core/error.hpp"
@@ -196,17 +197,29 @@ Map generate_map(const GeneratorPreset& preset, std::uint64_t seed,
   return generate_map(preset, seed, o);
 }
 
-Map generate_map(const GeneratorPreset& preset, std::uint64_t seed, const GeneratorOverrides& overrides) {
-  const std::optional<int> obstacle_count = overrides.obstacles;
-  if (obstacle_count && *obstacle_count < 0) {
-    throw Error("obstacles: count must not be negative, got " + std::to_string(*obstacle_count));
+void check_overrides(const GeneratorPreset& preset, const GeneratorOverrides& overrides) {
+  if (overrides.obstacles && *overrides.obstacles < 0)
+    throw Error("obstacles: count must not be negative, got " + std::to_string(*overrides.obstacles));
+  if (overrides.base) {
+    if (preset.name != "scan")
+      throw Error("base: only the scan preset flies over a base map, not \"" + preset.name + "\"");
+    const std::vector<std::string> bases = scan_base_names();
+    if (std::find(bases.begin(), bases.end(), *overrides.base) == bases.end()) {
+      std::string known;
+      for (const std::string& b : bases) known += (known.empty() ? "" : ", ") + b;
+      throw Error("base: a scan is drawn over one of " + known + ", not \"" + *overrides.base + "\"");
+    }
   }
-  if (overrides.base && preset.name != "scan")
-    throw Error("base: only the scan preset flies over a base map, not \"" + preset.name + "\"");
-  if (!is_family(preset) && preset.name != "scan" && (overrides.size || overrides.resolution)) {
-    throw Error("size/resolution: preset \"" + preset.name + "\" has fixed bounds and resolution; "
-                "the map families (cluttered, rooms, forest, multilevel) take them");
-  }
+  // The preset whose map is drawn: a scan's given base, else the preset itself.
+  const std::string drawn = preset.name == "scan" && overrides.base ? *overrides.base : preset.name;
+  if (drawn != "scan" && !is_family(generator_preset(drawn)))
+    for (const auto& [given, name] : {std::pair{overrides.size.has_value(), "size"}, {overrides.resolution.has_value(), "resolution"}})
+      if (given)
+        throw Error(std::string(name) + ": preset \"" + drawn + "\" has fixed bounds and resolution; "
+                    "the map families (cluttered, rooms, forest, multilevel) and scans over them take them");
+  // Rooms and multilevel maps draw their walls and floors, not a count of obstacles.
+  if (overrides.obstacles && (drawn == "rooms" || drawn == "multilevel"))
+    throw Error("obstacles: preset \"" + drawn + "\" has no obstacle count to override");
   if (overrides.size) {
     const Eigen::Vector3d& s = *overrides.size;
     if (!s.allFinite() || (s.array() < 3.0).any() || (s.array() > 1000.0).any())
@@ -214,6 +227,11 @@ Map generate_map(const GeneratorPreset& preset, std::uint64_t seed, const Genera
   }
   if (overrides.resolution && !(*overrides.resolution >= kMinFamilyResolution && *overrides.resolution <= kMaxFamilyResolution))
     throw Error("resolution: must be between 0.01 and 10 m");
+}
+
+Map generate_map(const GeneratorPreset& preset, std::uint64_t seed, const GeneratorOverrides& overrides) {
+  check_overrides(preset, overrides);
+  const std::optional<int> obstacle_count = overrides.obstacles;
   if (preset.name == "scan") return generate_scan_map(preset, seed, overrides).map;
   if (is_family(preset)) {
     for (int attempt = 0; attempt < kMaxGeneratorAttempts; ++attempt) {

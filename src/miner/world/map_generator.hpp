@@ -60,6 +60,14 @@ struct GeneratorOverrides {
 /// voxel grid stay within ~10^7 cells).
 inline constexpr double kMaxFamilyCells = 300.0;
 
+/// Throws miner::Error unless `overrides` suit `preset`: each message starts with the
+/// override's name as `miner map gen` spells its option without the dashes ("base: ...",
+/// "size: ...", "resolution: ...", "obstacles: ..."), so the command line reports it as a
+/// usage error before any work. generate_map checks the same.
+void check_overrides(const GeneratorPreset& preset, const GeneratorOverrides& overrides);
+/// The presets a "scan" map may fly over (`--base`).
+std::vector<std::string> scan_base_names();
+
 /// The named preset; throws miner::Error listing the known names otherwise.
 GeneratorPreset generator_preset(const std::string& name);
 std::vector<std::string> generator_preset_names();

@@ -95,12 +95,10 @@ std::vector<Eigen::Vector3d> mapping_tour(Rng& rng, const Map& map, const Query&
 
 }  // namespace
 
+std::vector<std::string> scan_base_names() { return {kScanBases.begin(), kScanBases.end()}; }
+
 ScanMap generate_scan_map(const GeneratorPreset& preset, std::uint64_t seed, const GeneratorOverrides& overrides) {
-  if (overrides.base && std::find(kScanBases.begin(), kScanBases.end(), *overrides.base) == kScanBases.end()) {
-    std::string known;
-    for (const char* b : kScanBases) known += (known.empty() ? "" : ", ") + std::string(b);
-    throw Error("base: a scan is drawn over one of " + known + ", not \"" + *overrides.base + "\"");
-  }
+  check_overrides(preset, overrides);
   GeneratorOverrides base_overrides = overrides;
   base_overrides.base.reset();
   for (int attempt = 0; attempt < kMaxGeneratorAttempts; ++attempt) {

@@ -279,6 +279,10 @@ PlanResult RrtStar::run() {
   while (iteration < options_.max_iterations) {
     if (options_.stop_at_first && result_.first) break;
     if (result_.target) break;
+    // No path is shorter than the straight line ||x_goal - x_init||: a path of that cost (start
+    // within the goal radius, start == goal included) is optimal, and more iterations would only
+    // grow the tree (issue 20, third campaign: 20 000 iterations after a cost-0 answer).
+    if (best_cost_ <= (problem_.goal - problem_.start).norm()) break;
     ++iteration;
     update_trust(iteration);
     const Eigen::Vector3d x_rand = sample();

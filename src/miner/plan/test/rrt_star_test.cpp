@@ -234,6 +234,22 @@ TEST_CASE("A start inside the goal region is solved at once", "[REQ-PLAN-001]") 
   CHECK(r.iterations == 0);
   CHECK(r.path == std::vector<V>{problem.start, problem.goal});
   CHECK(r.cost == Approx(0.5));
+  // Without stop_at_first the answer is the same and no iteration runs: the straight line is
+  // optimal, so every planner stops at once (issue 20: start == goal ran the whole budget).
+  for (const V& goal : {V(1.5, 1, 0.5), V(1, 1, 0.5)}) {
+    const auto p = PlanningProblem::make(map, V(1, 1, 0.5), goal, 0.1);
+    for (const PlannerKind kind : miner::plan::all_planners()) {
+      PlannerOptions full;
+      full.planner = kind;
+      full.max_iterations = 5000;
+      const HeuristicRegion region = astar_region(p);
+      const PlanResult whole = miner::plan::plan(p, full, kind == PlannerKind::kMiner ? &region : nullptr);
+      INFO(miner::plan::planner_name(kind));
+      REQUIRE(whole.solved);
+      CHECK(whole.iterations == 0);
+      CHECK(whole.cost == (goal - V(1, 1, 0.5)).norm());
+    }
+  }
 }
 
 TEST_CASE("The safeguard keeps full trust in a region the solution runs through and lowers it otherwise", "[REQ-PLAN-020]") {

@@ -300,6 +300,17 @@ Map Map::from_json(const Json& doc, const std::string& origin) {
     // (issue 20); 0 must be said.
     query = Query{q.at("start").vec3(), q.at("goal").vec3(), q.at("robot_radius").number()};
   }
+  // Space inside the bounds but outside the voxels was never observed: it is unknown, and
+  // the queries would answer it free. Under the default policy (unknown is occupied,
+  // REQ-WORLD-013) such bounds are refused (issue 20, fourth campaign: a path through it).
+  if (voxels && voxels->unknown == UnknownPolicy::kOccupied) {
+    const Box lb = voxels->layer->bounds();
+    if ((bounds.min.array() < lb.min.array()).any() || (bounds.max.array() > lb.max.array()).any())
+      root.at("bounds").fail("[" + format_point(bounds.min) + " - " + format_point(bounds.max) +
+                             "] reaches beyond the voxels [" + format_point(lb.min) + " - " + format_point(lb.max) +
+                             "]: the space outside them is unknown, which this map treats as occupied; keep the "
+                             "bounds within the voxels or set \"voxels\": {\"unknown\": \"free\"}");
+  }
   try {
     Map map(bounds, resolution, std::move(obstacles), query, std::move(voxels));
     // A box farther from the bounds than the largest robot radius can meet no query: in a

@@ -79,6 +79,16 @@ TEST_CASE("A map file references its voxels by path and SHA-256", "[REQ-WORLD-01
       Map::load(write("lattice.json", R"({"format": "miner-map-v1", "bounds": {"min": [0.5, 0, 0], "max": [4, 4, 4]},
                                           "resolution": 1, "obstacles": [], "voxels": {"file": "small.bt"}})")),
       Contains("bounds.min[0] = 0.5 is not a multiple of the voxels' resolution"));
+  // Bounds past the voxels hold space never observed: unknown, so refused while unknown is
+  // occupied (the queries would answer it free: issue 20, fourth campaign planned through it);
+  // with "unknown": "free" it is free as asked.
+  CHECK_THROWS_WITH(
+      Map::load(write("wide.json", R"({"format": "miner-map-v1", "bounds": {"min": [0, 0, 0], "max": [6, 4, 4]},
+                                       "resolution": 1, "voxels": {"file": "small.bt"}})")),
+      Contains("wide.json: bounds: [(0, 0, 0) - (6, 4, 4)] reaches beyond the voxels [(0, 0, 0) - (4, 4, 4)]"));
+  const Map wide = Map::load(write("wide-free.json", R"({"format": "miner-map-v1", "bounds": {"min": [0, 0, 0], "max": [6, 4, 4]},
+                                       "resolution": 1, "voxels": {"file": "small.bt", "unknown": "free"}})"));
+  CHECK_FALSE(wide.point_collision(V(5.5, 2, 2)));
   // Boxes and voxels obstruct together.
   const Map both = Map::load(write("both.json", R"({"format": "miner-map-v1", "obstacles": [{"type": "box", "min": [0, 3, 0], "max": [1, 4, 1]}],
                                                    "voxels": {"file": "small.bt"}})"));

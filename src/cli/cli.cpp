@@ -403,6 +403,20 @@ void check_list_values_distinct(CLI::App* app) {
   namespace fs = std::filesystem;
   const std::vector<CLI::App*> chain = parsed_commands(app);
   std::error_code ec;
+  // An option's value that is another option of the command (`--out --json`) was an option
+  // left without its value: CLI11 takes it as the value (issue 20, fourth campaign: a file
+  // named "--json" was written and the text printed).
+  std::vector<std::string> names;
+  for (CLI::App* cmd : chain)
+    for (const CLI::Option* o : cmd->get_options()) {
+      for (const std::string& n : o->get_lnames()) names.push_back("--" + n);
+      for (const std::string& n : o->get_snames()) names.push_back("-" + n);
+    }
+  for (CLI::App* cmd : chain)
+    for (const CLI::Option* o : cmd->get_options())
+      for (const std::string& value : o->results())
+        if (std::find(names.begin(), names.end(), value) != names.end())
+          throw CLI::ValidationError(o->get_name(), "needs a value, got the option " + value);
   for (CLI::App* cmd : chain)
     for (const CLI::Option* o : cmd->get_options()) {
       if (o->count() == 0 || o->get_items_expected_max() <= o->get_items_expected_min()) continue;

@@ -217,6 +217,9 @@ TEST_CASE("Bad input: each case names what is wrong and exits non-zero", "[REQ-C
        "--obstacles: preset \"multilevel\" has no obstacle count"},
       {{"map", "gen", "--preset", "forest", "--base", "rooms", "--out", dir() + "/x.json"}, 2, "--base: only the scan preset"},
       {{"map", "gen", "--preset", "scan", "--base", "scan", "--out", dir() + "/x.json"}, 2, "--base: unknown scan base \"scan\""},
+      // An option left without its value is not given the next option as one (fourth campaign).
+      {{"astar", "--map", map, "--out", "--json"}, 2, "--out: needs a value, got the option --json"},
+      {{"astar", "--map", "--quiet"}, 2, "--map: needs a value, got the option --quiet"},
       // CLI11's count messages in plain words.
       {{"astar", "--map", map, "--radius", "1", "--radius", "2"}, 2, "--radius: given more than once, it takes one value (got 2)"},
       {{"astar", "--map", map, "--start", "1", "1"}, 2, "--start: takes 3 values, got 2"},

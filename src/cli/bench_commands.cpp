@@ -83,9 +83,6 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   b->add_option("--seed", o->bench.seed, "seed of the waypoints")->capture_default_str()->check(kUnsigned64);
   add_output_options(b, o->output);
   b->callback([o, &out] {
-    require_distinct("--segments", o->bench.segments);
-    require_distinct("--orders", o->bench.orders);
-    require_distinct("--methods", o->bench.methods);
     const auto records = bench::run_backend_bench(o->bench);
     std::ostringstream table;
     bench::print_table(records, table);
@@ -133,7 +130,6 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   fc->add_flag("--quiet", f->quiet, "no progress bar on stderr");
   add_output_options(fc, f->output);
   fc->callback([f, fc, &out] {
-    require_distinct("--planners", f->bench.planners);
     // Options that only miner or miner-sgan read are refused when --planners leaves them out
     // (issue 20, third campaign: they were ignored without a word).
     const std::vector<std::string>& names = f->bench.planners;

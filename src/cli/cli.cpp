@@ -227,19 +227,6 @@ CLI::Validator one_of(const std::string& what, const std::vector<std::string>& n
 
 const CLI::Validator kMapPreset = one_of("map preset", world::generator_preset_names());
 
-void require_distinct(const std::string& option, const std::vector<std::string>& values) {
-  for (std::size_t i = 0; i < values.size(); ++i)
-    for (std::size_t j = 0; j < i; ++j)
-      if (values[i] == values[j])
-        throw CLI::ValidationError(option, "lists " + values[i] + " twice (each value once)");
-}
-
-void require_distinct(const std::string& option, const std::vector<int>& values) {
-  std::vector<std::string> text;
-  for (int v : values) text.push_back(std::to_string(v));
-  require_distinct(option, text);
-}
-
 const CLI::Validator kShard(
     [](std::string& text) -> std::string {
       try {
@@ -403,20 +390,6 @@ void check_list_values_distinct(CLI::App* app) {
   namespace fs = std::filesystem;
   const std::vector<CLI::App*> chain = parsed_commands(app);
   std::error_code ec;
-  // An option's value that is another option of the command (`--out --json`) was an option
-  // left without its value: CLI11 takes it as the value (issue 20, fourth campaign: a file
-  // named "--json" was written and the text printed).
-  std::vector<std::string> names;
-  for (CLI::App* cmd : chain)
-    for (const CLI::Option* o : cmd->get_options()) {
-      for (const std::string& n : o->get_lnames()) names.push_back("--" + n);
-      for (const std::string& n : o->get_snames()) names.push_back("-" + n);
-    }
-  for (CLI::App* cmd : chain)
-    for (const CLI::Option* o : cmd->get_options())
-      for (const std::string& value : o->results())
-        if (std::find(names.begin(), names.end(), value) != names.end())
-          throw CLI::ValidationError(o->get_name(), "needs a value, got the option " + value);
   for (CLI::App* cmd : chain)
     for (const CLI::Option* o : cmd->get_options()) {
       if (o->count() == 0 || o->get_items_expected_max() <= o->get_items_expected_min()) continue;
@@ -430,6 +403,24 @@ void check_list_values_distinct(CLI::App* app) {
                                                           ", one file twice (each value once)");
         }
     }
+}
+
+/// An option's value that is another option of the command line (`--out --json`) was an
+/// option left without its value: CLI11 takes it as the value (issue 20, fourth campaign: a
+/// file named "--json" was written and the text printed).
+void check_no_option_as_value(CLI::App* app) {
+  const std::vector<CLI::App*> chain = parsed_commands(app);
+  std::vector<std::string> names;
+  for (CLI::App* cmd : chain)
+    for (const CLI::Option* o : cmd->get_options()) {
+      for (const std::string& n : o->get_lnames()) names.push_back("--" + n);
+      for (const std::string& n : o->get_snames()) names.push_back("-" + n);
+    }
+  for (CLI::App* cmd : chain)
+    for (const CLI::Option* o : cmd->get_options())
+      for (const std::string& value : o->results())
+        if (std::find(names.begin(), names.end(), value) != names.end())
+          throw CLI::ValidationError(o->get_name(), "needs a value, got the option " + value);
 }
 
 /// CLI11's count messages in plain words (issue 20, third campaign: "--radius: At Most 1
@@ -622,6 +613,7 @@ constexpr const char* kAppDescription = "miner — MINER-RRT* quadrotor planning
 void build_app(CLI::App& app, std::ostream& out, Mode mode) {
   add_commands(app, out);
   app.parse_complete_callback([&app, mode] {
+    check_no_option_as_value(&app);
     check_list_values_distinct(&app);
     check_outputs_against_inputs(&app);
     if (mode == Mode::kParseOnly) throw ParsedOnly{};

@@ -95,10 +95,6 @@ CLI::Validator integer_in(long long lo, long long hi);
 CLI::Validator one_of(const std::string& what, const std::vector<std::string>& names);
 /// A map generator preset (`map gen --preset`, `dataset --preset`).
 extern const CLI::Validator kMapPreset;
-/// Refuses a list option that names a value twice (issue 20: `--segments 5,5` timed the same
-/// case twice), as a usage error naming the option.
-void require_distinct(const std::string& option, const std::vector<std::string>& values);
-void require_distinct(const std::string& option, const std::vector<int>& values);
 /// Resource bounds of the command line (issue 20: bounded work, named in --help). An iteration
 /// budget above 1e7 holds a tree of ~1 GB; more than 1e5 runs of a campaign, or 1e4 boxes
 /// placed by a generator whose placement is quadratic, run for hours.

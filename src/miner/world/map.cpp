@@ -459,10 +459,10 @@ std::optional<double> Map::raycast(const Eigen::Vector3d& origin, const Eigen::V
   // The ray's stretch inside the bounds, where every obstacle contained in the bounds is met
   // (a box inside the bounds is entered inside them; the slab arithmetic is monotone, so the
   // computed entry of such a box is never before the computed entry of the bounds).
-  const auto inside = ray_interval(bounds_, origin, dir, max_range);
   if (dir.isZero() || !std::isfinite(max_range) || obstacles_.size() < kRayWalkMinObstacles) return brute_force();
   for (const std::uint32_t i : index_.large) consider(i);
   for (const std::uint32_t i : index_.beyond) consider(i);
+  const auto inside = ray_interval(bounds_, origin, dir, max_range);
   if (!inside) return best;
   const auto [t_in, t_out] = *inside;
   // Walk the stretch in pieces about one bucket long, nearest first. Each piece's bounding

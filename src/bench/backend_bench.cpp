@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <iomanip>
 #include <limits>
@@ -105,7 +106,8 @@ void time_methods(const traj::MincoProblem& p, const BackendBenchOptions& o, std
 }  // namespace
 
 namespace {
-void validate(const BackendBenchOptions& o) {
+/// `on_path`: the run times one path (run_backend_on_path), whose M is the path's, not --segments.
+void validate(const BackendBenchOptions& o, bool on_path) {
   for (const auto& m : o.methods) {
     if (m != "minco" && baselines().count(m) == 0) {
       throw Error("--methods: unknown method \"" + m + "\" (known: minco, dense-lu, closed-form, kkt-qp)");
@@ -118,11 +120,29 @@ void validate(const BackendBenchOptions& o) {
     if (m < 1) throw Error("--segments: must be at least 1, got " + std::to_string(m));
   }
   if (!(o.budget_s > 0.0) || o.samples < 1) throw Error("--budget and --samples: must be positive");
+  // A baseline that --max-dense-segments skips at every M would be listed and never run
+  // (issue 20, fourth campaign: dense-lu with --max-dense-segments 0 was all "skipped").
+  const int smallest = o.segments.empty() ? 0 : *std::min_element(o.segments.begin(), o.segments.end());
+  for (const auto& m : o.methods)
+    if (!on_path && m != "minco" && !o.segments.empty() && smallest > o.max_dense_segments)
+      throw Error("--methods " + m + ": --max-dense-segments " + std::to_string(o.max_dense_segments) +
+                      " skips it at every --segments value (the smallest is " + std::to_string(smallest) + ")",
+                  ExitCode::kUsage);
+  // Bounded work: the budget is per (method, order, M), so the whole run is their product
+  // (issue 20, fourth campaign: --budget 3600 ran an hour per configuration, unbounded in all).
+  const std::size_t segment_counts = on_path ? 1 : o.segments.size();
+  const double total = o.budget_s * static_cast<double>(o.methods.size() * o.orders.size() * segment_counts);
+  if (total > kMaxBackendTotalSeconds) {
+    char text[160];
+    std::snprintf(text, sizeof text, "%g s x %zu methods x %zu orders x %zu segment counts = %g s, over the %g s bound",
+                  o.budget_s, o.methods.size(), o.orders.size(), segment_counts, total, kMaxBackendTotalSeconds);
+    throw Error(std::string("--budget: ") + text + " (lower --budget or list fewer configurations)", ExitCode::kUsage);
+  }
 }
 }  // namespace
 
 std::vector<BackendRecord> run_backend_bench(const BackendBenchOptions& o) {
-  validate(o);
+  validate(o, false);
 
   std::vector<BackendRecord> records;
   for (int s : o.orders)
@@ -132,7 +152,7 @@ std::vector<BackendRecord> run_backend_bench(const BackendBenchOptions& o) {
 
 std::vector<BackendRecord> run_backend_on_path(const Eigen::MatrixX3d& points, const traj::Limits& limits,
                                                const BackendBenchOptions& o) {
-  validate(o);
+  validate(o, true);
   if (points.rows() < 2) throw Error("bench backend: a path needs at least 2 points");
   std::vector<BackendRecord> records;
   for (int s : o.orders)

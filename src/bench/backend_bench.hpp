@@ -15,6 +15,10 @@
 
 namespace miner::bench {
 
+/// The most a back-end benchmark may spend in all: --budget times the number of (method,
+/// order, M) configurations (one hour).
+inline constexpr double kMaxBackendTotalSeconds = 3600.0;
+
 struct BackendBenchOptions {
   std::vector<int> segments{5, 15, 50, 200, 1000};
   std::vector<int> orders{3, 4};

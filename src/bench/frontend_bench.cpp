@@ -452,6 +452,20 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
     }
     const double lower = root.at("lower_bound").number(), budget = root.at("max_iterations").number();
     constexpr double kRoundoff = 1e-9;  // relative: the bound and the costs are sums of lengths
+    // The campaign's costs agree with each other as run_frontend_bench sets them (issue 20,
+    // fourth campaign: a target below the straight line was merged): the bound is a length,
+    // the A* reference a path no shorter than it, the target the factor times the reference.
+    if (!(lower >= 0.0)) root.at("lower_bound").fail("the straight-line bound is a length, >= 0");
+    const double reference = root.at("reference_cost").number();
+    if (reference < lower * (1.0 - kRoundoff))
+      root.at("reference_cost").fail("the A* reference " + root.at("reference_cost").value().dump() +
+                                     " is below the lower bound " + root.at("lower_bound").value().dump() +
+                                     " (no path is shorter)");
+    const double factor = root.at("target_factor").number(), target = root.at("target_cost").number();
+    if (std::fabs(target - factor * reference) > kRoundoff * std::max(1.0, std::fabs(target)))
+      root.at("target_cost").fail(root.at("target_cost").value().dump() + " is not target_factor x reference_cost = " +
+                                  root.at("target_factor").value().dump() + " x " +
+                                  root.at("reference_cost").value().dump());
     const JsonField records = root.at("run_records");
     for (std::size_t k = 0; k < records.array_size(); ++k) {
       const JsonField r = records.at(k);

@@ -74,8 +74,13 @@ HeuristicBenchResult run_heuristic_bench(const HeuristicBenchOptions& o, std::os
     for (const Family& g : families)
       if (g.preset == f.preset) throw Error(data + ": family '" + f.preset + "' is already measured from " + g.data);
     f.split = heuristic::read_split(data, o.split);
-    if (o.samples > 0 && static_cast<std::size_t>(o.samples) < f.split.size()) f.split.resize(static_cast<std::size_t>(o.samples));
     if (f.split.empty()) throw Error(data + ": split '" + o.split + "' has no samples");
+    // More samples than the split holds is refused, not measured on fewer without a word
+    // (issue 20, fourth campaign).
+    if (static_cast<std::size_t>(o.samples) > f.split.size())
+      throw Error("--samples " + std::to_string(o.samples) + ": " + data + ": split '" + o.split + "' has only " +
+                  std::to_string(f.split.size()) + " samples (give at most that many, or 0 for all)");
+    if (o.samples > 0) f.split.resize(static_cast<std::size_t>(o.samples));
     const Eigen::Vector3i dims(meta["dims"][0].get<int>(), meta["dims"][1].get<int>(), meta["dims"][2].get<int>());
     if (dims != sgan.architecture().dims)
       throw Error(data + ": the dataset's grid differs from the weights' grid (" + sgan.path() + ")");

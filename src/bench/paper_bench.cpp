@@ -20,6 +20,7 @@
 #include "miner/flight/closed_loop.hpp"
 #include "miner/pipeline/scenario.hpp"
 #include "miner/heuristic/dataset.hpp"
+#include "miner/heuristic/sgan.hpp"
 #include "miner/report/svg_plot.hpp"
 #include "miner/world/map.hpp"
 
@@ -156,22 +157,58 @@ PaperBenchResult run_paper_bench(const PaperBenchOptions& o, const std::string& 
   out.command = command;
   out.commit = git_commit();
   // Load everything first: a bad map or scenario fails before minutes of benchmarking.
+  // The back end's whole time is bounded like `bench backend`'s, checked before any work.
+  {
+    const double total = o.backend_budget_s * 8.0 * static_cast<double>(o.maps.size());  // 4 methods x 2 orders
+    if (total > kMaxBackendTotalSeconds)
+      throw Error("--backend-budget: " + std::to_string(o.backend_budget_s) + " s x 4 methods x 2 orders x " +
+                      std::to_string(o.maps.size()) + " maps is over the " +
+                      std::to_string(static_cast<int>(kMaxBackendTotalSeconds)) + " s bound",
+                  ExitCode::kUsage);
+  }
+  // The weights too (issue 20, fourth campaign: a file that is not weights was refused only
+  // after the front-end campaign).
+  if (!o.weights.empty()) (void)heuristic::Sgan::load(o.weights);
+  // An input given twice under two names (two files of one content; a scenario whose map is
+  // inlined once and referenced once) would run its campaign twice and count it twice.
+  const auto refuse_repeats = [](const std::vector<Json>& docs, const std::vector<std::string>& names,
+                                 const std::string& option, const std::string& what) {
+    if (const auto same = first_repeated(docs))
+      throw Error(option + ": " + names[same->second] + " is the same " + what + " as " + names[same->first] +
+                  ": each is run once");
+  };
   std::vector<world::Map> maps;
+  std::vector<Json> map_docs;
   for (const auto& path : o.maps) {
     maps.push_back(world::Map::load(path));
     if (!maps.back().query()) throw Error(path + ": the map stores no query (start, goal, robot radius)");
+    map_docs.push_back(maps.back().to_json());
   }
+  refuse_repeats(map_docs, o.maps, "--maps", "map");
   std::vector<pipeline::Scenario> scenarios;
+  std::vector<Json> scenario_docs;
+  std::vector<std::string> scenario_names;
   if (o.scenarios.empty()) {
     scenarios.push_back(pipeline::default_scenario());
+    scenario_docs.push_back(scenarios.back().map->to_json());
+    scenario_names.push_back("indoor-1 (the default scenario's map)");
     for (const auto& m : o.tracking_maps) {
       Json doc = pipeline::default_scenario_document();
       doc["map"] = read_json_file(m);
       doc["name"] = map_label(m);
       scenarios.push_back(pipeline::scenario_from_json(doc, m, ""));
+      scenario_docs.push_back(scenarios.back().map->to_json());
+      scenario_names.push_back(m);
     }
+    refuse_repeats(scenario_docs, scenario_names, "--tracking-maps", "map");
   } else {
-    for (const auto& s : o.scenarios) scenarios.push_back(pipeline::load_scenario(s));
+    for (const auto& s : o.scenarios) {
+      scenarios.push_back(pipeline::load_scenario(s));
+      Json doc = pipeline::self_contained_scenario(read_json_file(s), std::filesystem::path(s).parent_path().string());
+      if (doc.is_object()) doc.erase("name");  // a name does not change the flight
+      scenario_docs.push_back(std::move(doc));
+    }
+    refuse_repeats(scenario_docs, o.scenarios, "--scenarios", "scenario");
   }
   if (!o.weights.empty())
     for (auto& s : scenarios) s.weights = o.weights;

@@ -24,7 +24,13 @@ SimBenchResult run_sim_bench(const pipeline::Scenario& scenario, const SimBenchO
   std::vector<double> walls, factors;
   // One untimed flight first: page faults, allocator growth and cold caches belong to
   // process start-up, not to the loop being measured.
-  pipeline::fly(scenario, reference, fly_options);
+  const flight::FlightResult warm = pipeline::fly(scenario, reference, fly_options);
+  // A real-time factor of a flight that fails would time a failure as if it were the loop's
+  // work (issue 20, fourth campaign: `fly` exits 3 on the scenario, `bench sim` reported).
+  if (!warm.goal_reached)
+    throw NoSolution("bench sim: the flight of " + scenario.name + " does not reach the goal (final error " +
+                     std::to_string(warm.final_position_error) + " m, collisions " + std::to_string(warm.collisions) +
+                     "), as `miner fly` reports: a failed flight is not timed");
   for (int i = 0; i < options.runs; ++i) {
     const auto start = std::chrono::steady_clock::now();
     const flight::FlightResult flight = pipeline::fly(scenario, reference, fly_options);

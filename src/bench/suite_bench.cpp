@@ -280,14 +280,28 @@ SuiteBenchResult run_suite_bench(const SuiteBenchOptions& o, const std::string& 
   out.command = command;
   out.commit = git_commit();
   // Generate every map first: a bad recipe fails before minutes of benchmarking.
+  // A fault names the suite file and the entry (issue 20, fourth campaign: `bench suite: map
+  // "in"` named neither).
+  const std::string suite_file = o.suite_file.empty() ? std::string("bench suite") : o.suite_file;
+  const auto entry = [&](std::size_t i) {
+    return suite_file + ": maps[" + std::to_string(i) + "] (\"" + o.suite.maps[i].name + "\")";
+  };
   std::vector<world::Map> maps;
-  for (const auto& m : o.suite.maps) {
+  std::vector<Json> generated;
+  for (std::size_t i = 0; i < o.suite.maps.size(); ++i) {
+    const SuiteMap& m = o.suite.maps[i];
     try {
       maps.push_back(world::generate_map(world::generator_preset(m.preset), m.seed, m.overrides));
     } catch (const Error& e) {
-      throw Error("bench suite: map \"" + m.name + "\": " + e.what());
+      throw Error(entry(i) + ": " + e.what());
     }
+    generated.push_back(maps.back().to_json());
   }
+  // Two entries that generate one map (names aside) would run its campaign twice and count
+  // it twice in every summary.
+  if (const auto same = first_repeated(generated))
+    throw Error(entry(same->second) + " generates the same map as " + entry(same->first) +
+                ": each map is benchmarked once");
   for (std::size_t i = 0; i < maps.size(); ++i) {
     const world::Map& map = maps[i];
     const auto& q = *map.query();

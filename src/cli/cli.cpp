@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <iterator>
 #include <new>
 #include <regex>
 #include <sstream>
@@ -18,6 +19,7 @@
 #include "miner/core/error.hpp"
 #include "miner/core/progress.hpp"
 #include "miner/core/shard.hpp"
+#include "miner/plan/heuristic_region.hpp"
 #include "miner/world/map_generator.hpp"
 
 namespace miner::cli {
@@ -171,6 +173,19 @@ CLI::Validator output_folder_for(const std::string& marker, const std::vector<st
       "OUTPUT FOLDER");
 }
 
+CLI::Validator suffix_output(const std::string& suffix, const std::string& what) {
+  return CLI::Validator(
+      [suffix, what](std::string& text) -> std::string {
+        // An option taken as the value ("--out --json") is named as such by the parse-complete
+        // check, not blamed on its suffix.
+        if (text.rfind("--", 0) == 0) return "";
+        if (text.size() >= suffix.size() && text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0)
+          return "";
+        return text + " must end in " + suffix + " (" + what + ")";
+      },
+      "FILE" + suffix);
+}
+
 const CLI::Validator kOutputFileNewFolder(
     [](std::string& text) -> std::string {
       namespace fs = std::filesystem;
@@ -262,6 +277,12 @@ void add_query_options(CLI::App* cmd, QueryOptions& q) {
 world::Map load_map(const std::string& path, const std::string& unknown) {
   world::Map map = world::Map::load(path);
   if (unknown.empty()) return map;
+  // A box map has no unknown space: the option would change nothing (issue 20, fourth
+  // campaign: `--unknown free` on a box map was accepted and ignored).
+  if (!map.voxel_source())
+    throw Error("--unknown: " + path + " is a map of boxes, with no voxels and so no unknown space: the option "
+                "applies to voxel maps only",
+                ExitCode::kUsage);
   return map.with_unknown(world::parse_unknown_policy(unknown, "--unknown"));
 }
 
@@ -278,12 +299,17 @@ ResolvedQuery resolve_query(const QueryOptions& q) {
   const Eigen::Vector3d start = q.start.empty() ? map.query()->start : vec(q.start, "--start");
   const Eigen::Vector3d goal = q.goal.empty() ? map.query()->goal : vec(q.goal, "--goal");
   const double radius = q.radius >= 0.0 ? q.radius : (map.query() ? map.query()->robot_radius : 0.0);
+  // A stored query's fault names the map file and the field (issue 20, fourth campaign: "start
+  // ... lies inside obstacle 0" named neither).
+  if (q.start.empty()) map.require_free(start, radius, q.map + ": query.start");
+  if (q.goal.empty()) map.require_free(goal, radius, q.map + ": query.goal");
   return {std::move(map), start, goal, radius};
 }
 
 void add_output_options(CLI::App* cmd, OutputOptions& o) {
   cmd->add_flag("--json", o.json, "print the result as JSON");
-  cmd->add_option("--out", o.out, "also write the JSON result to this file")->check(kOutputFile);
+  cmd->add_option("--out", o.out, "also write the JSON result to this file (.json)")
+      ->check(kOutputFile & suffix_output(".json", "the result is JSON"));
 }
 
 void emit(const OutputOptions& o, const Json& doc, const std::string& human, std::ostream& out) {
@@ -418,9 +444,14 @@ void check_no_option_as_value(CLI::App* app) {
     }
   for (CLI::App* cmd : chain)
     for (const CLI::Option* o : cmd->get_options())
-      for (const std::string& value : o->results())
+      for (const std::string& value : o->results()) {
         if (std::find(names.begin(), names.end(), value) != names.end())
           throw CLI::ValidationError(o->get_name(), "needs a value, got the option " + value);
+        // An empty value names nothing (issue 20, fourth campaign: `--map ''` was answered
+        // ": cannot open file"); no option of MINER takes one.
+        if (value.empty() && o->get_expected_max() > 0)
+          throw CLI::ValidationError(o->get_name(), "needs a value, got an empty one");
+      }
 }
 
 /// CLI11's count messages in plain words (issue 20, third campaign: "--radius: At Most 1
@@ -438,6 +469,16 @@ std::string plain_usage_text(const std::string& text) {
     return m[1].str() + ": takes " + values(m[2].str()) + ", got " + m[3].str();
   if (std::regex_match(text, m, missing))
     return m[1].str() + ": needs " + values(m[2].str()) + ", got none";
+  // Words no option takes (after "--" every word is positional). CLI11 lists them in the order
+  // it met them, which is the line's reversed (parse_line hands it the words reversed).
+  static const std::regex extras(R"(^The following arguments? (?:was|were) not expected: (.*)$)");
+  if (std::regex_match(text, m, extras)) {
+    std::istringstream words(m[1].str());
+    std::vector<std::string> list{std::istream_iterator<std::string>(words), std::istream_iterator<std::string>()};
+    std::string line;
+    for (auto it = list.rbegin(); it != list.rend(); ++it) line += (line.empty() ? "" : " ") + *it;
+    return "the command takes no argument \"" + line + "\" (after \"--\" every word is an argument, not an option)";
+  }
   return text;
 }
 
@@ -605,6 +646,49 @@ std::vector<std::string> numeric_options_without_checks() {
   return unchecked;
 }
 
+void check_region_dims(const CLI::App* cmd, const std::vector<int>& dims) {
+  const CLI::Option* o = cmd->get_option("--dims");
+  if (o->count() == 0 || dims.size() != 3) return;
+  try {
+    (void)plan::HeuristicRegion::cell_count(Eigen::Vector3i(dims[0], dims[1], dims[2]));
+  } catch (const Error& e) {
+    throw CLI::ValidationError(o->get_name(), e.what());
+  }
+}
+
+std::string command_line(const CLI::App* cmd, const std::vector<std::string>& always) {
+  // A value a shell would split or expand is quoted, so the line can be pasted back.
+  const auto word = [](const std::string& v) {
+    if (!v.empty() && v.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789-_./,:=+@%") ==
+                          std::string::npos)
+      return v;
+    std::string quoted = "'";
+    for (const char c : v) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return quoted + "'";
+  };
+  std::string line = "miner " + command_path(cmd);
+  for (const CLI::Option* o : cmd->get_options()) {
+    const std::string name = o->get_name();
+    if (name == "--help" || name == "--quiet" || name == "--json") continue;  // no effect on the result
+    const bool given = o->count() > 0;
+    if (!given && std::find(always.begin(), always.end(), name) == always.end()) continue;
+    if (o->get_expected_max() == 0) {  // a flag: its name says it
+      if (given) line += " " + name;
+      continue;
+    }
+    std::vector<std::string> values = given ? o->results() : std::vector<std::string>{o->get_default_str()};
+    line += " " + name;
+    if (o->get_delimiter() != '\0' && values.size() > 1) {
+      std::string joined;
+      for (const auto& v : values) joined += (joined.empty() ? "" : std::string(1, o->get_delimiter())) + v;
+      line += " " + word(joined);
+    } else {
+      for (const auto& v : values) line += " " + word(v);
+    }
+  }
+  return line;
+}
+
 namespace {
 
 constexpr const char* kAppDescription = "miner — MINER-RRT* quadrotor planning and flight stack";
@@ -641,6 +725,17 @@ int parse_line(CLI::App& app, const std::vector<std::string>& args, std::ostream
           << (nearest.empty() ? "" : ", did you mean \"" + nearest + "\"?") << " (commands: " << list << ")\n"
           << "run '" << path << " --help' for usage\n";
       return static_cast<int>(ExitCode::kUsage);
+    }
+    // --help anywhere before "--" prints the command's help, whatever else the line holds
+    // (issue 20, fourth campaign: `astar --help --radius -5` was a usage error about --radius,
+    // since CLI11 checks values before it looks for the help flag).
+    for (const std::string& a : args) {
+      if (a == "--") break;
+      if (a == "--help" || a == "-h") {
+        app.clear();  // an earlier line's chosen subcommands would take over help()
+        out << cmd->help();
+        return 0;
+      }
     }
     const std::string unknown = unknown_option(cmd, path, args);
     if (!unknown.empty()) {

@@ -56,7 +56,8 @@ Json strict_json(const heuristic::HeuristicQuery& h) {
 }
 
 void run_heuristic(const HeuristicCliOptions& o, std::ostream& out) {
-  if (o.raw && o.strict_bridge) throw Error("--strict-bridge: is a filter step, --raw writes the unfiltered output");
+  if (o.raw && o.strict_bridge)
+    throw Error("--strict-bridge: is a filter step, --raw writes the unfiltered output", ExitCode::kUsage);
   const ResolvedQuery q = resolve_query(o.query);
   plan::PlanningProblem::make(q.map, q.start, q.goal, q.radius);  // start/goal checks, named errors
   const heuristic::Sgan sgan = heuristic::Sgan::load_or_builtin(o.weights);
@@ -158,7 +159,8 @@ void add_heuristic_commands(CLI::App& app, std::ostream& out) {
   c->add_flag("--raw", h->raw, "write the thresholded network output's probabilities, unfiltered");
   c->add_flag("--strict-bridge", h->strict_bridge,
               "filter step 5: add the cells a collision-free way from start to goal needs (REQ-HEUR-014)");
-  c->add_option("--out", h->region_out, "region file to write (miner-region-v1)")->required()->check(kOutputFile);
+  c->add_option("--out", h->region_out, "region file to write (miner-region-v1 JSON, .json)")->required()
+      ->check(kOutputFile & suffix_output(".json", "a region is JSON"));
   c->add_flag("--json", h->output.json, "print the summary as JSON");
   c->callback([h, &out] { run_heuristic(*h, out); });
 

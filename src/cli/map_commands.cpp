@@ -26,29 +26,20 @@ namespace miner::cli {
 
 namespace {
 
-/// A map file MINER writes: .json, or .bt (issue 20: ".ot" got JSON that no reader took back).
+/// A map file MINER writes: .json, or .bt, exactly (issue 20: ".ot" got JSON that no reader
+/// took back; fourth campaign: ".BT" and ".txt" got JSON too).
 const CLI::Validator kMapOutput(
     [](std::string& text) -> std::string {
       const auto ends = [&](const char* suffix) {
         const std::string x(suffix);
         return text.size() >= x.size() && text.compare(text.size() - x.size(), x.size(), x) == 0;
       };
+      if (ends(".json") || ends(".bt")) return "";
       if (ends(".ot")) return text + ": MINER writes OctoMaps as .bt only (.ot is read, not written)";
-      return "";
+      return text + " must end in .json (a miner-map-v1 file) or .bt (an OctoMap binary tree): the suffix chooses "
+                    "what is written";
     },
     "MAP FILE");
-
-/// An output that must have one suffix (checked when the line is parsed, exit 2: issue 20 found
-/// `--map-out x.bt` given JSON that every reader then refused, and `.bt` checked after parsing).
-CLI::Validator suffix_output(const std::string& suffix, const std::string& what) {
-  return CLI::Validator(
-      [suffix, what](std::string& text) -> std::string {
-        if (text.size() >= suffix.size() && text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0)
-          return "";
-        return text + " must end in " + suffix + " (" + what + ")";
-      },
-      "FILE" + suffix);
-}
 
 
 using world::Map;
@@ -320,7 +311,7 @@ void run_import(const ImportOptions& o, std::ostream& out) {
     } else throw Error(path + ": no sensor origin (" + (ply ? std::string("a PLY file has none") : std::string("the PCD file has no VIEWPOINT line")) + "): give --origin x y z, the sensor position the rays start from");
     points += cloud.points.size();
     skipped += cloud.skipped;
-    scans.push_back({std::move(cloud), origin});
+    scans.push_back({std::move(cloud), origin, path});
   }
   const auto layer = world::integrate_clouds(scans, o.resolution, o.range);
   world::write_octree_bt(*layer, o.out);
@@ -397,7 +388,7 @@ void add_map_commands(CLI::App& app, std::ostream& out) {
       "scan", "simulate a mapping run: a range sensor flown along the query's A* path (the vehicle's own volume, --radius, known free) builds an OctoMap (free, occupied, unknown)");
   add_query_options(sc, scan->query);
   sc->add_option("--range", scan->scan.range, "sensor range in m")->capture_default_str()->check(finite_in(0.01, 1000.0));
-  sc->add_option("--fov", scan->fov, "horizontal and vertical field of view in degrees")->expected(2)->capture_default_str()
+  sc->add_option("--fov", scan->fov, "horizontal field of view in (0, 360] and vertical in [0, 180) degrees")->expected(2)->capture_default_str()
       ->check(finite_in(0.0, 360.0));
   sc->add_option("--rays", scan->rays, "rays across the horizontal and the vertical field")->expected(2)->capture_default_str()
       ->check(integer_in(1, 100000));
@@ -420,7 +411,20 @@ void add_map_commands(CLI::App& app, std::ostream& out) {
   sc->add_option("--map-out", scan->map_out, "also a map file (.json) referencing the scan, with the query")
       ->check(kOutputFile & suffix_output(".json", "a map file referencing the scan"));
   sc->add_flag("--json", scan->json, "print the summary as JSON");
-  sc->callback([scan, &out] { run_scan(*scan, out); });
+  sc->callback([scan, &out] {
+    // The sensor's limits per axis and between options, as usage errors before any work (issue
+    // 20, fourth campaign: `--fov 0 60` passed the [0, 360] check and failed later, exit 1).
+    if (!(scan->fov[0] > 0.0 && scan->fov[0] <= 360.0))
+      throw CLI::ValidationError("--fov", "the horizontal field of view must lie in (0, 360] degrees, got " +
+                                              std::to_string(scan->fov[0]));
+    if (!(scan->fov[1] >= 0.0 && scan->fov[1] < 180.0))
+      throw CLI::ValidationError("--fov", "the vertical field of view must lie in [0, 180) degrees, got " +
+                                              std::to_string(scan->fov[1]));
+    if (scan->scan.noise > 0.5 * scan->scan.range)
+      throw CLI::ValidationError("--noise", "must be at most half of --range (" + std::to_string(scan->scan.range) +
+                                                " m)");
+    run_scan(*scan, out);
+  });
 
   auto import = std::make_shared<ImportOptions>();
   CLI::App* im = map->add_subcommand(

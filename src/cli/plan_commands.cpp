@@ -261,6 +261,12 @@ void add_plan_commands(CLI::App& app, std::ostream& out) {
       throw CLI::ValidationError("--weights", "applies to --region sgan only, not --region " + po->region);
     if (!po->planner_options.safeguard && given("--safeguard-iterations"))
       throw CLI::ValidationError("--safeguard-iterations", "tunes the safeguard, which --no-safeguard turns off");
+    // --tree and --timing add to the JSON result; the text summary has neither (issue 20,
+    // fourth campaign: both were accepted and ignored without --json or --out).
+    for (const char* name : {"--tree", "--timing"})
+      if (given(name) && !po->output.json && po->output.out.empty())
+        throw CLI::ValidationError(name, "adds to the JSON result, which only --json or --out produce");
+    check_region_dims(p, po->grid.dims);
     po->planner_options.record_tree = po->tree;
     run_plan(*po, out);
   });
@@ -271,9 +277,13 @@ void add_plan_commands(CLI::App& app, std::ostream& out) {
   CLI::App* ra = region->add_subcommand("astar", "the A*-dilated ground-truth region (paper Sec. V-A.1)");
   add_query_options(ra, ro->query);
   add_region_grid_options(ra, ro->grid);
-  ra->add_option("--out", ro->out, "output region file (miner-region-v1 JSON)")->required()->check(kOutputFile);
+  ra->add_option("--out", ro->out, "output region file (miner-region-v1 JSON, .json)")->required()
+      ->check(kOutputFile & suffix_output(".json", "a region is JSON"));
   ra->add_flag("--json", ro->json, "print the summary as JSON");
-  ra->callback([ro, &out] { run_region_astar(*ro, out); });
+  ra->callback([ro, ra, &out] {
+    check_region_dims(ra, ro->grid.dims);
+    run_region_astar(*ro, out);
+  });
 }
 
 }  // namespace miner::cli

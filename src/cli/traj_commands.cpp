@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/cli.hpp"
+#include "miner/core/error.hpp"
 #include "miner/core/json_io.hpp"
 #include "miner/traj/problem_io.hpp"
 
@@ -22,9 +23,16 @@ struct SolveOptions {
 void run_solve(const SolveOptions& o, std::ostream& out) {
   const auto request = traj::request_from_json(read_json_file(o.problem), o.problem, o.allocate, o.rho);
   const auto& problem = request.problem;
-  const Json answer = request.optimise
-                          ? traj::answer_to_json(traj::optimise_allocation(problem, *request.optimise), *request.optimise)
-                          : traj::answer_to_json(traj::solve_minco(problem));
+  Json answer;
+  try {
+    answer = request.optimise
+                 ? traj::answer_to_json(traj::optimise_allocation(problem, *request.optimise), *request.optimise)
+                 : traj::answer_to_json(traj::solve_minco(problem));
+  } catch (const Error& e) {
+    // The solver names the rule the problem breaks; the message names the problem file too
+    // (issue 20, fourth campaign: "allocation: \"optimise\" needs ..." named no file).
+    throw Error(o.problem + ": " + e.what(), e.code());
+  }
   if (o.out.empty()) {
     out << dump_json(answer);
   } else {
@@ -45,7 +53,8 @@ void add_traj_commands(CLI::App& app, std::ostream& out) {
   auto solve = std::make_shared<SolveOptions>();
   CLI::App* s = traj->add_subcommand("solve", "solve a trajectory problem file (docs/traj.md)");
   s->add_option("--problem", solve->problem, "problem JSON: order, points, head, tail, durations or limits")->required();
-  s->add_option("--out", solve->out, "write the answer JSON here (default: stdout)")->check(kOutputFile);
+  s->add_option("--out", solve->out, "write the answer JSON here (.json; default: stdout)")
+      ->check(kOutputFile & suffix_output(".json", "the answer is JSON"));
   s->add_option("--allocate", solve->allocate,
                 "durations from the limits: trapezoid (default) or optimise (min J + rho sum T within the limits, Ceres)")
       ->check(CLI::IsMember({"trapezoid", "optimise"}));

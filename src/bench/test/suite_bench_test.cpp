@@ -172,7 +172,7 @@ TEST_CASE("A suite map that cannot be generated is refused before any campaign",
   m.overrides.size = Eigen::Vector3d(0.5, 0.5, 0.5);  // too small to hold a query
   s.maps = {m};
   auto o = tiny_options(s);
-  CHECK_THROWS_WITH(run_suite_bench(o, "test", nullptr), Contains("map \"bad\""));
+  CHECK_THROWS_WITH(run_suite_bench(o, "test", nullptr), Contains("maps[0] (\"bad\"): size:"));
 }
 
 TEST_CASE("The Mann-Whitney test of the headlines matches the textbook values", "[REQ-REPORT-008]") {

@@ -1,4 +1,5 @@
 #include <catch2/catch.hpp>
+#include <CLI/CLI.hpp>
 
 #include <cstdlib>
 #include <filesystem>
@@ -235,6 +236,116 @@ TEST_CASE("Bad input: each case names what is wrong and exits non-zero", "[REQ-C
   }
   // A zero written with a tiny exponent is still zero, not an underflow.
   CHECK(miner_cli({"astar", "--map", map, "--start", "1", "1", "1", "--goal", "2", "2", "2", "--radius", "0e-400"}).code == 0);
+}
+
+TEST_CASE("Options a run would not read, clamped values and mismatched suffixes are usage errors", "[REQ-CLI-002][REQ-CLI-003]") {
+  // Issue 20, fourth campaign: each of these ran, ignoring or altering what the line said.
+  const std::string map = write("pillar-4th.json", kPillarMap);
+  const char* kQueryMap4 = R"({"format": "miner-map-v1", "bounds": {"min": [0,0,0], "max": [4,4,2]}, "resolution": 0.25,
+    "obstacles": [], "query": {"start": [0.5,0.5,1], "goal": [3.5,3.5,1], "robot_radius": 0.1}})";
+  const std::string problem = write("problem-4th.json", R"({"order": 3, "points": [[0,0,1],[1,1,1],[3,1,2]],
+    "head": [[0,0,1],[0,0,0],[0,0,0]], "tail": [[3,1,2],[0,0,0],[0,0,0]], "limits": {"v_max": 1, "a_max": 1}})");
+  const std::string bench_suite = write("suite-4th.json", R"({"format": "miner-bench-suite-v1", "steps": [0.1],
+    "maps": [{"name": "a", "preset": "indoor", "seed": 1}, {"name": "b", "preset": "indoor", "seed": 1}]})");
+  struct Case {
+    std::vector<std::string> args;
+    int code;
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      {{"astar", "--map", map, "--unknown", "free"}, 2, "--unknown: " + map + " is a map of boxes, with no voxels"},
+      {{"map", "info", "--map", map, "--unknown", "occupied"}, 2, "no unknown space"},
+      {{"plan", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5", "--planner", "rrtstar", "--tree"}, 2,
+       "--tree: adds to the JSON result, which only --json or --out produce"},
+      {{"plan", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5", "--planner", "rrtstar", "--timing"}, 2,
+       "--timing: adds to the JSON result"},
+      {{"plan", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5", "--region", "astar", "--dims", "4096",
+        "4096", "4096"},
+       2, "--dims: region dims: [4096, 4096, 4096] is"},
+      {{"region", "astar", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5", "--dims", "1024", "1024", "1024",
+        "--out", dir() + "/r4.json"},
+       2, "more than the limit"},
+      {{"traj", "solve", "--problem", problem, "--rho", "2"}, 2, "--rho: only used with --allocate optimise"},
+      {{"map", "scan", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5", "--fov", "0", "60", "--out",
+        dir() + "/s4.bt"},
+       2, "--fov: the horizontal field of view must lie in (0, 360]"},
+      {{"map", "scan", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5", "--fov", "360", "180", "--out",
+        dir() + "/s4.bt"},
+       2, "--fov: the vertical field of view must lie in [0, 180)"},
+      {{"map", "scan", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5", "--range", "2", "--noise", "1.5",
+        "--out", dir() + "/s4.bt"},
+       2, "--noise: must be at most half of --range"},
+      {{"heuristic", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5", "--raw", "--strict-bridge", "--out",
+        dir() + "/h4.json"},
+       2, "--strict-bridge: is a filter step"},
+      {{"bench", "backend", "--methods", "minco,dense-lu", "--max-dense-segments", "0", "--segments", "5"}, 2,
+       "--methods dense-lu: --max-dense-segments 0 skips it at every --segments value"},
+      {{"bench", "backend", "--budget", "3600", "--segments", "5", "--orders", "3", "--methods", "minco,kkt-qp"}, 2,
+       "--budget: 3600 s x 2 methods x 1 orders x 1 segment counts = 7200 s, over the 3600 s bound"},
+      {{"dataset", "--count", "2", "--val-fraction", "0.99", "--out", dir() + "/ds4"}, 1,
+       "keeps every sample for validation and none for training"},
+      {{"bench", "suite", "--suite", bench_suite, "--planners", "rrtstar", "--weights", "w.bin", "--out", dir() + "/s4.md"}, 2,
+       "--weights: applies to the miner-sgan planner"},
+      {{"bench", "suite", "--suite", bench_suite, "--planners", "rrtstar", "--runs", "1", "--out", dir() + "/s4.md"}, 1,
+       bench_suite + ": maps[1] (\"b\") generates the same map as " + bench_suite + ": maps[0] (\"a\")"},
+      {{"bench", "paper", "--scenarios", "x.json", "--tracking-maps", "y.json", "--out", dir() + "/p4.md"}, 2,
+       "--tracking-maps: maps flown with the default scenario, which --scenarios replaces"},
+      {{"bench", "paper", "--maps", write("q4a.json", kQueryMap4) + "," + write("q4b.json", kQueryMap4), "--out", dir() + "/p4.md"}, 1,
+       "is the same map as"},
+      // The suffix says what the file holds.
+      {{"astar", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5", "--out", dir() + "/a4.bt"}, 2,
+       "must end in .json (the result is JSON)"},
+      {{"region", "astar", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5", "--out", dir() + "/r4.bt"}, 2,
+       "must end in .json (a region is JSON)"},
+      {{"map", "convert", "--in", map, "--out", dir() + "/c4.BT"}, 2, "must end in .json (a miner-map-v1 file) or .bt"},
+      {{"map", "convert", "--in", map, "--out", dir() + "/c4.txt"}, 2, "must end in .json (a miner-map-v1 file) or .bt"},
+      {{"bench", "suite", "--suite", bench_suite, "--out", dir() + "/s4.json"}, 2, "must end in .md (the report is Markdown)"},
+      {{"traj", "solve", "--problem", problem, "--out", dir() + "/t4.txt"}, 2, "must end in .json (the answer is JSON)"},
+      // An empty value names nothing.
+      {{"astar", "--map", ""}, 2, "--map: needs a value, got an empty one"},
+      {{"astar", "--map", map, "--", "--radius", "5"}, 2,
+       "the command takes no argument \"--radius 5\" (after \"--\" every word is an argument"},
+      // A stored query's fault names the file and the field.
+      {{"astar", "--map", write("query-in-4th.json", R"({"format": "miner-map-v1", "bounds": {"min": [0,0,0], "max": [10,10,10]},
+         "resolution": 1, "obstacles": [{"type": "box", "min": [4,4,0], "max": [6,6,10]}],
+         "query": {"start": [5,5,5], "goal": [9,9,9], "robot_radius": 0.1}})")},
+       1, "query-in-4th.json: query.start (5, 5, 5) lies inside obstacle 0"},
+  };
+  for (const auto& c : cases) {
+    const Run r = miner_cli(c.args);
+    INFO("args: " << c.args.at(0) << " " << c.args.at(1) << " ... expected message: " << c.message << "\nstderr: " << r.err);
+    CHECK(r.code == c.code);
+    CHECK_THAT(r.err, Contains(c.message));
+  }
+  // --help wins over anything else on the line.
+  const Run help = miner_cli({"astar", "--help", "--radius", "-5"});
+  CHECK(help.code == 0);
+  CHECK_THAT(help.out, Contains("--radius"));
+  // The same options where the run does read them pass.
+  CHECK(miner_cli({"plan", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5", "--planner", "rrtstar",
+                   "--iterations", "200", "--tree", "--json"}).code != 2);
+}
+
+TEST_CASE("A report's Generated-by line is the command line that reproduces it", "[REQ-CLI-003]") {
+  CLI::App app{"t", "miner"};
+  CLI::App* cmd = app.add_subcommand("bench")->add_subcommand("paper");
+  int runs = 20, iterations = 0;
+  std::vector<std::string> maps{"a.json"};
+  std::string out;
+  bool quiet = false, flag = false;
+  cmd->add_option("--runs", runs)->capture_default_str();
+  cmd->add_option("--iterations", iterations)->capture_default_str();
+  cmd->add_option("--maps", maps)->delimiter(',')->capture_default_str();
+  cmd->add_option("--out,--results", out);
+  cmd->add_flag("--quiet", quiet);
+  cmd->add_flag("--strict", flag);
+  app.parse(std::vector<std::string>{"it's here.md", "--out", "b.json,c.json", "--maps", "--strict", "5", "--iterations", "--quiet", "paper", "bench"});
+  // Given options as given (a list joined by its delimiter, a value a shell would split quoted),
+  // --runs at its default because it is named, --quiet left out.
+  CHECK(miner::cli::command_line(cmd, {"--runs"}) ==
+        "miner bench paper --runs 20 --iterations 5 --maps b.json,c.json --out 'it'\\''s here.md' --strict");
+  CHECK(miner::cli::command_line(cmd, {}) ==
+        "miner bench paper --iterations 5 --maps b.json,c.json --out 'it'\\''s here.md' --strict");
 }
 
 TEST_CASE("An unreachable goal exits 3 with the reason", "[REQ-CLI-002][REQ-WORLD-010]") {
@@ -527,7 +638,7 @@ TEST_CASE("Unknown options are named with the nearest one: duplicates, exclusive
   p.erase("durations");
   const std::string limits_only = write("lim.json", p.dump());
   const Run rho = miner_cli({"traj", "solve", "--problem", limits_only, "--rho", "5"});
-  CHECK(rho.code == 1);
+  CHECK(rho.code == 2);  // an option the run would not read: a usage error
   CHECK_THAT(rho.err, Contains("--rho: only used with --allocate optimise"));
   // Negative numbers are values, not options.
   std::ostringstream out, err;
@@ -919,7 +1030,11 @@ TEST_CASE("miner bench paper writes the four tables beside the paper's numbers, 
   CHECK_THAT(md, Contains("| Ours (paper) | 96.3 % | 97.1 % |") && Contains("| MINER sGAN, filtered | 100.0 % | 100.0 % |"));
   CHECK_THAT(md, Contains("0.0023/0.0043") && Contains("| Map1 | paper (real flight) | 0.0513 |"));
   CHECK_THAT(md, Contains("| indoor-1 | MINER (simulation) |") && Contains("| indoor-2 | MINER (simulation) |"));
-  CHECK_THAT(md, Contains("`miner bench paper --runs 2 --seed 1") && Contains("at commit `"));
+  // The Generated-by line reproduces the run: every option given (issue 20, fourth campaign:
+  // --heuristic-iterations, --tracking-maps and --backend-budget were left out).
+  CHECK_THAT(md, Contains("Generated by `miner bench paper --maps ") && Contains(" --runs 2 --seed 1 --time-limit 0.2 ") &&
+                     Contains(" --heuristic-iterations 300 --tracking-maps ") && Contains(" --backend-budget 0.005 ") &&
+                     Contains("at commit `"));
   CHECK_THAT(md, Contains("](results/sim-1-first.svg)") && Contains("](results/sim-1-target.svg)"));
   const std::string box = read(dir() + "/paper/results/sim-1-first.svg");
   CHECK_THAT(box, Contains("<svg") && Contains(">rrtstar<") && Contains(">miner-sgan<"));
@@ -1039,6 +1154,12 @@ TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[RE
     doctor([](miner::Json& d) { d["foo"] = 1; }, "foo: unknown key");
     doctor([](miner::Json& d) { d["sed"] = d["seed"]; d.erase("seed"); }, "did you mean \"seed\"");
     doctor([](miner::Json& d) { d["steer_step"] = 123.0; }, "\"steer_step\" is 123.0 in the one");
+    // Fourth campaign: the campaign's own costs contradicting each other.
+    doctor([](miner::Json& d) { d["target_cost"] = 0.5 * d["lower_bound"].get<double>(); },
+           "is not target_factor x reference_cost");
+    doctor([](miner::Json& d) { d["reference_cost"] = 0.5 * d["lower_bound"].get<double>(); },
+           "reference_cost: the A* reference");
+    doctor([](miner::Json& d) { d["lower_bound"] = -1.0; }, "lower_bound: the straight-line bound is a length");
   }
   // Missing, repeated and foreign parts, and malformed shards, are refused.
   CHECK(miner_cli({"bench", "merge", parts[0], parts[1]}).code == 1);
@@ -1140,6 +1261,19 @@ TEST_CASE("miner bench sim reports the real-time factor", "[REQ-FLIGHT-010]") {
   CHECK(doc["flight_time_s"].get<double>() > 10.0);
   CHECK(doc["threads"] == 1);
   CHECK(miner_cli({"bench", "sim", "--runs", "0"}).code == 2);
+  // A flight that `fly` fails is not timed (issue 20, fourth campaign: every pose an outlier,
+  // the vehicle crashed, and a real-time factor was reported with exit 0).
+  const std::string map = write("sim-4th-map.json", R"({"format": "miner-map-v1", "bounds": {"min": [0,0,0], "max": [4,4,2]},
+    "resolution": 0.25, "obstacles": [{"type": "box", "min": [1.5,1.5,0], "max": [2.5,2.5,2]}]})");
+  const std::string scenario = write("sim-4th.json", R"({"format": "miner-scenario-v1", "name": "outliers", "map": "sim-4th-map.json",
+    "start": [0.5, 0.5, 1], "goal": [0.5, 3.5, 1], "waypoints": [[0.5, 2, 1]], "trajectory": {"order": 4, "v_max": 1.0, "a_max": 1.0},
+    "seed": 1, "hover_after_s": 1.0, "goal_tolerance_m": 0.3, "pose": {"outlier_probability": 1.0}})");
+  const Run fly = miner_cli({"fly", "--scenario", scenario, "--out", dir() + "/sim-4th-run"});
+  REQUIRE(fly.code == 3);
+  const Run failed = miner_cli({"bench", "sim", "--scenario", scenario, "--runs", "1"});
+  CHECK(failed.code == 3);
+  CHECK_THAT(failed.err, Contains("bench sim: the flight of outliers does not reach the goal") && Contains("not timed"));
+  CHECK(failed.out.empty());
 }
 
 TEST_CASE("miner dataset writes the dataset folder and refuses a missing --out", "[REQ-HEUR-001][REQ-HEUR-003]") {
@@ -1236,7 +1370,7 @@ TEST_CASE("miner heuristic --strict-bridge adds filter step 5 and reports its ch
   CHECK(bytes(dir() + "/strict-region.json") == bytes(dir() + "/strict-region2.json"));
   // It is a filter step: refused with --raw, and with a region other than the sGAN's.
   const Run raw = miner_cli({"heuristic", "--map", map, "--out", dir() + "/z.json", "--strict-bridge", "--raw"});
-  CHECK(raw.code == 1);
+  CHECK(raw.code == 2);
   CHECK_THAT(raw.err, Contains("--strict-bridge") && Contains("--raw"));
   CHECK_FALSE(std::filesystem::exists(dir() + "/z.json"));
   const Run astar = miner_cli({"plan", "--map", map, "--planner", "miner", "--region", "astar", "--strict-bridge"});
@@ -1451,11 +1585,11 @@ TEST_CASE("miner map scan writes a deterministic OctoMap and a map that referenc
   // An output that is the voxel file an input map references is refused, and the map still
   // loads (issue 20: astar --out scan.bt replaced the voxels the map points to).
   const std::string bt_before = read(bt);
-  const Run over_voxels = miner_cli({"astar", "--map", json, "--out", bt});
+  const Run over_voxels = miner_cli({"map", "convert", "--in", json, "--out", bt});
   CHECK(over_voxels.code == 2);
   CHECK_THAT(over_voxels.err, Contains("its voxels.file") && Contains("would replace its own input"));
   CHECK(read(bt) == bt_before);
-  CHECK(miner_cli({"map", "convert", "--in", json, "--out", bt}).code == 2);
+  CHECK(miner_cli({"astar", "--map", json, "--out", bt}).code == 2);  // and a JSON result is never a .bt
   CHECK(miner_cli({"map", "info", "--map", json}).code == 0);
 }
 

@@ -18,11 +18,18 @@ enum class ExitCode : int {
   kNoSolution = 3,    ///< the input is valid but no path/trajectory exists
 };
 
-/// An error caused by the user's input (a file, a field, a value).
+/// `text` with every control byte but newline and tab, and DEL, written as "\xNN": a message
+/// quotes the user's text (a key, a name, a line of a file), and a NUL byte in it cut the
+/// message there (issue 20, fourth campaign: `unknown obstacle type "bo`), other control
+/// bytes drive the terminal.
+std::string printable_text(const std::string& text);
+
+/// An error caused by the user's input (a file, a field, a value). Its message is kept
+/// printable (printable_text).
 class Error : public std::runtime_error {
  public:
   explicit Error(const std::string& what, ExitCode code = ExitCode::kInvalidInput)
-      : std::runtime_error(what), code_(code) {}
+      : std::runtime_error(printable_text(what)), code_(code) {}
   ExitCode code() const { return code_; }
 
  private:

@@ -50,6 +50,12 @@ Json parse_json(const std::string& text, const std::string& origin) {
   bool in_string = false;
   for (std::size_t i = 0; i < text.size(); ++i) {
     const char c = text[i];
+    // JSON text holds no NUL byte (inside a string it is written \u0000): the JSON library
+    // takes one as the end of the input, so a valid document, a NUL and garbage was read as
+    // the document alone (issue 20, fourth campaign).
+    if (c == '\0')
+      throw Error(origin + ": malformed JSON at byte " + std::to_string(i) +
+                  ": a NUL byte (JSON text has none; inside a string it is written \\u0000)");
     if (in_string) {
       if (c == '\\') ++i;
       else if (c == '"') in_string = false;
@@ -421,6 +427,13 @@ bool is_decimal_number(const std::string& text) {
     if (exponent == 0) return false;
   }
   return i == n;
+}
+
+std::optional<std::pair<std::size_t, std::size_t>> first_repeated(const std::vector<Json>& docs) {
+  for (std::size_t j = 1; j < docs.size(); ++j)
+    for (std::size_t i = 0; i < j; ++i)
+      if (docs[i] == docs[j]) return std::pair{i, j};
+  return std::nullopt;
 }
 
 std::string dump_json(const Json& j) { return j.dump(2) + "\n"; }

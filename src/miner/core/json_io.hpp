@@ -4,6 +4,7 @@
 /// writing files atomically so a good file is never half-overwritten (REQ-CORE-003,
 /// REQ-CORE-004).
 
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -24,6 +25,11 @@ Json read_json_file(const std::string& path);
 /// prefix (what users see names their file and field, not the library's internals).
 std::string json_error_text(const std::exception& e);
 std::string read_file_bytes(const std::string& path, const std::string& what = "file");
+
+/// The first (i, j), i < j, with docs[i] == docs[j]; nullopt when all differ. A campaign's
+/// inputs given twice under two names (two files of one content, a map inlined once and
+/// referenced once) are found by their documents (issue 20, fourth campaign).
+std::optional<std::pair<std::size_t, std::size_t>> first_repeated(const std::vector<Json>& docs);
 
 /// Parses JSON text; `origin` names it in messages (a path, or "<stdin>").
 Json parse_json(const std::string& text, const std::string& origin);

@@ -232,6 +232,11 @@ void validate(const DatasetOptions& o) {
   if (o.count < 1) throw Error("dataset: --count must be >= 1");
   if (o.test_count < 0) throw Error("dataset: --test-count must be >= 0");
   if (!(o.val_fraction >= 0.0 && o.val_fraction < 1.0)) throw Error("dataset: --val-fraction must be in [0, 1)");
+  // The validation share is rounded to whole samples; one that leaves no training sample is
+  // refused (issue 20, fourth campaign: --count 2 --val-fraction 0.99 wrote 0 training samples).
+  if (std::lround(o.val_fraction * o.count) >= o.count)
+    throw Error("dataset: --val-fraction " + std::to_string(o.val_fraction) + " of --count " + std::to_string(o.count) +
+                " keeps every sample for validation and none for training (raise --count or lower --val-fraction)");
   if ((o.dims.array() < 4).any() || (o.dims.array() > 256).any())
     throw Error("dataset: --dims must be between 4 and 256 cells per axis");
   if (o.dilation < 0 || o.dilation > plan::HeuristicRegion::kMaxDilation)

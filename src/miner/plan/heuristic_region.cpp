@@ -85,7 +85,9 @@ HeuristicRegion HeuristicRegion::from_json(const Json& doc, const std::string& o
   const std::size_t n = jp.array_size();
   std::vector<double> probabilities(n);
   for (std::size_t i = 0; i < n; ++i) probabilities[i] = jp.at(i).number();
-  const double threshold = root.has("threshold") ? root.at("threshold").number() : 0.5;
+  // Required: H depends on it, and a file without one was read with 0.5 (issue 20, fourth
+  // campaign); every region MINER writes records it.
+  const double threshold = root.at("threshold").number();
   const std::string source = root.has("source") ? root.at("source").string() : "";
   // Provenance shown in reports and run folders: one printable line (issue 20, S7).
   constexpr std::size_t kMaxSourceBytes = 512;

@@ -76,11 +76,14 @@ TrajectoryRequest request_from_json(const Json& doc, const std::string& origin, 
   const JsonField root(doc, "", origin);
   std::string method = root.has("allocation") ? root.at("allocation").string() : "trapezoid";
   if (!allocation_override.empty()) method = allocation_override;
-  if (method != "trapezoid" && method != "optimise")
-    (root.has("allocation") && allocation_override.empty() ? root.at("allocation") : root)
-        .fail("allocation: expected \"trapezoid\" or \"optimise\", got \"" + method + "\"");
+  if (method != "trapezoid" && method != "optimise") {
+    const std::string expected = "expected \"trapezoid\" or \"optimise\", got \"" + method + "\"";
+    if (!allocation_override.empty()) throw Error("--allocate: " + expected, ExitCode::kUsage);
+    root.at("allocation").fail(expected);
+  }
   if (method == "trapezoid") {
-    if (rho_override) throw Error("--rho: only used with --allocate optimise");
+    // A command-line option the run would not use is a usage error (exit 2).
+    if (rho_override) throw Error("--rho: only used with --allocate optimise", ExitCode::kUsage);
     if (root.has("rho")) root.at("rho").fail("only used with \"allocation\": \"optimise\"");
     return r;
   }

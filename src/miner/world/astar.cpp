@@ -62,9 +62,21 @@ Eigen::Vector3i endpoint_cell(const Map& map, const VoxelGrid& grid, const Eigen
   if (!cell) throw Error(what + " " + format_point(p) + " lies outside the grid");
   if (grid.occupied(*cell)) {
     std::ostringstream os;
+    // The last layer of cells, when the resolution does not divide the extent, has its centre
+    // past the bounds and is blocked (VoxelGrid): that is the cause, not an obstacle (issue 20,
+    // fourth campaign: such a goal was blamed on "an obstacle inflated by the robot radius").
+    const Eigen::Vector3d centre = map.bounds().min + (cell->cast<double>().array() + 0.5).matrix() * grid.resolution();
+    for (int k = 0; k < 3; ++k)
+      if (centre[k] > map.bounds().max[k]) {
+        os << what << " " << format_point(p) << " lies in the last grid cell along " << "xyz"[k] << ", whose centre "
+           << centre[k] << " m is past the map's bounds (max " << map.bounds().max[k] << " m): the resolution "
+           << grid.resolution() << " m does not divide the extent " << map.bounds().extent()[k]
+           << " m and such cells are blocked; move it inside or use a resolution that divides the extent";
+        throw Error(os.str());
+      }
     os << what << " " << format_point(p) << " lies in an occupied grid cell (clearance "
        << map.clearance(p) << " m; at resolution " << grid.resolution()
-       << " m the cell overlaps an obstacle inflated by the robot radius " << grid.robot_radius()
+       << " m the cell overlaps an obstacle (a box or a blocked voxel) inflated by the robot radius " << grid.robot_radius()
        << " m); move it away from obstacles or use a finer resolution";
     throw Error(os.str());
   }

@@ -256,18 +256,20 @@ Map Map::from_json(const Json& doc, const std::string& origin) {
     const std::string file = voxel_file_path(origin, jv.at("file").string());
     const std::string bytes = read_file_bytes(file, "voxel file");
     VoxelSource source{nullptr, UnknownPolicy::kOccupied, file, sha256_hex(bytes)};
+    // What the file is comes first: a point cloud given as the voxel file was blamed on its
+    // hash (issue 20, fourth campaign).
+    source.layer = parse_octree(bytes, file);
     if (jv.has("sha256") && jv.at("sha256").string() != source.sha256) {
       jv.at("sha256").fail("the voxel file " + file + " has SHA-256 " + source.sha256 +
                            ", not the recorded one: the file changed since the map was written");
     }
     if (jv.has("unknown")) {
       try {
-        source.unknown = parse_unknown_policy(jv.at("unknown").string(), "unknown");
+        source.unknown = parse_unknown_policy(jv.at("unknown").string(), "");  // the field names itself
       } catch (const Error& e) {
         jv.at("unknown").fail(e.what());
       }
     }
-    source.layer = parse_octree(bytes, file);
     voxels = std::move(source);
   }
   Box bounds = voxels ? voxels->layer->bounds() : Box{};
@@ -337,7 +339,18 @@ Map Map::load(const std::string& path) {
            path.compare(path.size() - suffix.size(), suffix.size(), suffix) == 0;
   };
   if (ends_with(".bt") || ends_with(".ot")) return load_octomap(path);
-  return from_json(read_json_file(path), path);
+  const std::string bytes = read_file_bytes(path);
+  // Formats MINER reads elsewhere, recognised by their first bytes, are named as such instead
+  // of as malformed JSON (issue 20, fourth campaign: an OctoMap named .BT got the JSON
+  // library's "invalid literal; last read: '#'").
+  const auto starts_with = [&](const std::string& magic) { return bytes.compare(0, magic.size(), magic) == 0; };
+  if (starts_with("# Octomap OcTree"))
+    throw Error(path + ": is an OctoMap file, not a miner-map-v1 JSON: MINER reads OctoMaps by their suffix, .bt or "
+                       ".ot (exactly, lower case); rename it");
+  if (starts_with("ply\n") || starts_with("ply\r\n") || starts_with("# .PCD") || starts_with("VERSION"))
+    throw Error(path + ": is a point cloud (PLY or PCD), not a map: turn it into one with `miner map import --cloud " +
+                path + " --out map.bt`");
+  return from_json(parse_json(bytes, path), path);
 }
 
 Json Map::to_json() const {
@@ -394,7 +407,25 @@ VoxelLayer Map::to_voxel_layer() const {
   return VoxelLayer(origin_cells, resolution_, boxes.dims(), std::move(states));
 }
 
-void Map::save_octomap(const std::string& path) const { write_octree_bt(to_voxel_layer(), path); }
+void Map::save_octomap(const std::string& path) const {
+  // An OctoMap's voxels lie on multiples of the resolution from the origin: bounds off that
+  // lattice would be written as the cells that cover them, and read back larger (issue 20,
+  // fourth campaign: 4 m at 0.3 m came back as 4.2 m). Such a map is refused, not altered.
+  constexpr double kLatticeTolerance = 1e-9;  // in cells: the bounds are written with %g-like decimals
+  for (int k = 0; k < 3; ++k)
+    for (const double edge : {bounds_.min[k], bounds_.max[k]}) {
+      const double cells = edge / resolution_;
+      if (std::fabs(cells - std::round(cells)) > kLatticeTolerance * std::max(1.0, std::fabs(cells))) {
+        std::ostringstream os;
+        os << path << ": the map's bounds " << format_point(bounds_.min) << " - " << format_point(bounds_.max)
+           << " are not whole multiples of its resolution " << resolution_ << " m along " << "xyz"[k] << " (" << edge
+           << " m is " << cells << " cells): an OctoMap's voxels lie on that lattice, so the .bt would cover more "
+           << "than the map; use a resolution that divides the bounds, or write .json";
+        throw Error(os.str());
+      }
+    }
+  write_octree_bt(to_voxel_layer(), path);
+}
 
 void Map::save(const std::string& path) const {
   // issue 20: a ".ot" path got JSON that load() then read as an OctoMap and refused.

@@ -1,6 +1,7 @@
 #include "miner/world/map_generator.hpp"
 
 #include <algorithm>
+#include <sstream>
 #include <cmath>
 
 #include "miner/core/error.hpp"
@@ -227,6 +228,18 @@ void check_overrides(const GeneratorPreset& preset, const GeneratorOverrides& ov
   }
   if (overrides.resolution && !(*overrides.resolution >= kMinFamilyResolution && *overrides.resolution <= kMaxFamilyResolution))
     throw Error("resolution: must be between 0.01 and 10 m");
+  // A grid needs a cell along every axis: a resolution coarser than the smallest extent the map
+  // can have is a fault of the overrides, found here, not after drawing (issue 20, fourth
+  // campaign: it failed in the map's own check, exit 1).
+  if (overrides.resolution && drawn != "scan" && is_family(generator_preset(drawn))) {
+    const double smallest = overrides.size ? overrides.size->minCoeff() : generator_preset(drawn).min_extent.minCoeff();
+    if (*overrides.resolution > smallest) {
+      std::ostringstream os;
+      os << "resolution: " << *overrides.resolution << " m is coarser than the smallest extent " << smallest
+         << " m the map " << (overrides.size ? "is given" : "may be drawn with") << ": the grid would have no cell along it";
+      throw Error(os.str());
+    }
+  }
 }
 
 Map generate_map(const GeneratorPreset& preset, std::uint64_t seed, const GeneratorOverrides& overrides) {
@@ -249,8 +262,11 @@ Map generate_map(const GeneratorPreset& preset, std::uint64_t seed, const Genera
       }
       const Box bounds{Eigen::Vector3d::Zero(), extent};
       detail::FamilyDraw draw = detail::draw_family(preset, rng, bounds, obstacle_count);
-      Map map(bounds, resolution, std::move(draw.obstacles), draw.query);
       try {
+        // Inside the try: a family drawn at a size too small for its layout can put its query
+        // outside the bounds, which the map refuses; that attempt is redrawn like a blocked one
+        // (issue 20, fourth campaign: `--preset rooms --size 3 3 3` failed on its own query).
+        Map map(bounds, resolution, std::move(draw.obstacles), draw.query);
         map.require_free(draw.query.start, draw.query.robot_radius, "start");
         map.require_free(draw.query.goal, draw.query.robot_radius, "goal");
         const VoxelGrid grid(map, draw.query.robot_radius);

@@ -305,6 +305,9 @@ PointCloud parse_ply(const std::string& bytes, const std::string& origin) {
     } else if (w[0] == "element") {
       if (w.size() != 3) fail(origin, "malformed element line");
       if (!seen_element && w[1] != "vertex") fail(origin, "the first element is \"" + w[1] + "\", not \"vertex\"");
+      // One vertex element: a second one's points would be walked as another element's and
+      // dropped (issue 20, fourth campaign).
+      if (seen_element && w[1] == "vertex") fail(origin, "a second \"vertex\" element (MINER reads one)");
       in_vertex = !seen_element;
       if (in_vertex) vertices = count_of(w[2], "element vertex", origin);
       else later.push_back({w[1], count_of(w[2], "element " + w[1], origin), {}});
@@ -472,10 +475,15 @@ std::shared_ptr<const VoxelLayer> integrate_clouds(const std::vector<CloudScan>&
   };
   // Sensor origins first: one beyond the keys made the ray bound below infinite, blamed on the
   // rays (issue 20); and a cloud of no finite point is named as such.
+  // Each cloud is named by its file when it has one (issue 20, fourth campaign: "cloud 0:
+  // point 0" named none).
+  const auto label = [&](std::size_t s) {
+    return scans[s].name.empty() ? "cloud " + std::to_string(s) : scans[s].name;
+  };
   std::size_t finite_points = 0;
   for (std::size_t s = 0; s < scans.size(); ++s) {
     if (!(scans[s].origin.allFinite() && scans[s].origin.cwiseAbs().maxCoeff() < reach))
-      throw Error("cloud " + std::to_string(s) + ": the sensor origin " + format_point(scans[s].origin) +
+      throw Error(label(s) + ": the sensor origin " + format_point(scans[s].origin) +
                   " lies beyond OctoMap's key range at this resolution (32767 voxels from the origin)");
     finite_points += scans[s].cloud.points.size();
   }
@@ -503,7 +511,7 @@ std::shared_ptr<const VoxelLayer> integrate_clouds(const std::vector<CloudScan>&
     for (std::size_t i = 0; i < scan.cloud.points.size(); ++i) {
       const Eigen::Vector3d& p = scan.cloud.points[i];
       if (beyond(p))
-        throw Error("cloud " + std::to_string(s) + ": point " + std::to_string(i) + " " + format_point(p) +
+        throw Error(label(s) + ": point " + std::to_string(i) + " " + format_point(p) +
                     " lies beyond OctoMap's key range at this resolution (32767 voxels from the origin)");
       cloud.push_back(point(p));
     }

@@ -41,6 +41,7 @@ PointCloud parse_point_cloud(const std::string& bytes, bool ply, const std::stri
 struct CloudScan {
   PointCloud cloud;
   Eigen::Vector3d origin;  ///< sensor position the rays start from
+  std::string name;        ///< the file it came from, named in messages (empty: "cloud <i>")
 };
 
 /// Integrates the scans with OctoMap at `resolution` (rays longer than max_range, if positive,

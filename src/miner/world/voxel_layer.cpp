@@ -90,7 +90,8 @@ std::vector<double> squared_distance_transform(const std::vector<std::uint8_t>& 
 UnknownPolicy parse_unknown_policy(const std::string& text, const std::string& what) {
   if (text == "occupied") return UnknownPolicy::kOccupied;
   if (text == "free") return UnknownPolicy::kFree;
-  throw Error(what + ": unknown-space policy \"" + text + "\" is not one of \"occupied\", \"free\"");
+  throw Error((what.empty() ? "" : what + ": ") + "unknown-space policy \"" + text +
+              "\" is not one of \"occupied\", \"free\"");
 }
 
 const char* to_string(UnknownPolicy policy) { return policy == UnknownPolicy::kOccupied ? "occupied" : "free"; }

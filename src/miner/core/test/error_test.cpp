@@ -20,3 +20,12 @@ TEST_CASE("Errors carry the exit code of their kind", "[REQ-CORE-002]") {
   CHECK(miner::NoSolution("y").code() == miner::ExitCode::kNoSolution);
   CHECK(miner::format_point(Eigen::Vector3d(1, 2.5, -3)) == "(1, 2.5, -3)");
 }
+
+TEST_CASE("An error's message keeps the user's control bytes visible and whole", "[REQ-CORE-002]") {
+  // A NUL in a quoted key cut the printed message there (issue 20, fourth campaign).
+  const std::string key = std::string("bo") + '\0' + "x\x1b[2J";
+  const miner::Error e("m.json: unknown obstacle type \"" + key + "\"");
+  CHECK(std::string(e.what()) == "m.json: unknown obstacle type \"bo\\x00x\\x1b[2J\"");
+  CHECK(miner::printable_text("line one\n\tline two\x7f") == "line one\n\tline two\\x7f");
+  CHECK(miner::printable_text("caf\xc3\xa9") == "caf\xc3\xa9");  // UTF-8 stays as it is
+}

@@ -39,6 +39,12 @@ TEST_CASE("Malformed JSON names the file and the byte offset", "[REQ-CORE-003]")
     CHECK_THROWS_WITH(miner::parse_json(bad, "w.json"), Contains("w.json: malformed JSON at byte") && !Contains("json.exception"));
   CHECK_THROWS_WITH(miner::parse_json("{\"a\": 1e999}", "z.json"),
                     Contains("z.json: the number 1e999 at byte 6 is beyond the largest double"));
+  // A NUL byte ended the document for the JSON library: a valid one followed by a NUL and
+  // garbage was read as valid (issue 20, fourth campaign).
+  CHECK_THROWS_WITH(miner::parse_json(std::string("{\"a\": 1}\0{garbage", 17), "n.json"),
+                    Contains("n.json: malformed JSON at byte 8: a NUL byte"));
+  CHECK_THROWS_WITH(miner::parse_json(std::string("{\"a\": \"b\0c\"}", 12), "s.json"), Contains("at byte 8: a NUL byte"));
+  CHECK(miner::parse_json("{\"a\": \"b\\u0000c\"}", "u.json")["a"].get<std::string>() == std::string("b\0c", 3));
   CHECK_THROWS_WITH(miner::read_json_file("/nonexistent/file.json"),
                     Contains("/nonexistent/file.json: cannot open file"));
 }

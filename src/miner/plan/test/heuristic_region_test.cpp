@@ -67,6 +67,9 @@ TEST_CASE("A region round-trips through miner-region-v1 and bad files name the f
   doc["dims"] = {4, 0, 2};
   CHECK_THROWS_WITH(HeuristicRegion::from_json(doc, "r.json"), Contains("dims"));
   doc = r.to_json();
+  doc.erase("threshold");  // H depends on it: never defaulted
+  CHECK_THROWS_WITH(HeuristicRegion::from_json(doc, "r.json"), Contains("r.json: threshold: missing required field"));
+  doc = r.to_json();
   doc["threshold"] = 0.0;
   CHECK_THROWS_WITH(HeuristicRegion::from_json(doc, "r.json"), Contains("threshold"));
   doc = r.to_json();

@@ -147,6 +147,20 @@ TEST_CASE("Start and goal errors name the point and what is wrong", "[REQ-WORLD-
                     Contains("start (3.2, 5, 5) lies in an occupied grid cell (clearance 0.8"));
 }
 
+TEST_CASE("A point in a grid cell past the bounds is refused for that reason, not blamed on an obstacle",
+          "[REQ-WORLD-010]") {
+  // 0.3 m does not divide 4 m: the last layer of cells (3.9 - 4.2 m) has its centre past the
+  // bounds and is blocked (issue 20, fourth campaign: the message blamed an inflated obstacle).
+  const Map map(Box{{0, 0, 0}, {4, 4, 1.9}}, 0.3, {});
+  const VoxelGrid grid(map, 0.1);
+  CHECK_THROWS_WITH(astar(map, grid, V(0.5, 0.5, 1), V(3.95, 2, 1)),
+                    Contains("goal (3.95, 2, 1) lies in the last grid cell along x, whose centre 4.05 m is past the "
+                             "map's bounds (max 4 m)") &&
+                        Contains("does not divide the extent 4 m"));
+  CHECK_THROWS_WITH(astar(map, grid, V(0.5, 0.5, 1.85), V(1, 1, 1)), Contains("along z, whose centre 1.95 m"));
+  CHECK_NOTHROW(astar(map, grid, V(0.5, 0.5, 1), V(3.85, 2, 1)));
+}
+
 TEST_CASE("An unreachable goal is a NoSolution that says how much was searched", "[REQ-WORLD-010]") {
   // The goal sits in a closed room: a hollow box made of 6 walls.
   const Map map(Box{{0, 0, 0}, {10, 10, 10}}, 1.0,

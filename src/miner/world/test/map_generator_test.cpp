@@ -177,4 +177,25 @@ TEST_CASE("Family overrides: size, resolution and count: bad overrides are refus
   bad = {};
   bad.obstacles = 3;
   CHECK_THROWS_WITH(generate_map(generator_preset("rooms"), 1, bad), Contains("has no obstacle count to override"));
+  // A resolution with no cell along the smallest extent is the overrides' fault (fourth campaign).
+  bad = {};
+  bad.size = Eigen::Vector3d(3, 3, 3);
+  bad.resolution = 5.0;
+  CHECK_THROWS_WITH(check_overrides(generator_preset("cluttered"), bad),
+                    Contains("resolution: 5 m is coarser than the smallest extent 3 m the map is given"));
+  bad.size.reset();
+  CHECK_THROWS_WITH(check_overrides(generator_preset("rooms"), bad), Contains("the map may be drawn with"));
+  // A size too small for a family's layout is redrawn, then refused as such, never a map whose
+  // own query lies outside it (fourth campaign: rooms at 3 x 3 x 3 m).
+  GeneratorOverrides tiny;
+  tiny.size = Eigen::Vector3d(3, 3, 3);
+  for (std::uint64_t seed = 1; seed <= 8; ++seed) {
+    try {
+      const Map m = generate_map(generator_preset("rooms"), seed, tiny);
+      CHECK(m.in_bounds(m.query()->start));
+      CHECK(m.in_bounds(m.query()->goal));
+    } catch (const miner::NoSolution& e) {
+      CHECK_THAT(e.what(), Contains("no solvable map") && Contains("too small a size?"));
+    }
+  }
 }

@@ -1,5 +1,7 @@
 #include <catch2/catch.hpp>
 
+#include <filesystem>
+
 #include <fstream>
 #include <functional>
 #include <sstream>
@@ -157,6 +159,18 @@ TEST_CASE("A box map survives a round trip through an OctoMap .bt file", "[REQ-W
   const std::string again = miner::world::test::temp_path("roundtrip2.bt");
   back.save(again);
   CHECK(slurp(again) == slurp(path));
+}
+
+TEST_CASE("A map whose bounds are off its resolution's lattice is not written as a larger .bt", "[REQ-WORLD-003]") {
+  // 4 m at 0.3 m is 13.33 cells: the .bt would cover 4.2 m (issue 20, fourth campaign).
+  const std::string path = miner::world::test::temp_path("offlattice.bt");
+  std::filesystem::remove(path);
+  CHECK_THROWS_WITH(Map(Box{{0, 0, 0}, {4, 4, 3}}, 0.3, {}).save(path),
+                    Contains("offlattice.bt: the map's bounds") && Contains("not whole multiples of its resolution 0.3 m along x"));
+  CHECK_FALSE(std::filesystem::exists(path));
+  CHECK_THROWS_WITH(Map(Box{{0.1, 0, 0}, {4.1, 4, 3}}, 0.5, {}).save(path), Contains("along x (0.1 m is 0.2 cells)"));
+  CHECK_NOTHROW(Map(Box{{-0.6, 0, 0}, {3, 4.2, 3}}, 0.3, {}).save(path));  // on the lattice: -2, 10, 14 cells
+  CHECK(Map::load(path).bounds().max.y() == Approx(4.2));
 }
 
 namespace {

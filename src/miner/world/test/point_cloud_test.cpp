@@ -226,6 +226,10 @@ TEST_CASE("Malformed point clouds are refused naming the fault, never crash", "[
           "property float z\nend_header\nabc",
           true, "only 3 data bytes follow");
   refuses("ply\nformat ascii 1.0\nelement vertex 999999999999\nend_header\n", true, "exceeds the");
+  // A second vertex element's points were walked as another element's and dropped (fourth campaign).
+  refuses("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+          "element vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 1\n5 5 5\n",
+          true, "a second \"vertex\" element");
   refuses("VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 1\nDATA binary_compressed\n", false,
           "binary_compressed is not supported");
   refuses("VERSION 0.7\nFIELDS x y z\nSIZE 4 4\nTYPE F F F\nPOINTS 1\nDATA ascii\n", false, "different numbers of fields");

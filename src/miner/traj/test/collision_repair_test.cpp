@@ -52,6 +52,25 @@ TEST_CASE("Repair refuses an infeasible path and gives up after its iteration bo
   CHECK_THROWS_WITH(repair_collisions(map, corner_path(), o), Contains("max_iterations: must not be negative"));
 }
 
+TEST_CASE("The iteration bound is exact: a repair needing m insertion rounds passes with m, not with m - 1",
+          "[REQ-TRAJ-008]") {
+  // A held-out mutant (session 23) let the repair run one round past its bound: the corner path
+  // needs more than one round, so "0 rounds gives up" alone did not see it.
+  const Map map = corner_map();
+  RepairOptions o;
+  o.limits = Limits{2.0, 1.0};
+  const int m = repair_collisions(map, corner_path(), o).iterations;
+  REQUIRE(m >= 1);
+  o.max_iterations = m;
+  const RepairResult r = repair_collisions(map, corner_path(), o);
+  CHECK(r.iterations == m);
+  CHECK(colliding_segments(r.trajectory, map, 0.0, 0.01).empty());
+  o.max_iterations = m - 1;
+  CHECK_THROWS_WITH(repair_collisions(map, corner_path(), o),
+                    Contains("still collide after " + std::to_string(m - 1) + " iterations"));
+  CHECK_THROWS_AS(repair_collisions(map, corner_path(), o), miner::NoSolution);
+}
+
 TEST_CASE("An A* path on an indoor map is repaired into a collision-free snap trajectory", "[REQ-TRAJ-008]") {
   // A small indoor-like site: three pillars between start and goal.
   const Map map(Box{{0, 0, 0}, {6, 6, 3}}, 0.1,

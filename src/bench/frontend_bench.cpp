@@ -130,7 +130,17 @@ FrontendBenchResult run_frontend_bench(const world::Map& map, const std::string&
                                        std::ostream* progress) {
   if (options.runs < 1) throw Error("--runs: must be >= 1, got " + std::to_string(options.runs));
   require_shard(options.shard_index, options.shard_count);
+  // A shard that holds no run would report rates over nothing (issue 20, fifth campaign:
+  // "--runs 1 --shard 1/2" gave a 0 % success rate).
+  if (options.shard_index >= options.runs)
+    throw Error("--shard " + std::to_string(options.shard_index) + "/" + std::to_string(options.shard_count) +
+                    ": with --runs " + std::to_string(options.runs) + " this shard holds no run (runs r with r % " +
+                    std::to_string(options.shard_count) + " == " + std::to_string(options.shard_index) + ")",
+                ExitCode::kUsage);
   if (!(options.target_factor > 0.0)) throw Error("--target-factor: must be > 0");
+  // A campaign measures planners between two points (issue 20, fifth campaign: start == goal
+  // scored 100 % for one planner and 0 % for another).
+  if (start == goal) throw Error("start and goal coincide at " + format_point(start) + ": there is no path to measure");
   const Clock::time_point campaign_start = Clock::now();
   const plan::PlanningProblem problem = plan::PlanningProblem::make(map, start, goal, robot_radius);
   const plan::ReferencePath reference = plan::astar_reference(problem);

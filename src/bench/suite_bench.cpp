@@ -293,7 +293,7 @@ SuiteBenchResult run_suite_bench(const SuiteBenchOptions& o, const std::string& 
     try {
       maps.push_back(world::generate_map(world::generator_preset(m.preset), m.seed, m.overrides));
     } catch (const Error& e) {
-      throw Error(entry(i) + ": " + e.what());
+      throw Error(entry(i) + ": " + e.what(), e.code());  // "no solvable map" stays exit 3, as in map gen
     }
     generated.push_back(maps.back().to_json());
   }

@@ -763,6 +763,12 @@ int parse_line(CLI::App& app, const std::vector<std::string>& args, std::ostream
     err << "run 'miner --help' (or 'miner <command> --help') for usage\n";
     return static_cast<int>(ExitCode::kUsage);
   } catch (const Error& e) {
+    // A command-line fault found by the command (exit 2) reads as one, like the parser's.
+    if (e.code() == ExitCode::kUsage) {
+      err << "miner: usage error: " << e.what() << "\n"
+          << "run 'miner --help' (or 'miner <command> --help') for usage\n";
+      return static_cast<int>(ExitCode::kUsage);
+    }
     err << "miner: error: " << e.what() << "\n";
     return static_cast<int>(e.code());
   } catch (const std::bad_alloc&) {

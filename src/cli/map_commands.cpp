@@ -420,6 +420,13 @@ void add_map_commands(CLI::App& app, std::ostream& out) {
     if (!(scan->fov[1] >= 0.0 && scan->fov[1] < 180.0))
       throw CLI::ValidationError("--fov", "the vertical field of view must lie in [0, 180) degrees, got " +
                                               std::to_string(scan->fov[1]));
+    // The turns at the first and last pose alone cast 4 x 360 / h_fov poses of these rays: over
+    // the bound a scan may cast, the options are at fault whatever the path (fifth campaign).
+    const double spin_rays = 4.0 * 360.0 / scan->fov[0] * scan->rays[0] * static_cast<double>(scan->rays[1]);
+    if (spin_rays > world::kMaxScanRays)
+      throw CLI::ValidationError("--rays", "with --fov " + std::to_string(scan->fov[0]) + " the turns at the ends alone cast " +
+                                               std::to_string(spin_rays) + " rays, more than the " +
+                                               std::to_string(world::kMaxScanRays) + " a scan may");
     if (scan->scan.noise > 0.5 * scan->scan.range)
       throw CLI::ValidationError("--noise", "must be at most half of --range (" + std::to_string(scan->scan.range) +
                                                 " m)");

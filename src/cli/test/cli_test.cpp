@@ -282,7 +282,7 @@ TEST_CASE("Options a run would not read, clamped values and mismatched suffixes 
        "--methods dense-lu: --max-dense-segments 0 skips it at every --segments value"},
       {{"bench", "backend", "--budget", "3600", "--segments", "5", "--orders", "3", "--methods", "minco,kkt-qp"}, 2,
        "--budget: 3600 s x 2 methods x 1 orders x 1 segment counts = 7200 s, over the 3600 s bound"},
-      {{"dataset", "--count", "2", "--val-fraction", "0.99", "--out", dir() + "/ds4"}, 1,
+      {{"dataset", "--count", "2", "--val-fraction", "0.99", "--out", dir() + "/ds4"}, 2,
        "keeps every sample for validation and none for training"},
       {{"bench", "suite", "--suite", bench_suite, "--planners", "rrtstar", "--weights", "w.bin", "--out", dir() + "/s4.md"}, 2,
        "--weights: applies to the miner-sgan planner"},
@@ -324,6 +324,53 @@ TEST_CASE("Options a run would not read, clamped values and mismatched suffixes 
   // The same options where the run does read them pass.
   CHECK(miner_cli({"plan", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5", "--planner", "rrtstar",
                    "--iterations", "200", "--tree", "--json"}).code != 2);
+}
+
+TEST_CASE("Fifth campaign: empty shards, coinciding ends, far clouds and shard parts are refused before work",
+          "[REQ-CLI-002][REQ-REPORT-006][REQ-WORLD-018]") {
+  const std::string map = write("pillar-5th.json", kPillarMap);
+  std::string far = "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+  far += "1 1 1\n1600 1600 5\n";
+  const std::string cloud = write("far-5th.ply", far);
+  struct Case {
+    std::vector<std::string> args;
+    int code;
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      {{"bench", "frontend", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5", "--planners", "rrtstar",
+        "--runs", "1", "--shard", "1/2", "--json"},
+       2, "--shard 1/2: with --runs 1 this shard holds no run"},
+      {{"bench", "frontend", "--map", map, "--start", "1", "5", "5", "--goal", "1", "5", "5", "--planners", "rrtstar",
+        "--runs", "1"},
+       1, "start and goal coincide at (1, 5, 5)"},
+      {{"map", "scan", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5", "--rays", "100000", "100000",
+        "--out", dir() + "/s5.bt"},
+       2, "--rays: with --fov 360"},
+      {{"map", "gen", "--preset", "rooms", "--size", "1000", "1000", "1000", "--resolution", "0.01", "--out",
+        dir() + "/g5.json"},
+       2, "grid cells (at most 5e+07)"},
+      {{"map", "import", "--cloud", cloud, "--origin", "0", "0", "0", "--resolution", "0.1", "--out", dir() + "/i5.bt"}, 1,
+       "the clouds and their sensor origins span (0, 0, 0) - (1600, 1600, 5)"},
+      // A fault the command finds in its own options reads as a usage error, like the parser's.
+      {{"astar", "--map", map, "--unknown", "free"}, 2, "miner: usage error: --unknown:"},
+  };
+  for (const auto& c : cases) {
+    const Run r = miner_cli(c.args);
+    INFO("args: " << c.args.at(0) << " " << c.args.at(1) << " ... expected message: " << c.message << "\nstderr: " << r.err);
+    CHECK(r.code == c.code);
+    CHECK_THAT(r.err, Contains(c.message));
+  }
+  const Run far_run = miner_cli({"map", "import", "--cloud", cloud, "--origin", "0", "0", "0", "--resolution", "0.1",
+                                 "--out", dir() + "/i5.bt"});
+  CHECK_THAT(far_run.err, Contains("more than the") && Contains("a map may have"));
+  // A part of a sharded dataset is not measured as if it were the split.
+  const std::string part = dir() + "/part-5th";
+  REQUIRE(miner_cli({"dataset", "--preset", "indoor", "--count", "4", "--test-count", "2", "--shard-size", "1", "--shard",
+                     "0/2", "--out", part, "--quiet"}).code == 0);
+  const Run measured = miner_cli({"bench", "heuristic", "--data", part, "--split", "test", "--no-planners"});
+  CHECK(measured.code == 1);
+  CHECK_THAT(measured.err, Contains("is a part of a sharded dataset") && Contains("dataset --merge"));
 }
 
 TEST_CASE("A report's Generated-by line is the command line that reproduces it", "[REQ-CLI-003]") {

@@ -1,5 +1,6 @@
 #include "miner/traj/problem_io.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "miner/core/error.hpp"
@@ -138,6 +139,14 @@ Json answer_to_json(const PolynomialTrajectory& t) {
 
 PolynomialTrajectory trajectory_from_answer_json(const Json& doc, const std::string& origin) {
   const JsonField root(doc, "", origin);
+  // Strict like every file (issue 20, fifth campaign: unknown keys and a junk "allocation"
+  // block were ignored): an answer's own keys, and its allocation record's.
+  root.only_keys({"order", "durations", "cost", "coefficients", "allocation"});
+  if (root.has("allocation"))
+    root.at("allocation").only_keys({"method", "rho", "objective", "trapezoid_objective", "trapezoid_stretch", "cost",
+                                     "total_time", "max_speed", "max_acceleration", "v_max", "a_max",
+                                     "samples_per_segment", "iterations", "polish_evaluations", "termination",
+                                     "solve_ms"});
   const JsonField order_field = root.at("order");
   const int order = order_field.integer();
   if (order != 3 && order != 4) order_field.fail("must be 3 (jerk) or 4 (snap)");
@@ -158,7 +167,33 @@ PolynomialTrajectory trajectory_from_answer_json(const Json& doc, const std::str
     for (int r = 0; r < 2 * order; ++r)
       c.row(2 * order * static_cast<Eigen::Index>(i) + r) = seg.at(static_cast<std::size_t>(r)).vec3().transpose();
   }
-  return PolynomialTrajectory(order, std::move(durations), std::move(c));
+  PolynomialTrajectory t(order, std::move(durations), std::move(c));
+  // A trajectory is flown as one curve: at every junction position and derivatives 1..s-1
+  // (velocity, acceleration and, for snap, jerk) must meet, or the reference jumps (issue 20,
+  // fifth campaign: a 0.5 m jump between segments was flown). kJunctionTolerance is relative
+  // to the larger side, with 1 as the floor: the answers MINER writes meet to ~1e-12.
+  constexpr double kJunctionTolerance = 1e-6;
+  for (int i = 0; i + 1 < t.segments(); ++i)
+    for (int k = 0; k < order; ++k) {
+      const Eigen::Vector3d end = t.evaluate_segment(i, t.durations()[static_cast<std::size_t>(i)], k);
+      const Eigen::Vector3d next = t.evaluate_segment(i + 1, 0.0, k);
+      const double scale = std::max({1.0, end.cwiseAbs().maxCoeff(), next.cwiseAbs().maxCoeff()});
+      if ((end - next).cwiseAbs().maxCoeff() > kJunctionTolerance * scale) {
+        static const char* const kNames[] = {"position", "velocity", "acceleration", "jerk"};
+        coefficients_field.at(static_cast<std::size_t>(i) + 1)
+            .fail(std::string("the ") + kNames[k] + " at the start of segment " + std::to_string(i + 1) + ", " +
+                  format_point(next) + ", does not meet the end of segment " + std::to_string(i) + ", " +
+                  format_point(end) + ": the trajectory would jump there");
+      }
+    }
+  // The recorded cost, when given, is this trajectory's (a stale or edited one is refused).
+  if (root.has("cost")) {
+    const double recorded = root.at("cost").number(), actual = t.cost();
+    if (!(std::fabs(recorded - actual) <= kJunctionTolerance * std::max(1.0, std::fabs(actual))))
+      root.at("cost").fail("is " + root.at("cost").value().dump() + " but the coefficients' cost is " +
+                           std::to_string(actual) + ": the file was edited or is stale");
+  }
+  return t;
 }
 
 }  // namespace miner::traj

@@ -241,6 +241,15 @@ AllocationResult optimise_allocation(const MincoProblem& problem, const Allocati
     log_of(best);
     ceres::Solve(options, gp, tau.data(), &summary);
     ceres_iterations += static_cast<int>(summary.iterations.size());
+    // The objective or its gradient not finite where Ceres starts: the problem lies outside
+    // what double precision can optimise (issue 20, fifth campaign: rho 1e9 with limits 1e6
+    // gave an 81 s segment, "Initial cost and jacobian evaluation failed", and exit 0).
+    if (summary.termination_type == ceres::FAILURE &&
+        summary.message.rfind("Initial cost and jacobian evaluation failed", 0) == 0)
+      throw Error("allocation: the optimiser could not evaluate the objective J + rho sum T or its gradient at the "
+                  "start (Ceres: " + summary.message + "): rho " + std::to_string(o.rho) + " and the limits (v_max " +
+                  std::to_string(o.limits.v_max) + ", a_max " + std::to_string(o.limits.a_max) +
+                  ") put it beyond double precision; use a smaller rho or tighter limits, or give durations");
     for (std::size_t i = 0; i < M; ++i) T[i] = std::exp(tau[i]);
     Evaluation e;
     if (evaluate(base, T, o, solver, e) && e.F < best.F) best = std::move(e);  // never worse than before

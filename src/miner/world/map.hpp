@@ -34,14 +34,16 @@
 namespace miner::world {
 
 inline constexpr const char* kMapFormat = "miner-map-v1";
-/// Largest grid a map may have (cells of `resolution` over its bounds): 2^28 cells keep A*'s
-/// ~9 bytes per cell near 2.4 GB. A map whose resolution gives more is refused (REQ-WORLD-002).
-inline constexpr double kMaxGridCells = 268435456.0;
+/// Largest grid a map may have (cells of `resolution` over its bounds): 2^26 cells keep A*'s
+/// ~9 bytes per cell near 600 MB and one search within tens of seconds. A map whose resolution
+/// gives more is refused (REQ-WORLD-002). (2^28 before issue 20's fifth campaign: a 180-byte
+/// .bt of two leaves 639 voxels apart passed it and took 4.9 GB and over a minute to plan on.)
+inline constexpr double kMaxGridCells = 67108864.0;
 /// The metric range of a map (REQ-WORLD-002; issue 20: a resolution of 1e-300 overflowed the
 /// voxel grid's inflation, 1e300 made OctoMap's keys infinite and planning hang, and maps of
 /// 1e300 m gave infinite costs). Every reader (JSON, OctoMap, point-cloud import, scans)
 /// refuses values outside it, naming the file and field.
-/// 1 mm: finer than any mapping sensor's voxel (and 2^28 cells then span only 0.65 m^3).
+/// 1 mm: finer than any mapping sensor's voxel (and 2^26 cells then span only 0.07 m^3).
 inline constexpr double kMinResolution = 1e-3;
 /// 100 m: coarser cells than any vehicle could plan in.
 inline constexpr double kMaxResolution = 100.0;

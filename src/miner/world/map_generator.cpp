@@ -126,6 +126,8 @@ GeneratorPreset family(const std::string& name, const Eigen::Vector3d& min_exten
 }
 
 /// Largest grid a drawn family resolution may give (A*'s arrays stay ~100 MB).
+/// Largest grid a generated map may have (A* over it stays ~450 MB).
+constexpr double kMaxGeneratedCells = 5e7;
 constexpr double kMaxFamilyGridCells = 6e6;
 
 double family_resolution(const GeneratorPreset& p, const Eigen::Vector3d& extent) {
@@ -233,6 +235,15 @@ void check_overrides(const GeneratorPreset& preset, const GeneratorOverrides& ov
   // campaign: it failed in the map's own check, exit 1).
   if (overrides.resolution && drawn != "scan" && is_family(generator_preset(drawn))) {
     const double smallest = overrides.size ? overrides.size->minCoeff() : generator_preset(drawn).min_extent.minCoeff();
+    if (overrides.size) {
+      const Eigen::Vector3d cells = (*overrides.size / *overrides.resolution).array().ceil();
+      if (cells.prod() > kMaxGeneratedCells) {
+        std::ostringstream os;
+        os << "resolution: " << *overrides.resolution << " m over the size " << format_point(*overrides.size)
+           << " m gives " << cells.prod() << " grid cells (at most " << kMaxGeneratedCells << ")";
+        throw Error(os.str());
+      }
+    }
     if (*overrides.resolution > smallest) {
       std::ostringstream os;
       os << "resolution: " << *overrides.resolution << " m is coarser than the smallest extent " << smallest
@@ -256,9 +267,11 @@ Map generate_map(const GeneratorPreset& preset, std::uint64_t seed, const Genera
       if (overrides.size) extent = *overrides.size;
       const double resolution = overrides.resolution ? *overrides.resolution : family_resolution(preset, extent);
       const Eigen::Vector3d cells = (extent / resolution).array().ceil();
-      if (cells.prod() > 5e7) {
-        throw Error("resolution: " + std::to_string(resolution) + " m gives " + std::to_string(cells.prod()) +
-                    " grid cells (at most 5e7)");
+      if (cells.prod() > kMaxGeneratedCells) {
+        std::ostringstream os;
+        os << "resolution: " << resolution << " m gives " << cells.prod() << " grid cells (at most "
+           << kMaxGeneratedCells << ")";
+        throw Error(os.str());
       }
       const Box bounds{Eigen::Vector3d::Zero(), extent};
       detail::FamilyDraw draw = detail::draw_family(preset, rng, bounds, obstacle_count);

@@ -503,6 +503,29 @@ std::shared_ptr<const VoxelLayer> integrate_clouds(const std::vector<CloudScan>&
        << " an import may; use --range, a coarser --resolution or fewer points";
     throw Error(os.str());
   }
+  // The voxels the rays reach span the box of the origins and the rays' ends: a grid over it
+  // larger than a map may have is refused now, not after integrating (issue 20, fifth campaign:
+  // 100 points 1600 m away integrated for 27 s before the layer was refused).
+  Eigen::Vector3d lo = scans.front().origin, hi = lo;
+  for (const CloudScan& scan : scans) {
+    lo = lo.cwiseMin(scan.origin);
+    hi = hi.cwiseMax(scan.origin);
+    for (const Eigen::Vector3d& p : scan.cloud.points) {
+      const double length = (p - scan.origin).norm();
+      const Eigen::Vector3d end =
+          max_range > 0.0 && length > max_range ? Eigen::Vector3d(scan.origin + (p - scan.origin) * (max_range / length)) : p;
+      lo = lo.cwiseMin(end);
+      hi = hi.cwiseMax(end);
+    }
+  }
+  const Eigen::Vector3d cells = ((hi - lo) / resolution).array().floor() + 1.0;
+  if (cells.prod() > kMaxGridCells) {
+    std::ostringstream os;
+    os << "the clouds and their sensor origins span " << format_point(lo) << " - " << format_point(hi) << ", "
+       << cells.x() << " x " << cells.y() << " x " << cells.z() << " voxels at " << resolution << " m, more than the "
+       << kMaxGridCells << " a map may have; use --range, a coarser --resolution or drop the far points";
+    throw Error(os.str());
+  }
   for (std::size_t s = 0; s < scans.size(); ++s) {
     const CloudScan& scan = scans[s];
     const auto beyond = [&](const Eigen::Vector3d& p) { return !(p.cwiseAbs().maxCoeff() < reach); };  // origins checked above

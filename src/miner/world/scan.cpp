@@ -15,8 +15,7 @@ namespace miner::world {
 namespace {
 
 constexpr double kDegree = M_PI / 180.0;
-/// Most rays one scan may cast (poses x rays per pose): ~10 minutes of OctoMap integration.
-constexpr double kMaxRays = 1e8;
+constexpr double kMaxRays = kMaxScanRays;
 /// Most voxels all rays together may cross (OctoMap integrates ~1e7 per second).
 constexpr double kMaxRaySteps = 2e9;
 

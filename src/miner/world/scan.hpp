@@ -28,6 +28,9 @@
 
 namespace miner::world {
 
+/// Most rays one scan may cast (poses x rays per pose): ~10 minutes of OctoMap integration.
+inline constexpr double kMaxScanRays = 1e8;
+
 struct ScanOptions {
   double range = 8.0;          ///< m
   double h_fov_deg = 360.0;    ///< horizontal field of view, (0, 360]

@@ -86,3 +86,32 @@ TEST_CASE("Problem file errors name the file and the field", "[REQ-TRAJ-007]") {
   CHECK_THROWS_WITH(problem_from_json(doc, "p.json"), Contains("points[1]: expected an array of 3 numbers"));
   CHECK_THROWS_WITH(problem_from_json(miner::Json::array(), "p.json"), Contains("expected a JSON object"));
 }
+
+TEST_CASE("A trajectory answer file is read strictly: junctions meet, the cost is its own, no unknown key",
+          "[REQ-TRAJ-006][REQ-TRAJ-007]") {
+  // Issue 20, fifth campaign: a 0.5 m jump between segments, an unknown key and a wrong cost
+  // were all read and flown.
+  const miner::Json good = answer_to_json(solve_minco(problem_from_json(problem(), "p.json")));
+  const PolynomialTrajectory back = trajectory_from_answer_json(good, "a.json");
+  CHECK(back.segments() == 2);
+  CHECK(back.cost() == Approx(good["cost"].get<double>()).epsilon(1e-12));
+  miner::Json jump = good;
+  jump["coefficients"][1][0][0] = jump["coefficients"][1][0][0].get<double>() + 0.5;  // position x at the junction
+  CHECK_THROWS_WITH(trajectory_from_answer_json(jump, "a.json"),
+                    Contains("a.json: coefficients[1]: the position at the start of segment 1") && Contains("would jump"));
+  miner::Json kink = good;
+  kink["coefficients"][1][1][1] = kink["coefficients"][1][1][1].get<double>() + 0.05;  // velocity y
+  CHECK_THROWS_WITH(trajectory_from_answer_json(kink, "a.json"), Contains("the velocity at the start of segment 1"));
+  miner::Json extra = good;
+  extra["extra"] = 1;
+  CHECK_THROWS_WITH(trajectory_from_answer_json(extra, "a.json"), Contains("a.json: extra: unknown key"));
+  miner::Json junk = good;
+  junk["allocation"] = {{"bogus", 1}};
+  CHECK_THROWS_WITH(trajectory_from_answer_json(junk, "a.json"), Contains("allocation.bogus: unknown key"));
+  miner::Json cost = good;
+  cost["cost"] = -1.0;
+  CHECK_THROWS_WITH(trajectory_from_answer_json(cost, "a.json"), Contains("a.json: cost: is -1.0 but the coefficients' cost"));
+  miner::Json tiny = good;  // below the junction tolerance: the rounding of a written file
+  tiny["coefficients"][1][0][0] = tiny["coefficients"][1][0][0].get<double>() + 1e-9;
+  CHECK_NOTHROW(trajectory_from_answer_json(tiny, "a.json"));
+}

@@ -97,6 +97,19 @@ TEST_CASE("Optimised allocation refuses moving ends, naming why", "[REQ-TRAJ-011
   CHECK_THROWS_WITH(optimise_allocation(rest_to_rest(4, zigzag(), {}), o), Contains("rho: must be positive"));
 }
 
+TEST_CASE("An objective the optimiser cannot evaluate is refused, not answered", "[REQ-TRAJ-011]") {
+  // Issue 20, fifth campaign: rho 1e9 with limits of 1e6 made Ceres fail at its first
+  // evaluation, and an 81 s segment was returned with exit 0.
+  Eigen::MatrixX3d points(3, 3);
+  points << 0, 0, 1, 1, 1, 1, 3, 1, 2;
+  const auto p = rest_to_rest(4, points, {});
+  AllocationOptions o;
+  o.limits = Limits{1e6, 1e6};
+  o.rho = 1e9;
+  CHECK_THROWS_WITH(optimise_allocation(p, o), Contains("allocation: the optimiser could not evaluate") &&
+                                                   Contains("use a smaller rho or tighter limits"));
+}
+
 TEST_CASE("Optimised allocation bounds its work: more segments than it optimises are refused up front", "[REQ-TRAJ-011]") {
   // issue 20: 400 segments ran for more than 5 minutes. The refusal comes before any solve.
   Eigen::MatrixX3d points(miner::traj::kMaxOptimisedSegments + 2, 3);

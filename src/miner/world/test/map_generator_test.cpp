@@ -173,7 +173,7 @@ TEST_CASE("Family overrides: size, resolution and count: bad overrides are refus
   bad = {};
   bad.size = Eigen::Vector3d(1000, 1000, 1000);
   bad.resolution = 0.01;
-  CHECK_THROWS_WITH(generate_map(generator_preset("forest"), 1, bad), Contains("grid cells (at most 5e7)"));
+  CHECK_THROWS_WITH(generate_map(generator_preset("forest"), 1, bad), Contains("grid cells (at most 5e+07)"));
   bad = {};
   bad.obstacles = 3;
   CHECK_THROWS_WITH(generate_map(generator_preset("rooms"), 1, bad), Contains("has no obstacle count to override"));
@@ -191,9 +191,9 @@ TEST_CASE("Family overrides: size, resolution and count: bad overrides are refus
   tiny.size = Eigen::Vector3d(3, 3, 3);
   for (std::uint64_t seed = 1; seed <= 8; ++seed) {
     try {
-      const Map m = generate_map(generator_preset("rooms"), seed, tiny);
-      CHECK(m.in_bounds(m.query()->start));
-      CHECK(m.in_bounds(m.query()->goal));
+      const Map drawn = generate_map(generator_preset("rooms"), seed, tiny);
+      CHECK(drawn.in_bounds(drawn.query()->start));
+      CHECK(drawn.in_bounds(drawn.query()->goal));
     } catch (const miner::NoSolution& e) {
       CHECK_THAT(e.what(), Contains("no solvable map") && Contains("too small a size?"));
     }

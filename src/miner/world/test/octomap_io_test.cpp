@@ -161,6 +161,18 @@ TEST_CASE("A box map survives a round trip through an OctoMap .bt file", "[REQ-W
   CHECK(slurp(again) == slurp(path));
 }
 
+TEST_CASE("A tiny .bt whose two leaves lie far apart is refused by its grid size before any work",
+          "[REQ-WORLD-014][REQ-WORLD-002]") {
+  // Issue 20, fifth campaign: 180 bytes, two leaves 639 voxels apart, 2.6e8 voxels: under the old
+  // 2^28 bound, planning on it took 4.9 GB and over a minute.
+  octomap::OcTree tree(0.1);
+  tree.updateNode(octomap::point3d(0.05f, 0.05f, 0.05f), true);
+  tree.updateNode(octomap::point3d(63.95f, 63.95f, 63.95f), true);
+  const std::string path = miner::world::test::temp_path("far-leaves.bt");
+  tree.writeBinary(path);
+  CHECK_THROWS_WITH(Map::load(path), Contains("far-leaves.bt: the known leaves span 640 x 640 x 640 voxels, more than the 6.71089e+07"));
+}
+
 TEST_CASE("A map whose bounds are off its resolution's lattice is not written as a larger .bt", "[REQ-WORLD-003]") {
   // 4 m at 0.3 m is 13.33 cells: the .bt would cover 4.2 m (issue 20, fourth campaign).
   const std::string path = miner::world::test::temp_path("offlattice.bt");

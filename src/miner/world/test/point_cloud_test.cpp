@@ -179,7 +179,7 @@ TEST_CASE("Binary PCD records with fields of COUNT > 1 read the same points as A
 TEST_CASE("A cloud becomes free space along its rays, occupied at its points, unknown behind", "[REQ-WORLD-018]") {
   PointCloud cloud;
   cloud.points = wall_points();
-  const auto layer = integrate_clouds({{cloud, V(0, 0, 0.5)}}, 0.1, 0.0);
+  const auto layer = integrate_clouds({{cloud, V(0, 0, 0.5), ""}}, 0.1, 0.0);
   const auto state = [&](const V& p) {
     const Eigen::Vector3i c = layer->clamped_cell(p);
     return layer->bounds().contains(p) ? layer->state(layer->index(c.x(), c.y(), c.z())) : VoxelState::kUnknown;
@@ -190,7 +190,7 @@ TEST_CASE("A cloud becomes free space along its rays, occupied at its points, un
   CHECK(state(V(1.5, 0.95, 0.05)) == VoxelState::kUnknown);  // off every ray
   CHECK(state(V(3.5, 0.0, 0.5)) == VoxelState::kUnknown);    // behind the wall
   // A range limit keeps the far points' rays free up to it and drops their hits.
-  const auto short_range = integrate_clouds({{cloud, V(0, 0, 0.5)}}, 0.1, 2.0);
+  const auto short_range = integrate_clouds({{cloud, V(0, 0, 0.5), ""}}, 0.1, 2.0);
   CHECK(short_range->count(VoxelState::kOccupied) == 0);
   CHECK(short_range->count(VoxelState::kFree) > 0);
 }
@@ -296,20 +296,20 @@ TEST_CASE("Malformed point clouds are refused naming the fault, never crash", "[
           "0 0X10 1\n",
           true, "\"0X10\" is not a number");
   CHECK(parse_point_cloud(pcd_head + "POINTS 2\nDATA ascii\n-1.5e-3 +2 1E2\nNaN -inf 1\n", false, "ok.pcd").skipped == 1);
-  CHECK_THROWS_WITH(integrate_clouds({{parse_point_cloud(pcd(wall_points(), false), false, "w.pcd"), V(0, 0, 0.5)}},
+  CHECK_THROWS_WITH(integrate_clouds({{parse_point_cloud(pcd(wall_points(), false), false, "w.pcd"), V(0, 0, 0.5), ""}},
                                      1e300, 0.0),
                     Contains("resolution: 1e+300 m is outside"));
   PointCloud none;
   none.skipped = 3;
-  CHECK_THROWS_WITH(integrate_clouds({{none, V(0, 0, 0)}}, 0.05, 0.0), Contains("no finite point"));
+  CHECK_THROWS_WITH(integrate_clouds({{none, V(0, 0, 0), ""}}, 0.05, 0.0), Contains("no finite point"));
   PointCloud one;
   one.points = {V(1, 0, 0)};
-  CHECK_THROWS_WITH(integrate_clouds({{one, V(1e308, 0, 0)}}, 0.05, 0.0), Contains("cloud 0: the sensor origin"));
+  CHECK_THROWS_WITH(integrate_clouds({{one, V(1e308, 0, 0), ""}}, 0.05, 0.0), Contains("cloud 0: the sensor origin"));
   PointCloud far;
   far.points = {V(1e9, 0, 0)};
-  CHECK_THROWS_WITH(integrate_clouds({{far, V(0, 0, 0)}}, 0.05, 0.0), Contains("would walk"));
+  CHECK_THROWS_WITH(integrate_clouds({{far, V(0, 0, 0), ""}}, 0.05, 0.0), Contains("would walk"));
   far.points = {V(2000, 0, 0)};
-  CHECK_THROWS_WITH(integrate_clouds({{far, V(0, 0, 0)}}, 0.05, 0.0), Contains("beyond OctoMap's key range"));
+  CHECK_THROWS_WITH(integrate_clouds({{far, V(0, 0, 0), ""}}, 0.05, 0.0), Contains("beyond OctoMap's key range"));
   // Random corruption of a valid file: read or refused, nothing else.
   miner::Rng rng(3);
   int refused = 0;

@@ -34,8 +34,9 @@ void require_complete_parts(const std::vector<Json>& tags, const std::vector<std
   for (std::size_t p = 0; p < tags.size(); ++p) {
     const int index = tags[p].at("index").get<int>();
     if (tags[p].at("count").get<int>() != n || index < 0 || index >= n)
-      throw Error(names[p] + ": splits " + job + " differently (part " + std::to_string(index) + " of " +
-                  std::to_string(tags[p].at("count").get<int>()) + ", expected N = " + std::to_string(n) + ")");
+      // Plain words (fifth campaign: "splits dataset merge: the dataset differently").
+      throw Error(names[p] + ": is part " + std::to_string(index) + " of " + std::to_string(tags[p].at("count").get<int>()) +
+                  ", but " + names.front() + " is a part of " + std::to_string(n) + ": the parts come from different splits");
     if (seen[static_cast<std::size_t>(index)])
       throw Error(names[p] + ": part " + std::to_string(index) + "/" + std::to_string(n) + " appears twice");
     seen[static_cast<std::size_t>(index)] = true;

@@ -60,7 +60,9 @@ Config config_from_json(const JsonField& f) {
   try {
     validate(c);
   } catch (const Error& e) {
-    f.fail(e.what());
+    // The field path already says "n3" (fifth campaign: "n3: n3: rate_hz").
+    const std::string what = e.what();
+    f.fail(what.rfind("n3: ", 0) == 0 ? what.substr(4) : what);
   }
   return c;
 }

@@ -51,7 +51,10 @@ TensorFile parse_tensor_file(const std::string& blob, const std::string& path, c
     throw Error(path + ": not a miner-tensors-v1 file (bad magic)");
   std::uint32_t header_bytes = 0;
   for (int i = 3; i >= 0; --i) header_bytes = (header_bytes << 8) | static_cast<std::uint8_t>(blob[8 + static_cast<std::size_t>(i)]);
-  if (header_bytes > kMaxHeaderBytes || 12 + static_cast<std::size_t>(header_bytes) > blob.size())
+  if (header_bytes > kMaxHeaderBytes)
+    throw Error(path + ": the header declares " + std::to_string(header_bytes) + " bytes, more than the " +
+                std::to_string(kMaxHeaderBytes) + " a tensor file's header may have");
+  if (12 + static_cast<std::size_t>(header_bytes) > blob.size())
     throw Error(path + ": truncated (the header runs past the end of the file)");
   TensorFile f;
   f.path = path;

@@ -253,6 +253,16 @@ Map Map::from_json(const Json& doc, const std::string& origin) {
   if (root.has("voxels")) {
     const JsonField jv = root.at("voxels");
     jv.only_keys({"file", "sha256", "unknown"});
+    // An empty name is named as such, and a hash must look like one before it is compared
+    // (fifth campaign: "in/: not a regular file"; an upper-case or short hash called "the file
+    // changed").
+    if (jv.at("file").string().empty()) jv.at("file").fail("is empty: name the voxel file (.bt or .ot)");
+    if (jv.has("sha256")) {
+      const std::string h = jv.at("sha256").string();
+      if (h.size() != 64 || h.find_first_not_of("0123456789abcdef") != std::string::npos)
+        jv.at("sha256").fail("must be 64 lower-case hexadecimal digits (a SHA-256 as `sha256sum` prints it), got \"" +
+                             h + "\"");
+    }
     const std::string file = voxel_file_path(origin, jv.at("file").string());
     const std::string bytes = read_file_bytes(file, "voxel file");
     VoxelSource source{nullptr, UnknownPolicy::kOccupied, file, sha256_hex(bytes)};

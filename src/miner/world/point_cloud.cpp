@@ -118,6 +118,14 @@ double parse_number(const std::string& token, const std::string& origin, std::si
     os << "point " << point << ": \"" << token << "\" is not a number";
     fail(origin, os.str());
   }
+  // A written number beyond the largest double is an error in the file, not a missing return
+  // (those are written nan or inf): refused like the JSON readers do (fifth campaign: "1e400"
+  // was skipped as non-finite).
+  if (std::isinf(v) && token.find_first_of("0123456789") != std::string::npos) {
+    std::ostringstream os;
+    os << "point " << point << ": the number " << token << " is beyond the largest double";
+    fail(origin, os.str());
+  }
   return v;
 }
 

@@ -80,7 +80,12 @@ TEST_CASE("Bad scenarios are refused before flight with the fault named", "[REQ-
   expect_scenario_error(doc, "must divide the N3 loop rate");
   doc = default_doc();
   doc["n3"]["rate_hz"] = 200;
-  expect_scenario_error(doc, "rate_hz must be in [400, 10000]");
+  expect_scenario_error(doc, "n3: rate_hz must be in [400, 10000]");
+  try {  // one "n3:" (fifth campaign: "n3: n3: rate_hz")
+    pipeline::scenario_from_json(doc, "s.json", kScenarios);
+  } catch (const miner::Error& e) {
+    CHECK_THAT(e.what(), !Contains("n3: n3:"));
+  }
   doc = default_doc();
   doc["n3"]["rate_hz"] = 4e9;  // bounded work: refused, not flown for 3e10 ticks
   expect_scenario_error(doc, "rate_hz must be in [400, 10000]");

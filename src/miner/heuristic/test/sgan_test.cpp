@@ -250,6 +250,11 @@ TEST_CASE("A missing, truncated, altered or mismatched weights file is refused n
                                         std::vector<float>(648, 0.1f));
   CHECK_THROWS_WITH(heuristic::Sgan::from_bytes(wrong, "wrong.bin"),
                     Contains("wrong.bin") && Contains("enc1.weight") && Contains("[8, 3, 3, 3, 3]") && Contains("[4, 3, 3, 3, 3]"));
+  // A header length over the bound is named as such, not as a truncated file (fifth campaign).
+  std::string huge = wrong;
+  huge[8] = '\xff', huge[9] = '\xff', huge[10] = '\xff', huge[11] = '\x7f';
+  CHECK_THROWS_WITH(heuristic::parse_tensor_file(huge, "huge.bin", "k"),
+                    Contains("huge.bin: the header declares 2147483647 bytes, more than the"));
   // A tensor that runs past the data, and a count that disagrees with the shape.
   tensors[0]["count"] = 700;
   CHECK_THROWS_WITH(heuristic::parse_tensor_file(tensor_blob({{"kind", "k"}, {"tensors", tensors}}, std::vector<float>(648)),

@@ -226,6 +226,8 @@ TEST_CASE("Malformed point clouds are refused naming the fault, never crash", "[
           "property float z\nend_header\nabc",
           true, "only 3 data bytes follow");
   refuses("ply\nformat ascii 1.0\nelement vertex 999999999999\nend_header\n", true, "exceeds the");
+  refuses("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n"
+          "1e400 0 1\n", true, "point 0: the number 1e400 is beyond the largest double");
   // A second vertex element's points were walked as another element's and dropped (fourth campaign).
   refuses("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
           "element vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 1\n5 5 5\n",

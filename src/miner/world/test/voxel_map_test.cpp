@@ -77,6 +77,10 @@ TEST_CASE("A map file references its voxels by path and SHA-256", "[REQ-WORLD-01
   CHECK_THROWS_WITH(Map::load(write("cloud-ref.json", R"({"format": "miner-map-v1", "voxels": {"file": "cloud.ply",
                                                           "sha256": "0000000000000000000000000000000000000000000000000000000000000000"}})")),
                     Contains("cloud.ply") && !Contains("sha256"));
+  CHECK_THROWS_WITH(Map::load(write("empty-ref.json", R"({"format": "miner-map-v1", "voxels": {"file": ""}})")),
+                    Contains("empty-ref.json: voxels.file: is empty"));
+  CHECK_THROWS_WITH(Map::load(write("upper-ref.json", R"({"format": "miner-map-v1", "voxels": {"file": "small.bt", "sha256": "ABC"}})")),
+                    Contains("upper-ref.json: voxels.sha256: must be 64 lower-case hexadecimal digits"));
   // Formats read elsewhere are named, not reported as malformed JSON.
   std::filesystem::copy_file(dir / "small.bt", dir / "upper.BT", std::filesystem::copy_options::overwrite_existing);
   CHECK_THROWS_WITH(Map::load((dir / "upper.BT").string()), Contains("upper.BT: is an OctoMap file") && Contains("rename it"));

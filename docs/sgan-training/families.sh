@@ -13,6 +13,8 @@
 #   bash docs/sgan-training/families.sh grid16  [cuda]    -> runs-grid16/all, runs-grid16/without-F: the 16^3
 #        network (train.py --pool 2, fixtures/sgan/grid16 at threshold 0.2); one H200, all eight
 #        runs at once, 178 s (session 19)
+#   bash docs/sgan-training/families.sh passability [cuda] -> runs-pass/all, runs-pass/without-F: the shipped
+#        recipe with the network reading channel P (dataset v2; session 24)
 set -euo pipefail
 families=(sim indoor cluttered rooms forest multilevel scan)
 declare -A count=([sim]=2000 [indoor]=1200 [cluttered]=2000 [rooms]=2000 [forest]=2000 [multilevel]=1500 [scan]=700)
@@ -78,5 +80,15 @@ case "${1:-}" in
     # + safety (docs/figures/threshold_sweep.sh with SPLIT=test PREFIX=s16-; docs/heuristic.md):
     set_threshold 0.2 "chosen on held-back 16^3 maps (seed 2000003) by strict connectivity + safety" \
       runs-grid16/all runs-grid16/without-* ;;
-  *) echo "usage: $0 data [miner] | train [cuda] | cube [cuda] | longer [cuda] | grid16 [cuda]" >&2; exit 2 ;;
+  passability)
+    # Session 24: the shipped recipe (all families 16 epochs, leave-one-out 8) on dataset v2,
+    # the network reading channel P (train.py's default --passability-channels 3); the data of
+    # `data` above with the same seeds, so E, S and T are the shipped network's and only P is new.
+    device=${2:-cuda}
+    train_bg runs-pass/all runs-pass-all.log 8 16 "" "${all[@]}"
+    train_bg runs-pass/all-e20 runs-pass-all-e20.log 8 20 "" "${all[@]}"  # session 20's longer recipe
+    lofo_bg runs-pass ""
+    wait ;;
+  *) echo "usage: $0 data [miner] | train [cuda] | cube [cuda] | longer [cuda] | grid16 [cuda] | passability [cuda]" >&2
+     exit 2 ;;
 esac

@@ -78,7 +78,7 @@ HeuristicBenchResult run_heuristic_bench(const HeuristicBenchOptions& o, std::os
     // More samples than the split holds is refused, not measured on fewer without a word
     // (issue 20, fourth campaign).
     if (static_cast<std::size_t>(o.samples) > f.split.size())
-      throw Error("--samples " + std::to_string(o.samples) + ": " + data + ": split '" + o.split + "' has only " +
+      throw Error(o.samples_option + " " + std::to_string(o.samples) + ": " + data + ": split '" + o.split + "' has only " +
                   std::to_string(f.split.size()) + " samples (give at most that many, or 0 for all)");
     if (o.samples > 0) f.split.resize(static_cast<std::size_t>(o.samples));
     const Eigen::Vector3i dims(meta["dims"][0].get<int>(), meta["dims"][1].get<int>(), meta["dims"][2].get<int>());

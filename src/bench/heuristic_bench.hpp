@@ -23,6 +23,8 @@ struct HeuristicBenchOptions {
   std::vector<std::string> data;  ///< `miner dataset` folders (one family each)
   std::string split = "test";
   int samples = 0;              ///< first N samples of the split (0: all)
+  /// The option that set `samples`, named when the split has fewer (bench paper's own name).
+  std::string samples_option = "--samples";
   std::string weights;          ///< empty: the shipped weights
   std::uint64_t seed = 1;       ///< noise of sample k: seed + k; planner stream k
   std::size_t max_iterations = 20000;

@@ -32,7 +32,10 @@ struct PaperBenchOptions {
   /// Heuristic quality: a `miner dataset` folder's test split, or (empty) a test set
   /// generated here from unseen map seeds.
   std::string heuristic_data;
+  /// Unseen maps generated for the heuristic table; with heuristic_data, the first this many of
+  /// its test split when heuristic_samples_given, else all of it.
   int heuristic_samples = 100;
+  bool heuristic_samples_given = false;
   std::size_t heuristic_iterations = 20000;
   /// Tracking: scenario files; empty: the embedded default (indoor-1) and the same
   /// scenario on each map in tracking_maps.

@@ -227,7 +227,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
       ->check(kIterationsRange);
   pc->add_option("--weights", p->bench.weights, "sGAN weights (default: the shipped ones)");
   pc->add_option("--heuristic-data", p->bench.heuristic_data, "a `miner dataset` folder (default: generate unseen maps)");
-  pc->add_option("--heuristic-samples", p->bench.heuristic_samples, "unseen maps for the heuristic table")
+  pc->add_option("--heuristic-samples", p->bench.heuristic_samples, "unseen maps for the heuristic table (with --heuristic-data: its first N test samples; default all)")
       ->capture_default_str()->check(integer_in(1, 100000));
   pc->add_option("--heuristic-iterations", p->bench.heuristic_iterations, "MINER vs RRT* budget per heuristic query")
       ->capture_default_str()->check(kIterationsRange);
@@ -249,6 +249,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
     // fourth campaign: a missing --tracking-maps file beside --scenarios went unread).
     if (pc->get_option("--tracking-maps")->count() > 0 && pc->get_option("--scenarios")->count() > 0)
       throw CLI::ValidationError("--tracking-maps", "maps flown with the default scenario, which --scenarios replaces");
+    p->bench.heuristic_samples_given = pc->get_option("--heuristic-samples")->count() > 0;
     const std::string command = command_line(pc, {"--runs", "--seed", "--time-limit", "--heuristic-samples"});
     namespace fs = std::filesystem;
     const fs::path results(p->results);

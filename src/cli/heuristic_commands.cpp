@@ -147,7 +147,7 @@ void add_heuristic_commands(CLI::App& app, std::ostream& out) {
       return;
     }
     out << "wrote " << o->out << ": " << s["train"]["count"] << " train, " << s["val"]["count"] << " val, "
-        << s["test"]["count"] << " test samples of 3 x " << o->dims[0] << "x" << o->dims[1] << "x" << o->dims[2]
+        << s["test"]["count"] << " test samples of " << heuristic::kDatasetChannels << " x " << o->dims[0] << "x" << o->dims[1] << "x" << o->dims[2]
         << " (dataset.json describes the layout)\n";
   });
 

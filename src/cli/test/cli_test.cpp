@@ -247,6 +247,9 @@ TEST_CASE("Options a run would not read, clamped values and mismatched suffixes 
     "head": [[0,0,1],[0,0,0],[0,0,0]], "tail": [[3,1,2],[0,0,0],[0,0,0]], "limits": {"v_max": 1, "a_max": 1}})");
   const std::string bench_suite = write("suite-4th.json", R"({"format": "miner-bench-suite-v1", "steps": [0.1],
     "maps": [{"name": "a", "preset": "indoor", "seed": 1}, {"name": "b", "preset": "indoor", "seed": 1}]})");
+  const std::string two_tests = dir() + "/two-tests";
+  REQUIRE(miner_cli({"dataset", "--preset", "indoor", "--count", "1", "--test-count", "2", "--quiet", "--out", two_tests})
+              .code == 0);
   struct Case {
     std::vector<std::string> args;
     int code;
@@ -292,6 +295,9 @@ TEST_CASE("Options a run would not read, clamped values and mismatched suffixes 
        "--tracking-maps: maps flown with the default scenario, which --scenarios replaces"},
       {{"bench", "paper", "--maps", write("q4a.json", kQueryMap4) + "," + write("q4b.json", kQueryMap4), "--out", dir() + "/p4.md"}, 1,
        "is the same map as"},
+      // Session 23 review: named bench heuristic's --samples after every other table had run.
+      {{"bench", "paper", "--heuristic-data", two_tests, "--heuristic-samples", "3", "--out", dir() + "/p5.md"}, 1,
+       "--heuristic-samples 3: " + two_tests + ": split 'test' has only 2 samples"},
       // The suffix says what the file holds.
       {{"astar", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5", "--out", dir() + "/a4.bt"}, 2,
        "must end in .json (the result is JSON)"},

@@ -92,8 +92,9 @@ struct DatasetLayout {
 /// that says otherwise is refused (issue 20: a dtype "float32" or reordered channels were read as
 /// uint8 E, S, T without a word).
 Json format_fields() {
-  return {{"channels", {"environment", "state", "target"}},
+  return {{"channels", {"environment", "state", "target", "passability"}},
           {"environment_levels", {{"free", 0}, {"partial", 1}, {"solid", 2}}},
+          {"passability_bits", {{"x", kPassX}, {"y", kPassY}, {"z", kPassZ}}},
           {"dtype", "uint8"},
           {"layout", "sample, channel, z, y, x (x fastest)"},
           {"map_seed_rule", "splitmix64(seed ^ k); train and val: k < count, test: k >= count"}};
@@ -101,14 +102,15 @@ Json format_fields() {
 
 DatasetLayout read_layout(const Json& doc, const std::string& origin) {
   const JsonField root(doc, "", origin);
-  root.only_keys({"format", "preset", "seed", "dims", "bounds", "channels", "environment_levels", "dtype", "layout",
+  root.only_keys({"format", "preset", "seed", "dims", "bounds", "channels", "environment_levels", "passability_bits",
+                  "dtype", "layout",
                   "robot_radius", "dilation", "min_separation", "map_seed_rule", "splits", "part"});
   if (root.at("format").string() != kDatasetFormat)
     root.at("format").fail(std::string("not a dataset folder (expected \"") + kDatasetFormat + "\")");
   DatasetLayout L;
   const Json format = format_fields();
   for (const auto& [key, value] : format.items())
-    if (root.at(key).value() != value) root.at(key).fail("must be " + value.dump() + " (the miner-dataset-v1 format)");
+    if (root.at(key).value() != value) root.at(key).fail("must be " + value.dump() + " (the " + std::string(kDatasetFormat) + " format)");
   // The preset fixes the robot radius and the nominal bounds; a file that says otherwise was
   // edited (issue 20: robot_radius -1 was planned with, a changed preset measured as another).
   const JsonField preset_field = root.at("preset");
@@ -176,10 +178,10 @@ DatasetLayout read_layout(const Json& doc, const std::string& origin) {
 std::string read_shard(const std::string& dir, const ShardRecord& r, std::size_t cells) {
   const std::string path = dir + "/" + r.file;
   std::string bytes = read_file_bytes(path, "dataset shard");
-  const std::size_t expected = r.count * 3 * cells;
+  const std::size_t expected = r.count * kDatasetChannels * cells;
   if (bytes.size() != expected)
     throw Error(path + ": expected " + std::to_string(expected) + " bytes (" + std::to_string(r.count) +
-                " samples of 3 x " + std::to_string(cells) + "), found " + std::to_string(bytes.size()));
+                " samples of " + std::to_string(kDatasetChannels) + " x " + std::to_string(cells) + "), found " + std::to_string(bytes.size()));
   if (sha256_hex(bytes) != r.sha256)
     throw Error(path + ": its SHA-256 differs from the one dataset.json records (the file was changed)");
   return bytes;
@@ -246,11 +248,11 @@ void validate(const DatasetOptions& o) {
   // Bounded output, refused before any sample is drawn (issue 20: 10^7 samples of 256^3 cells
   // asked for 5e14 bytes and ran until killed). 2^38 bytes = 256 GiB.
   constexpr double kMaxDatasetBytes = 274877906944.0;
-  const double bytes = (static_cast<double>(o.count) + static_cast<double>(o.test_count)) * 3.0 *
+  const double bytes = (static_cast<double>(o.count) + static_cast<double>(o.test_count)) * kDatasetChannels *
                        static_cast<double>(o.dims.x()) * o.dims.y() * o.dims.z();
   if (bytes > kMaxDatasetBytes) {
     std::ostringstream os;
-    os << "dataset: --count + --test-count samples of 3 x " << o.dims.x() << " x " << o.dims.y() << " x " << o.dims.z()
+    os << "dataset: --count + --test-count samples of " << kDatasetChannels << " x " << o.dims.x() << " x " << o.dims.y() << " x " << o.dims.z()
        << " cells are " << bytes << " bytes, more than the " << kMaxDatasetBytes << " (256 GiB) a dataset may have";
     throw Error(os.str());
   }
@@ -290,7 +292,9 @@ Sample make_sample(const DatasetOptions& o, std::uint64_t k) {
   }
   s.astar_cost = path->cost;
   s.bounds = b;
-  s.environment = encode_environment(map, o.dims, r);
+  Encoding encoded = encode_environment_passability(map, o.dims, r);
+  s.environment = std::move(encoded.environment);
+  s.passability = std::move(encoded.passability);
   s.state = encode_state(b, o.dims, s.start, s.goal, o.dilation);
   // T = the cells the A* path passes through, and of the cells the dilation adds only the
   // free ones (no obstacle grown by the robot radius meets them). The path's own cells keep T
@@ -362,7 +366,7 @@ Json write_dataset(const DatasetOptions& o, const std::string& dir, std::ostream
       if (failure) std::rethrow_exception(failure);
       for (int i = 0; i < n; ++i) {
         const Sample& s = batch[static_cast<std::size_t>(i)];
-        for (const auto* channel : {&s.environment, &s.state, &s.target})
+        for (const auto* channel : {&s.environment, &s.state, &s.target, &s.passability})
           shard.append(reinterpret_cast<const char*>(channel->data()), cells);
         index.push_back({{"k", first[sp] + static_cast<std::uint64_t>(i0 + i)}, {"map_seed", s.map_seed},
                          {"bounds", {{"min", vec3_json(s.bounds.min)}, {"max", vec3_json(s.bounds.max)}}},
@@ -491,10 +495,11 @@ std::vector<Sample> read_split(const std::string& dir, const std::string& split)
       sample.goal = f.at("goal").vec3();
       sample.astar_cost = f.at("astar_cost").number();
       sample.bounds = index_bounds(f.at("bounds"));
-      const auto* base = reinterpret_cast<const std::uint8_t*>(bytes.data()) + s * 3 * L.cells;
+      const auto* base = reinterpret_cast<const std::uint8_t*>(bytes.data()) + s * kDatasetChannels * L.cells;
       sample.environment.assign(base, base + L.cells);
       sample.state.assign(base + L.cells, base + 2 * L.cells);
       sample.target.assign(base + 2 * L.cells, base + 3 * L.cells);
+      sample.passability.assign(base + 3 * L.cells, base + 4 * L.cells);
       out.push_back(std::move(sample));
     }
   }

@@ -2,22 +2,24 @@
 /// \file
 /// The sGAN's training data (paper Sec. V-A.1; REQ-HEUR-001..003): random cluttered maps
 /// with a random start and goal, the A* path as ground truth, encoded on a fixed heuristic
-/// grid over the map bounds as three channels of 0/1 bytes:
+/// grid over the map bounds as four channels of bytes:
 ///   E (environment)  0 free, 1 partially occupied, 2 solid (grid.hpp: the cell against the
 ///                    obstacles grown by the robot radius);
 ///   S (state)        1 in the 3x3x3 cubes of cells around the start and the goal cells;
 ///   T (target)       1 in the cells the A* path passes through, dilated to 3x3x3 cubes
 ///                    (HeuristicRegion::from_path, the same region `miner region astar`
-///                    writes and the MINER planner samples), less its solid cells.
+///                    writes and the MINER planner samples), less its solid cells;
+///   P (passability)  bits 1 x, 2 y, 4 z: the cell's free space joins its two faces across
+///                    that axis (grid.hpp; a door and a wall, both partial in E, differ here).
 /// Grid: 32^3 by default. A 100 m sim map gives 3.1 x 3.1 x 1.25 m cells, about a quarter
 /// of the preset's smallest obstacle side (4 m) horizontally, so obstacles survive the
 /// encoding while a 3D convolution over 32^3 stays within the 5 ms CPU budget of the
 /// issue (~0.45 GFLOP per 16->16 channel layer, ../shared/anchors.md).
 ///
-/// Layout on disk (`miner-dataset-v1`): DIR/dataset.json describes everything; each split
+/// Layout on disk (`miner-dataset-v2`; v1 had no P): DIR/dataset.json describes everything; each split
 /// (train, val, test) is a series of shards `<split>-NNNNN.bin`, each the raw bytes of
-/// uint8[n][3][nz][ny][nx] (channel order E, S, T; x fastest), readable with
-/// numpy.fromfile(..., dtype=uint8).reshape(n, 3, nz, ny, nx); DIR/<split>-index.json
+/// uint8[n][4][nz][ny][nx] (channel order E, S, T, P; x fastest), readable with
+/// numpy.fromfile(..., dtype=uint8).reshape(n, 4, nz, ny, nx); DIR/<split>-index.json
 /// lists each sample's map seed, map bounds, start, goal and A* cost.
 ///
 /// Seeds: sample k (0 <= k < count + test_count) uses map seed splitmix64(seed ^ k), a
@@ -39,7 +41,8 @@
 
 namespace miner::heuristic {
 
-inline constexpr const char* kDatasetFormat = "miner-dataset-v1";
+inline constexpr const char* kDatasetFormat = "miner-dataset-v2";
+inline constexpr std::size_t kDatasetChannels = 4;  ///< E, S, T, P
 
 struct DatasetOptions {
   std::string preset = "sim";
@@ -72,7 +75,7 @@ struct Sample {
   /// The map's bounds: the grid covers them, so a cell is (max - min) / dims (the families
   /// draw their extents per map; the sGAN's scale input, sgan.hpp, is computed from them).
   world::Box bounds{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
-  std::vector<std::uint8_t> environment, state, target;  ///< each dims.prod(), x fastest
+  std::vector<std::uint8_t> environment, state, target, passability;  ///< each dims.prod(), x fastest
 };
 
 /// Sample k of the dataset: the preset's map for seed splitmix64(seed ^ k) with a random

@@ -113,7 +113,54 @@ void encode_voxels(const world::Map& map, const Eigen::Vector3i& dims, double ra
 
 }  // namespace
 
-std::vector<std::uint8_t> encode_environment(const world::Map& map, const Eigen::Vector3i& dims, double radius) {
+namespace {
+
+/// The sub-cells (bit x + 4 y + 16 z of kPassabilitySubcells^3) whose centres lie in the closed
+/// box g, for the cell `cell`.
+std::uint64_t subcells_inside(const world::Box& cell, const world::Box& g) {
+  constexpr int n = kPassabilitySubcells;
+  int lo[3], hi[3];
+  for (int a = 0; a < 3; ++a) {
+    const double h = cell.extent()[a] / n;
+    lo[a] = std::max(0, static_cast<int>(std::ceil((g.min[a] - cell.min[a]) / h - 0.5)));
+    hi[a] = std::min(n - 1, static_cast<int>(std::floor((g.max[a] - cell.min[a]) / h - 0.5)));
+    if (lo[a] > hi[a]) return 0;
+  }
+  const std::uint64_t row = ((std::uint64_t{1} << (hi[0] - lo[0] + 1)) - 1) << lo[0];
+  std::uint64_t plane = 0, volume = 0;
+  for (int y = lo[1]; y <= hi[1]; ++y) plane |= row << (n * y);
+  for (int z = lo[2]; z <= hi[2]; ++z) volume |= plane << (n * n * z);
+  return volume;
+}
+
+/// The sub-cells of `cell` whose centres lie in a grown-blocked voxel (the voxel holding the
+/// centre; centres off the layer are not blocked by it).
+std::uint64_t subcells_in_grown_voxels(const world::VoxelObstacles& voxels, double radius, const world::Box& cell) {
+  constexpr int n = kPassabilitySubcells;
+  const world::VoxelLayer& layer = voxels.layer();
+  const float limit = static_cast<float>(radius / layer.resolution());
+  const Eigen::Vector3d h = cell.extent() / n;
+  int coord[3][n];
+  for (int a = 0; a < 3; ++a)
+    for (int s = 0; s < n; ++s) {
+      const double centre = cell.min[a] + (s + 0.5) * h[a];
+      const int v = static_cast<int>(std::floor(centre / layer.resolution())) - layer.origin_cells()[a];
+      coord[a][s] = v >= 0 && v < layer.dims()[a] ? v : -1;
+    }
+  std::uint64_t blocked = 0;
+  for (int z = 0; z < n; ++z)
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < n; ++x) {
+        if (coord[0][x] < 0 || coord[1][y] < 0 || coord[2][z] < 0) continue;
+        if (voxels.centre_distance(layer.index(coord[0][x], coord[1][y], coord[2][z])) <= limit)
+          blocked |= std::uint64_t{1} << (x + n * (y + n * z));
+      }
+  return blocked;
+}
+
+/// E, and P when `passability` is given (see grid.hpp).
+std::vector<std::uint8_t> encode(const world::Map& map, const Eigen::Vector3i& dims, double radius,
+                                 std::vector<std::uint8_t>* passability) {
   const world::Box& b = map.bounds();
   const Eigen::Vector3d c = cell_size(b, dims);
   const auto cells = static_cast<std::size_t>(dims.prod());
@@ -147,6 +194,8 @@ std::vector<std::uint8_t> encode_environment(const world::Map& map, const Eigen:
   for (std::size_t o = 0; o < grown.size(); ++o)
     for_each_cell(o, [&](std::size_t idx) { touching[fill[idx]++] = static_cast<std::uint32_t>(o); });
 
+  // Blocked sub-cells of each partial cell, for P (only when asked for).
+  std::vector<std::uint64_t> blocked(passability ? cells : 0, 0);
   std::vector<world::Box> local;
   for (std::size_t idx = 0; idx < cells; ++idx) {
     if (offset[idx] == offset[idx + 1]) continue;
@@ -169,9 +218,60 @@ std::vector<std::uint8_t> encode_environment(const world::Map& map, const Eigen:
     constexpr double kVolumeRounding = 1e-9;
     const bool could_fill = clipped_volume >= cell.extent().prod() * (1.0 - kVolumeRounding);
     if (inside_one || (local.size() > 1 && could_fill && box_covered(cell, local))) e[idx] = kSolid;
+    if (passability && e[idx] == kPartial)
+      for (const world::Box& g : local) blocked[idx] |= subcells_inside(cell, g);
   }
   if (map.voxels()) encode_voxels(map, dims, radius, e);
+  if (passability) {
+    passability->assign(cells, 0);
+    for (std::size_t idx = 0; idx < cells; ++idx) {
+      if (e[idx] == kFree) {
+        (*passability)[idx] = kPassAll;
+      } else if (e[idx] == kPartial) {
+        if (map.voxels())
+          blocked[idx] |= subcells_in_grown_voxels(*map.voxels(), radius, cell_box(b, dims, cell_coords(dims, idx)));
+        (*passability)[idx] = passability_of(~blocked[idx]);
+      }
+    }
+  }
   return e;
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> encode_environment(const world::Map& map, const Eigen::Vector3i& dims, double radius) {
+  return encode(map, dims, radius, nullptr);
+}
+
+Encoding encode_environment_passability(const world::Map& map, const Eigen::Vector3i& dims, double radius) {
+  Encoding out;
+  out.environment = encode(map, dims, radius, &out.passability);
+  return out;
+}
+
+std::uint8_t passability_of(std::uint64_t free_subcells) {
+  static_assert(kPassabilitySubcells == 4, "the masks below are for 4^3 sub-cells in one 64-bit word");
+  // Bits of the sub-cells with x = 0, y = 0, z = 0 (bit x + 4 y + 16 z); the high faces are
+  // these shifted by 3 steps along their axis.
+  constexpr std::uint64_t kX0 = 0x1111111111111111ULL, kY0 = 0x000F000F000F000FULL, kZ0 = 0xFFFFULL;
+  constexpr std::uint64_t kLow[3] = {kX0, kY0, kZ0};
+  constexpr std::uint64_t kHigh[3] = {kX0 << 3, kY0 << 12, kZ0 << 48};
+  std::uint8_t bits = 0;
+  for (int a = 0; a < 3; ++a) {
+    // Flood from the low face through face-adjacent free sub-cells (a shift by 1, 4 or 16 bits,
+    // masked so that a step off one side of a row or plane does not wrap onto the next).
+    std::uint64_t reached = free_subcells & kLow[a];
+    while (true) {
+      const std::uint64_t grown = reached | ((reached << 1) & ~kX0) | ((reached >> 1) & ~(kX0 << 3)) |
+                                  ((reached << 4) & ~kY0) | ((reached >> 4) & ~(kY0 << 12)) | (reached << 16) |
+                                  (reached >> 16);
+      const std::uint64_t next = grown & free_subcells;
+      if (next == reached) break;
+      reached = next;
+    }
+    if (reached & kHigh[a]) bits |= static_cast<std::uint8_t>(1u << a);
+  }
+  return bits;
 }
 
 std::vector<std::uint8_t> encode_state(const world::Box& b, const Eigen::Vector3i& dims, const Eigen::Vector3d& start,

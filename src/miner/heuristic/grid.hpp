@@ -55,6 +55,28 @@ bool box_covered(const world::Box& cell, const std::vector<world::Box>& boxes);
 /// partial, solid when all the voxel centres it holds are and the layer covers it.
 std::vector<std::uint8_t> encode_environment(const world::Map& map, const Eigen::Vector3i& dims, double radius);
 
+/// Channel P bits (issue 16: a door and a wall are both kPartial in E; P tells them apart).
+enum PassabilityBit : std::uint8_t { kPassX = 1, kPassY = 2, kPassZ = 4, kPassAll = 7 };
+/// Sub-cells per axis on which P is decided (4^3 = 64: one bit mask of a 64-bit word per cell).
+inline constexpr int kPassabilitySubcells = 4;
+
+/// Channels E and P of one map, from one pass over its obstacles (the same E as
+/// encode_environment). P, per cell: bit a (kPassX, kPassY, kPassZ) set when the cell's free
+/// space joins its two faces across axis a. Decided on kPassabilitySubcells^3 sub-cells: a
+/// sub-cell is blocked when its centre lies in a grown box or in a grown-blocked voxel (the
+/// voxel holding it); the face-adjacent free sub-cells of the low face a are flooded through
+/// face-adjacent free sub-cells, and the bit is set when the flood reaches the high face. kFree
+/// cells are kPassAll and kSolid cells 0 without the flood. A thin wall crossing a cell (its
+/// grown slab wider than a sub-cell) clears the bit of the axis it crosses; a door through it
+/// (its free gap wider than a sub-cell) keeps it.
+struct Encoding {
+  std::vector<std::uint8_t> environment, passability;  ///< each dims.prod(), x fastest
+};
+Encoding encode_environment_passability(const world::Map& map, const Eigen::Vector3i& dims, double radius);
+
+/// The kPassabilitySubcells^3 free-sub-cell mask (bit x + 4 y + 16 z) -> its P bits.
+std::uint8_t passability_of(std::uint64_t free_subcells);
+
 /// Channel S: the (2 dilation + 1)^3 cubes around the cells of start and goal.
 std::vector<std::uint8_t> encode_state(const world::Box& bounds, const Eigen::Vector3i& dims,
                                        const Eigen::Vector3d& start, const Eigen::Vector3d& goal, int dilation);

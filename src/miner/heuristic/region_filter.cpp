@@ -137,13 +137,19 @@ HeuristicQuery query_region(const Sgan& sgan, const world::Map& map, const Eigen
   const world::Box& b = map.bounds();
   const Eigen::Vector3i dims = arch.dims;
   auto t0 = std::chrono::steady_clock::now();
-  std::vector<std::uint8_t> env = encode_environment(map, dims, robot_radius);
+  // P only for a network that reads it (the encoding costs a flood per partial cell).
+  Encoding encoded;
+  if (arch.passability_channels != 0)
+    encoded = encode_environment_passability(map, dims, robot_radius);
+  else
+    encoded.environment = encode_environment(map, dims, robot_radius);
+  std::vector<std::uint8_t>& env = encoded.environment;
   // The network was trained with the dataset's 3x3x3 state cubes (dilation 1).
   const std::vector<std::uint8_t> state = encode_state(b, dims, start, goal, 1);
   const double encode_ms = elapsed_ms(t0);
   t0 = std::chrono::steady_clock::now();
   Rng rng(seed, kNoiseStream);
-  std::vector<float> prob = sgan.predict(env, state, b, robot_radius, rng);
+  std::vector<float> prob = sgan.predict(env, state, encoded.passability, b, robot_radius, rng);
   const double inference_ms = elapsed_ms(t0);
   t0 = std::chrono::steady_clock::now();
   FilteredRegion f = filter_region(prob, env, dims, cell_of(b, dims, start), cell_of(b, dims, goal), arch.threshold);

@@ -264,10 +264,10 @@ struct Sgan::Impl {
   /// Starts a query's input (the sparse list is rebuilt by set_input).
   void begin_input() { sparse.clear(); }
 
-  /// Voxel (x, y, z), index v, of the input: E/2 = e, S = s, N = noise; cond1 = (E/2, S) and,
-  /// with the own kernels, N on the padded grid and (e, s) in the sparse list when nonzero;
-  /// else x0 = (E/2, S, N) channels-last.
-  void set_input(int x, int y, int z, std::size_t v, float e, float s, float noise) {
+  /// Voxel (x, y, z), index v, of the input: E/2 = e, S = s, N = noise, P bits pass[0..2] (when
+  /// the network reads P); cond1 = (E/2, S[, P]) and, with the own kernels (never with P), N on
+  /// the padded grid and (e, s) in the sparse list when nonzero; else x0 = (cond1, N) channels-last.
+  void set_input(int x, int y, int z, std::size_t v, float e, float s, float noise, const float* pass = nullptr) {
     if (own_kernels) {
       const Eigen::Vector3i d = cond1.dims;
       const int padded = ((z + 1) * (d.y() + 2) + y + 1) * (d.x() + 2) + x + 1;
@@ -276,12 +276,16 @@ struct Sgan::Impl {
       state_padded[static_cast<std::size_t>(padded)] = s;
       if (e != 0.0f || s != 0.0f) sparse.push_back({padded, e, s});
     } else {
-      x0.data[3 * v] = e;
-      x0.data[3 * v + 1] = s;
-      x0.data[3 * v + 2] = noise;
+      const auto c = static_cast<std::size_t>(x0.channels);
+      x0.data[c * v] = e;
+      x0.data[c * v + 1] = s;
+      for (int a = 0; a < arch.passability_channels; ++a) x0.data[c * v + 2 + static_cast<std::size_t>(a)] = pass[a];
+      x0.data[c * v + c - 1] = noise;
     }
-    cond1.data[2 * v] = e;
-    cond1.data[2 * v + 1] = s;
+    const auto c = static_cast<std::size_t>(cond1.channels);
+    cond1.data[c * v] = e;
+    cond1.data[c * v + 1] = s;
+    for (int a = 0; a < arch.passability_channels; ++a) cond1.data[c * v + 2 + static_cast<std::size_t>(a)] = pass[a];
   }
 
   /// Calls f(x, y, z, v) for every voxel in index order (x fastest).
@@ -336,7 +340,8 @@ void Sgan::Impl::build(const TensorFile& f, Sgan::Kernels which) {
   for (const char* key : {"final", "training"})
     if (a.has(key) && !a.at(key).value().is_object()) a.at(key).fail("must be an object (the training record)");
   const JsonField ar = a.at("architecture");
-  ar.only_keys({"name", "width", "dims", "environment_scale", "threshold", "layers", "scale_channels", "scale_divisor"});
+  ar.only_keys({"name", "width", "dims", "environment_scale", "threshold", "layers", "scale_channels", "scale_divisor",
+                "passability_channels"});
   if (ar.at("name").string() != "sgan-unet4") ar.at("name").fail("unknown architecture (expected sgan-unet4)");
   if (ar.has("layers")) {  // optional (the tensors name the layers); when given it must be right
     const std::vector<std::string> expected{"enc1", "enc2", "enc3", "enc4", "mid1", "mid2", "dec3", "dec2", "dec1"};
@@ -368,10 +373,17 @@ void Sgan::Impl::build(const TensorFile& f, Sgan::Kernels which) {
   } else if (ar.has("scale_divisor")) {
     ar.at("scale_divisor").fail("is given without scale_channels");
   }
+  // Absent in the files written before channel P (dataset v1).
+  arch.passability_channels = ar.has("passability_channels") ? ar.at("passability_channels").integer() : 0;
+  if (arch.passability_channels != 0 && arch.passability_channels != 3)
+    ar.at("passability_channels").fail("must be 0 or 3 (x, y, z)");
 
   const int w = arch.width;
   const Eigen::Vector3i n1 = arch.dims, n2 = n1 / 2, n4 = n1 / 4, n8 = n1 / 8;
-  own_kernels = which == Sgan::Kernels::kFastest && w == kernels::kWidth;
+  // The condition channels c_k: E/2, S and P's three bits when the network reads them.
+  const int nc = 2 + arch.passability_channels;
+  // MINER's own first-layer kernel takes exactly (E/2, S, N): networks reading P run oneDNN's.
+  own_kernels = which == Sgan::Kernels::kFastest && w == kernels::kWidth && arch.passability_channels == 0;
   const Eigen::Vector3i padded = n1 + Eigen::Vector3i::Constant(2);
   if (own_kernels) {
     noise_padded.assign(static_cast<std::size_t>(padded.prod()), 0.0f);
@@ -379,24 +391,24 @@ void Sgan::Impl::build(const TensorFile& f, Sgan::Kernels which) {
     environment_padded.assign(static_cast<std::size_t>(padded.prod()), 0.0f);
     state_padded.assign(static_cast<std::size_t>(padded.prod()), 0.0f);
   }
-  x0 = Activation(3, own_kernels ? Eigen::Vector3i(0, 0, 0) : n1);  // oneDNN's enc1 input only
-  cond1 = Activation(2, n1);
+  x0 = Activation(nc + 1, own_kernels ? Eigen::Vector3i(0, 0, 0) : n1);  // oneDNN's enc1 input only
+  cond1 = Activation(nc, n1);
   a1 = Activation(w, n1);
-  c2 = Activation(2, n2);
+  c2 = Activation(nc, n2);
   a2 = Activation(2 * w, n2);
-  cat2 = Activation(2 * w + 2, n2);
-  c4 = Activation(2, n4);
+  cat2 = Activation(2 * w + nc, n2);
+  c4 = Activation(nc, n4);
   a3 = Activation(4 * w, n4);
-  cat3 = Activation(4 * w + 2, n4);
-  c8 = Activation(2, n8);
+  cat3 = Activation(4 * w + nc, n4);
+  c8 = Activation(nc, n8);
   a4 = Activation(4 * w, n8);
   sigma = Activation(arch.scale_channels, n8);
-  cat4 = Activation(4 * w + 2 + arch.scale_channels, n8);
+  cat4 = Activation(4 * w + nc + arch.scale_channels, n8);
   m1 = Activation(4 * w, n8);
   m2 = Activation(4 * w, n8);
   d3 = Activation(2 * w, n4);
   d2 = Activation(2 * w, n2);
-  catd1 = Activation(w + 2, Eigen::Vector3i(n1.x(), n1.y(), 1));
+  catd1 = Activation(w + nc, Eigen::Vector3i(n1.x(), n1.y(), 1));
   out = Activation(1, n1);
   io = {{{&x0, &a1}, {&a1, &a2}, {&cat2, &a3}, {&cat3, &a4}, {&cat4, &m1}, {&m1, &m2}, {&cat3, &d3},
          {&cat2, &d2}, {&catd1, &out}}};
@@ -586,14 +598,23 @@ const std::string& Sgan::path() const { return impl_->path; }
 bool Sgan::own_kernels() const { return impl_->own_kernels; }
 
 std::vector<float> Sgan::forward(const std::vector<float>& env, const std::vector<float>& state,
-                                 const std::vector<float>& noise, const std::vector<float>& scale) const {
+                                 const std::vector<float>& noise, const std::vector<float>& scale,
+                                 const std::vector<float>& passability) const {
   Impl& g = *impl_;
   const std::size_t n = g.cond1.voxels();
   if (env.size() != n || state.size() != n || noise.size() != n)
     throw Error("sgan: inputs must have " + std::to_string(n) + " cells each (the weights' grid)");
+  const auto pc = static_cast<std::size_t>(g.arch.passability_channels);
+  if (pc != 0 && passability.size() != pc * n)
+    throw Error("sgan: the network reads P: " + std::to_string(pc) + " x " + std::to_string(n) + " values, given " +
+                std::to_string(passability.size()));
   g.set_scale(scale);
   g.begin_input();
-  g.for_voxels([&](int x, int y, int z, std::size_t v) { g.set_input(x, y, z, v, env[v], state[v], noise[v]); });
+  g.for_voxels([&](int x, int y, int z, std::size_t v) {
+    float p[3] = {0.0F, 0.0F, 0.0F};
+    for (std::size_t a = 0; a < pc; ++a) p[a] = passability[a * n + v];
+    g.set_input(x, y, z, v, env[v], state[v], noise[v], p);
+  });
   return g.run();
 }
 
@@ -679,17 +700,23 @@ std::vector<float> Sgan::Impl::run() {
 }
 
 std::vector<float> Sgan::predict(const std::vector<std::uint8_t>& environment, const std::vector<std::uint8_t>& state,
-                                 const world::Box& bounds, double robot_radius, Rng& rng) const {
+                                 const std::vector<std::uint8_t>& passability, const world::Box& bounds,
+                                 double robot_radius, Rng& rng) const {
   Impl& g = *impl_;
   const std::size_t n = g.cond1.voxels();
   if (environment.size() != n || state.size() != n)
     throw Error("sgan: E and S must have " + std::to_string(n) + " cells each (the weights' grid)");
+  const int pc = g.arch.passability_channels;
+  if (pc != 0 && passability.size() != n)
+    throw Error("sgan: the network reads P: " + std::to_string(n) + " cells, given " + std::to_string(passability.size()));
   if (g.arch.scale_channels != 0) g.set_scale(scale_input(bounds, g.arch.dims, robot_radius, g.arch.scale_divisor));
   const auto scale = static_cast<float>(g.arch.environment_scale);
   g.begin_input();
   g.for_voxels([&](int x, int y, int z, std::size_t v) {
+    float p[3] = {0.0F, 0.0F, 0.0F};
+    for (int a = 0; a < pc; ++a) p[a] = static_cast<float>((passability[v] >> a) & 1U);
     g.set_input(x, y, z, v, scale * static_cast<float>(environment[v]), static_cast<float>(state[v]),
-                static_cast<float>(rng.normal_ziggurat()));
+                static_cast<float>(rng.normal_ziggurat()), p);
   });
   std::vector<float> r = g.run();
   // A probability outside [0, 1] or not a number means weights the network cannot carry (e.g.
@@ -712,9 +739,11 @@ std::vector<double> reference_errors(const Sgan& sgan, const std::string& refere
   for (int k = 0; k < samples.integer(); ++k) {
     const std::string p = std::to_string(k) + ".";
     const int sc = sgan.architecture().scale_channels;
+    const int pc = sgan.architecture().passability_channels;
     const auto out = sgan.forward(ref.at(p + "environment", shape).values, ref.at(p + "state", shape).values,
                                   ref.at(p + "noise", shape).values,
-                                  sc ? ref.at(p + "scale", {sc}).values : std::vector<float>{});
+                                  sc ? ref.at(p + "scale", {sc}).values : std::vector<float>{},
+                                  pc ? ref.at(p + "passability", {pc, d.z(), d.y(), d.x()}).values : std::vector<float>{});
     const auto& want = ref.at(p + "output", shape).values;
     double worst = 0.0;
     for (std::size_t i = 0; i < out.size(); ++i) {

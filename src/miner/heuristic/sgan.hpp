@@ -45,6 +45,9 @@ struct SganArchitecture {
   Eigen::Vector3i dims = plan::HeuristicRegion::default_dims();  ///< nx, ny, nz; each divisible by 8
   double environment_scale = 0.5;   ///< E levels 0/1/2 enter the network as E * scale
   double threshold = 0.5;           ///< cell in the raw region iff R >= threshold
+  /// 3 when the network reads channel P (grid.hpp: whether each cell's free space joins its
+  /// faces across x, y, z) beside E and S in every condition c_k; 0 for the networks before it.
+  int passability_channels = 0;
 };
 
 class Sgan {
@@ -79,14 +82,19 @@ class Sgan {
   /// R = G(N | E, S) on the grid: three inputs of dims.prod() floats (x fastest) — the
   /// One query at a time per object (the buffers are reused). Inputs: the
   /// environment already scaled, the state, the noise — and dims.prod() probabilities out.
-  /// `scale` is sigma (ignored, and may be empty, when the network has no scale channels).
+  /// `scale` is sigma (ignored, and may be empty, when the network has no scale channels);
+  /// `passability` the P bits x, y, z as 0/1, channel after channel (3 x dims.prod(); ignored,
+  /// and may be empty, when the network has no passability channels).
   std::vector<float> forward(const std::vector<float>& environment_scaled, const std::vector<float>& state,
-                             const std::vector<float>& noise, const std::vector<float>& scale = {}) const;
+                             const std::vector<float>& noise, const std::vector<float>& scale = {},
+                             const std::vector<float>& passability = {}) const;
 
-  /// The same from the dataset encoding (E levels 0/1/2, S 0/1) of a grid over `bounds` for
-  /// a robot of `robot_radius` (which give sigma), with N(0, 1) noise drawn from `rng`.
+  /// The same from the dataset encoding (E levels 0/1/2, S 0/1, P bits; grid.hpp) of a grid over
+  /// `bounds` for a robot of `robot_radius` (which give sigma), with N(0, 1) noise drawn from
+  /// `rng`. `passability` may be empty when the network has no passability channels.
   std::vector<float> predict(const std::vector<std::uint8_t>& environment, const std::vector<std::uint8_t>& state,
-                             const world::Box& bounds, double robot_radius, Rng& rng) const;
+                             const std::vector<std::uint8_t>& passability, const world::Box& bounds,
+                             double robot_radius, Rng& rng) const;
 
  private:
   struct Impl;

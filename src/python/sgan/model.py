@@ -5,7 +5,8 @@ conditional discriminators, one judging R against S (connectivity) and one again
 
 Generator (width w, grid n^3 with n divisible by 8; "encoded at several scales", the
 conditions c_k = maxpool_k([E/2, S]) enter at every scale; the 1/8 level sees the whole
-grid, so every cell knows where both start and goal are):
+grid, so every cell knows where both start and goal are; with passability_channels = 3 the
+conditions are [E/2, S, Px, Py, Pz], the P bits of the dataset, wherever [E/2, S] stands below):
     x   = [E/2, S, N]                                   3 x n^3
     a1  = relu(conv3(x))                                w  x n^3
     a2  = relu(conv3_stride2(a1))                       2w x (n/2)^3
@@ -38,16 +39,17 @@ import torch.nn.functional as F
 # The generator's layers in graph order, with their input/output widths as functions of w.
 # The weights file lists them in this order (export.py) and C++ checks the shapes.
 # (w, s): width and scale channels.
+# (w, s, p): width, scale channels and passability channels; c = 2 + p condition channels.
 GENERATOR_LAYERS = [
-    ("enc1", lambda w, s: (3, w), 1),
-    ("enc2", lambda w, s: (w, 2 * w), 2),
-    ("enc3", lambda w, s: (2 * w + 2, 4 * w), 2),
-    ("enc4", lambda w, s: (4 * w + 2, 4 * w), 2),
-    ("mid1", lambda w, s: (4 * w + 2 + s, 4 * w), 1),
-    ("mid2", lambda w, s: (4 * w, 4 * w), 1),
-    ("dec3", lambda w, s: (4 * w + 4 * w + 2, 2 * w), 1),
-    ("dec2", lambda w, s: (2 * w + 2 * w + 2, 2 * w), 1),
-    ("dec1", lambda w, s: (2 * w + w + 2, 1), 1),
+    ("enc1", lambda w, s, p: (2 + p + 1, w), 1),
+    ("enc2", lambda w, s, p: (w, 2 * w), 2),
+    ("enc3", lambda w, s, p: (2 * w + 2 + p, 4 * w), 2),
+    ("enc4", lambda w, s, p: (4 * w + 2 + p, 4 * w), 2),
+    ("mid1", lambda w, s, p: (4 * w + 2 + p + s, 4 * w), 1),
+    ("mid2", lambda w, s, p: (4 * w, 4 * w), 1),
+    ("dec3", lambda w, s, p: (4 * w + 4 * w + 2 + p, 2 * w), 1),
+    ("dec2", lambda w, s, p: (2 * w + 2 * w + 2 + p, 2 * w), 1),
+    ("dec1", lambda w, s, p: (2 * w + w + 2 + p, 1), 1),
 ]
 
 # sigma = log2(cell / robot radius) / SCALE_DIVISOR: cells of 1/16 to 16 robot radii (a 0.1 m
@@ -68,22 +70,23 @@ def scale_input(lo, hi, dims, robot_radius):
 
 
 class Generator(nn.Module):
-    def __init__(self, width=8, scale_channels=3):
+    def __init__(self, width=8, scale_channels=3, passability_channels=0):
         super().__init__()
-        self.width, self.scale_channels = width, scale_channels
+        self.width, self.scale_channels, self.passability_channels = width, scale_channels, passability_channels
         self.convs = nn.ModuleDict()
         for name, io, stride in GENERATOR_LAYERS:
-            cin, cout = io(width, scale_channels)
+            cin, cout = io(width, scale_channels, passability_channels)
             self.convs[name] = nn.Conv3d(cin, cout, 3, stride=stride, padding=1)
 
-    def logits(self, env, state, noise, scale=None):
+    def logits(self, env, state, noise, scale=None, passability=None):
         """env: E/2 in {0, 0.5, 1}; state: S in {0, 1}; noise: N(0, 1); each B x 1 x n^3;
-        scale: sigma, B x scale_channels (None when scale_channels is 0)."""
+        scale: sigma, B x scale_channels (None when scale_channels is 0); passability: the P
+        bits x, y, z as 0/1, B x 3 x n^3 (None when passability_channels is 0)."""
         c = self.convs
-        cond1 = torch.cat([env, state], 1)
+        cond1 = torch.cat([env, state] + ([passability] if self.passability_channels else []), 1)
         c2, c4, c8 = (F.max_pool3d(cond1, k) for k in (2, 4, 8))
         up = upsample2
-        a1 = F.relu(c["enc1"](torch.cat([env, state, noise], 1)))
+        a1 = F.relu(c["enc1"](torch.cat([cond1, noise], 1)))
         a2 = F.relu(c["enc2"](a1))
         a3 = F.relu(c["enc3"](torch.cat([a2, c2], 1)))
         a4 = F.relu(c["enc4"](torch.cat([a3, c4], 1)))
@@ -96,8 +99,8 @@ class Generator(nn.Module):
         d2 = F.relu(c["dec2"](torch.cat([up(d3), a2, c2], 1)))
         return c["dec1"](torch.cat([up(d2), a1, cond1], 1))
 
-    def forward(self, env, state, noise, scale=None):
-        return torch.sigmoid(self.logits(env, state, noise, scale))
+    def forward(self, env, state, noise, scale=None, passability=None):
+        return torch.sigmoid(self.logits(env, state, noise, scale, passability))
 
 
 def upsample2(t):

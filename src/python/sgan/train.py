@@ -74,8 +74,14 @@ import tensors  # noqa: E402
 #                network is 8x cheaper to run (docs/heuristic.md)
 #   scale_channels  3: the network is told sigma, its cells' metric size (model.py); 0: the
 #                graph of the weights trained before (one map family, one scale)
+#   passability_channels  3: the network also reads P, per cell whether its free space joins
+#                its two faces across x, y, z (dataset v2, grid.hpp): a wall thinner than a cell
+#                and the door through it are both "partial" in E, so without P no network can tell
+#                the one cell of a wall that lets a path through (held-out rooms: 1 of 20 maps
+#                strictly connected, docs/heuristic.md); 0: the graph without it
 DEFAULTS = dict(epochs=10, batch=32, lr_g=2e-3, lr_d=2e-4, kappa=1.0, alpha1=0.002, alpha2=1.0, alpha3=0.5,
-                alpha4=100.0, delta=0.5, pos_weight=8.0, width=8, scale_channels=3, threshold=0.5, seed=1, threads=2,
+                alpha4=100.0, delta=0.5, pos_weight=8.0, width=8, scale_channels=3, passability_channels=3,
+                threshold=0.5, seed=1, threads=2,
                 max_train=0, references=2, thresholds="0.3,0.4,0.5,0.6,0.7,0.8", augment=1, schedule="cosine",
                 select="best", val_samples=400, pool=1)
 
@@ -88,11 +94,11 @@ def cell_of(lo, hi, dims, p):
 def pool_samples(x, index, meta, pool):
     """uint8 [N, 3, nz, ny, nx] on the dataset's grid -> the same on the grid of dims / pool
     (see `pool` above); meta["dims"] is updated."""
-    n, _, nz, ny, nx = x.shape
+    n, ch, nz, ny, nx = x.shape
     if nx % pool or ny % pool or nz % pool:
         raise SystemExit(f"train: --pool {pool} does not divide the grid {meta['dims']}")
     d = [nx // pool, ny // pool, nz // pool]
-    blocks = x.reshape(n, 3, d[2], pool, d[1], pool, d[0], pool)
+    blocks = x.reshape(n, ch, d[2], pool, d[1], pool, d[0], pool)  # P (channel 3) is dropped
     lo_e, hi_e = blocks[:, 0].min(axis=(2, 4, 6)), blocks[:, 0].max(axis=(2, 4, 6))
     env = np.where(hi_e == 0, 0, np.where(lo_e == 2, 2, 1)).astype(np.uint8)
     target = blocks[:, 2].max(axis=(2, 4, 6))
@@ -115,17 +121,18 @@ def load_split(data, split, pool=1):
         raise SystemExit(f"train: {path} not found (make one with `miner dataset`)")
     with open(path) as f:
         meta = json.load(f)
-    if meta.get("format") != "miner-dataset-v1":
-        raise SystemExit(f"train: {data}/dataset.json is not a miner-dataset-v1 folder")
+    if meta.get("format") != "miner-dataset-v2":
+        raise SystemExit(f"train: {data}/dataset.json is not a miner-dataset-v2 folder")
     nx, ny, nz = meta["dims"]
+    ch = len(meta["channels"])  # E, S, T, P
     parts = []
     for shard in meta["splits"][split]["shards"]:
         path = os.path.join(data, shard["file"])
         raw = np.fromfile(path, dtype=np.uint8)
-        if raw.size != shard["count"] * 3 * nx * ny * nz:
+        if raw.size != shard["count"] * ch * nx * ny * nz:
             raise SystemExit(f"train: {path} is truncated")
-        parts.append(raw.reshape(shard["count"], 3, nz, ny, nx))
-    x = np.concatenate(parts) if parts else np.zeros((0, 3, nz, ny, nx), np.uint8)
+        parts.append(raw.reshape(shard["count"], ch, nz, ny, nx))
+    x = np.concatenate(parts) if parts else np.zeros((0, ch, nz, ny, nx), np.uint8)
     index_path = os.path.join(data, meta["splits"][split]["index"])
     with open(index_path) as f:
         index = json.load(f)
@@ -164,10 +171,24 @@ def balanced_first(family, n):
 
 
 def to_inputs(batch):
-    """uint8 [B, 3, n, n, n] (numpy or torch) -> (E/2, S, T, solid) float tensors [B, 1, n, n, n]."""
-    t = (torch.from_numpy(batch) if isinstance(batch, np.ndarray) else batch).float()
+    """uint8 [B, C, n, n, n] (numpy or torch; C = 3: E, S, T, or 4 with P) -> (E/2, S, T, solid)
+    float tensors [B, 1, n, n, n] and the P bits x, y, z as 0/1 [B, 3, n, n, n] (None when C = 3)."""
+    u = torch.from_numpy(batch) if isinstance(batch, np.ndarray) else batch
+    t = u[:, 0:3].float()
     env, state, target = t[:, 0:1], t[:, 1:2], t[:, 2:3]
-    return env * 0.5, state, target, (env == 2).float()
+    passability = None
+    if u.shape[1] > 3:
+        p = u[:, 3:4]
+        passability = torch.cat([((p >> a) & 1).float() for a in range(3)], 1)
+    return env * 0.5, state, target, (env == 2).float(), passability
+
+
+def permute_bits(p, axes):
+    """P bits (uint8) of a grid whose new axis a is old axis axes[a]: new bit a = old bit axes[a]."""
+    out = torch.zeros_like(p)
+    for a in range(3):
+        out |= ((p >> axes[a]) & 1) << a
+    return out
 
 
 def square_grid(meta):
@@ -207,11 +228,17 @@ def augment(batch, sigma, code, swap_xy, cube=False):
         for p, axes in enumerate(AXIS_ORDERS[1:], start=1):
             dims = [0, 1] + [4 - axes[2 - d] for d in range(3)]
             mask = order == p
-            out = torch.where(mask.view(-1, 1, 1, 1, 1), batch.permute(*dims), out)
+            turned = batch.permute(*dims)
+            if turned.shape[1] > 3:  # P's bits follow the axes
+                turned = torch.cat([turned[:, :3], permute_bits(turned[:, 3:], axes)], 1)
+            out = torch.where(mask.view(-1, 1, 1, 1, 1), turned, out)
             out_sigma = torch.where(mask.view(-1, 1), sigma[:, list(axes)], out_sigma)
         return out, out_sigma
     if swap_xy:
-        batch = where(bit(2), batch.transpose(3, 4))
+        swapped = batch.transpose(3, 4)
+        if swapped.shape[1] > 3:  # P's x and y bits swap with the axes
+            swapped = torch.cat([swapped[:, :3], permute_bits(swapped[:, 3:], (1, 0, 2))], 1)
+        batch = where(bit(2), swapped)
         sigma = torch.where(bit(2).view(-1, 1), sigma[:, [1, 0, 2]], sigma)
     return batch, sigma
 
@@ -269,6 +296,11 @@ def parse_args(argv):
         raise SystemExit("train: --augment must be 0, 1 or 2 and --val-samples >= 0")
     if a.pool not in (1, 2):
         raise SystemExit("train: --pool must be 1 or 2")
+    if a.passability_channels not in (0, 3):
+        raise SystemExit("train: --passability-channels must be 0 or 3")
+    if a.passability_channels and a.pool != 1:
+        raise SystemExit("train: --pool 2 drops P (a coarse cell's passability is not its children's): "
+                         "use --passability-channels 0")
     try:
         a.candidates = sorted({float(t) for t in a.thresholds.split(",")} | {a.threshold})
     except ValueError:
@@ -319,7 +351,7 @@ def main(argv=None):
 
     gen = torch.Generator().manual_seed(a.seed)  # shuffles and symmetries (CPU)
     noise_gen = torch.Generator(device=dev).manual_seed(a.seed + 3)  # noise, drawn on the device
-    G = sgan.Generator(a.width, a.scale_channels).to(dev)
+    G = sgan.Generator(a.width, a.scale_channels, a.passability_channels).to(dev)
     Dc, Ds = sgan.Discriminator().to(dev), sgan.Discriminator().to(dev)
     opt_g = torch.optim.Adam(G.parameters(), lr=a.lr_g, betas=(0.5, 0.99))
     opt_d = torch.optim.Adam(list(Dc.parameters()) + list(Ds.parameters()), lr=a.lr_d, betas=(0.5, 0.99))
@@ -356,9 +388,9 @@ def main(argv=None):
             batch, sigma = train[idx.to(dev)], train_sigma[idx.to(dev)]
             if a.augment:
                 batch, sigma = augment(batch, sigma, codes[idx].to(dev), swap_xy, cube)
-            env, state, target, solid = to_inputs(batch)
+            env, state, target, solid, passability = to_inputs(batch)
             noise = torch.randn(env.shape, generator=noise_gen, device=dev)
-            o = G(env, state, noise, sigma)
+            o = G(env, state, noise, sigma, passability)
             # Discriminators: real = ground truth, fake = generated (Eqs. connectivity/safety_loss).
             l_dc = bce(Dc(target, state), 1.0) + bce(Dc(o.detach(), state), 0.0)
             l_ds = bce(Ds(target, env), 1.0) + bce(Ds(o.detach(), env), 0.0)
@@ -466,10 +498,11 @@ def evaluate(G, val_set, a, dev, all_samples=False):
         for i in range(0, len(pick), a.batch):
             ids = pick[i:i + a.batch]
             b = val_set["x"][ids]
-            env, state, _, _ = to_inputs(b)
+            env, state, _, _, passability = to_inputs(b)
             noise = torch.randn(env.shape, generator=gen)
             sigma = torch.from_numpy(val_set["sigma"][ids])
-            p = G(env.to(dev), state.to(dev), noise.to(dev), sigma.to(dev)).cpu().numpy()[:, 0]
+            passability = passability.to(dev) if passability is not None else None
+            p = G(env.to(dev), state.to(dev), noise.to(dev), sigma.to(dev), passability).cpu().numpy()[:, 0]
             for k, v in enumerate(ids):
                 ends = val_set["ends"][v]
                 fam = val_set["family"][v]
@@ -498,6 +531,8 @@ def export(G, a, metas, val_set, log, summary, argv):
         weights.append((name + ".bias", conv.bias.detach().numpy()))
     arch = {"name": "sgan-unet4", "width": a.width, "dims": metas[0]["dims"], "layers": names,
             "environment_scale": 0.5, "threshold": a.threshold, "scale_channels": a.scale_channels}
+    if a.passability_channels:
+        arch["passability_channels"] = a.passability_channels
     if a.scale_channels:
         arch["scale_divisor"] = sgan.SCALE_DIVISOR
     training = {k: getattr(a, k) for k in DEFAULTS}
@@ -514,12 +549,14 @@ def export(G, a, metas, val_set, log, summary, argv):
     picks = balanced_first(val_set["family"], a.references)[:a.references] if len(val) else []
     with torch.no_grad():
         for k, v in enumerate(picks):
-            env, state, _, _ = to_inputs(val[v:v + 1])
+            env, state, _, _, passability = to_inputs(val[v:v + 1])
             noise = torch.randn(env.shape, generator=gen)
             sigma = torch.from_numpy(val_set["sigma"][v:v + 1])
-            out = G(env, state, noise, sigma)
+            out = G(env, state, noise, sigma, passability)
             refs += [(f"{k}.environment", env[0, 0].numpy()), (f"{k}.state", state[0, 0].numpy()),
                      (f"{k}.noise", noise[0, 0].numpy()), (f"{k}.output", out[0, 0].numpy())]
+            if a.passability_channels:
+                refs.append((f"{k}.passability", passability[0].numpy()))
             if a.scale_channels:
                 refs.append((f"{k}.scale", sigma[0].numpy()))
     tensors.write(os.path.join(a.out, "reference.bin"), "sgan-reference", refs,

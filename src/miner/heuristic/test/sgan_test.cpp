@@ -133,7 +133,7 @@ TEST_CASE("Weights that overflow a layer give an error naming the file, never a 
   env[5] = 1;
   state[0] = state[cells - 1] = 1;
   miner::Rng rng(1);
-  CHECK_THROWS_WITH(g.predict(env, state, miner::world::Box{{0, 0, 0}, {10, 10, 5}}, 0.2, rng),
+  CHECK_THROWS_WITH(g.predict(env, state, {}, miner::world::Box{{0, 0, 0}, {10, 10, 5}}, 0.2, rng),
                     Contains("huge.bin") && Contains("not a probability"));
 }
 
@@ -189,12 +189,12 @@ TEST_CASE("The same inputs and seed give the same region bytes", "[REQ-HEUR-005]
   s[5] = s[n - 9] = 1;
   const miner::world::Box bounds{Eigen::Vector3d::Zero(), Eigen::Vector3d(100, 100, 40)};
   miner::Rng r1(3, 1), r2(3, 1), r3(4, 1);
-  const auto a = g.predict(e, s, bounds, 0.5, r1), b = g.predict(e, s, bounds, 0.5, r2),
-             c = g.predict(e, s, bounds, 0.5, r3);
+  const auto a = g.predict(e, s, {}, bounds, 0.5, r1), b = g.predict(e, s, {}, bounds, 0.5, r2),
+             c = g.predict(e, s, {}, bounds, 0.5, r3);
   CHECK(a == b);
   CHECK(a != c);  // the noise enters the network
   for (float v : a) REQUIRE((v >= 0.0f && v <= 1.0f));
-  CHECK_THROWS_WITH(g.predict(std::vector<std::uint8_t>(10, 0), s, bounds, 0.5, r1), Contains("cells"));
+  CHECK_THROWS_WITH(g.predict(std::vector<std::uint8_t>(10, 0), s, {}, bounds, 0.5, r1), Contains("cells"));
 }
 
 TEST_CASE("The network is told its cells' metric size: sigma = log2(cell / radius) / divisor", "[REQ-HEUR-013]") {
@@ -222,7 +222,7 @@ TEST_CASE("The network is told its cells' metric size: sigma = log2(cell / radiu
   miner::Rng r1(3, 1), r2(3, 1);
   const miner::world::Box small{Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(10.0)};
   const miner::world::Box large{Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(200.0)};
-  CHECK(g.predict(e, s, small, 0.3, r1) != g.predict(e, s, large, 0.3, r2));
+  CHECK(g.predict(e, s, {}, small, 0.3, r1) != g.predict(e, s, {}, large, 0.3, r2));
   // A forward call with the wrong number of scale values is refused.
   std::vector<float> env(n, 0.0f), st(n, 0.0f), noise(n, 0.0f);
   CHECK_THROWS_WITH(g.forward(env, st, noise, {0.1f}), Contains("scale input of 3"));

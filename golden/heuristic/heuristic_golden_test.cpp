@@ -42,7 +42,8 @@ TEST_CASE("Golden: the first sim dataset samples of seed 1", "[REQ-HEUR-001][REQ
                        {"environment", {count(s.environment, 0), count(s.environment, 1), count(s.environment, 2)}},
                        {"state_cells", count(s.state, 1)},
                        {"target_cells", count(s.target, 1)},
-                       {"bytes_fnv1a64", {hash(s.environment), hash(s.state), hash(s.target)}}});
+                       {"passability", {count(s.passability, 0), count(s.passability, 7)}},
+                       {"bytes_fnv1a64", {hash(s.environment), hash(s.state), hash(s.target), hash(s.passability)}}});
   }
   MINER_REQUIRE_GOLDEN("heuristic/dataset-sim-seed-1.json", samples, (miner::testing::Tolerance{1e-9, 1e-12}));
 }

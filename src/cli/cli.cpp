@@ -17,6 +17,7 @@
 #include <unistd.h>
 
 #include "miner/core/error.hpp"
+#include "miner/core/text.hpp"
 #include "miner/core/progress.hpp"
 #include "miner/core/shard.hpp"
 #include "miner/plan/heuristic_region.hpp"
@@ -179,8 +180,7 @@ CLI::Validator suffix_output(const std::string& suffix, const std::string& what)
         // An option taken as the value ("--out --json") is named as such by the parse-complete
         // check, not blamed on its suffix.
         if (text.rfind("--", 0) == 0) return "";
-        if (text.size() >= suffix.size() && text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0)
-          return "";
+        if (ends_with(text, suffix)) return "";
         return text + " must end in " + suffix + " (" + what + ")";
       },
       "FILE" + suffix);

@@ -12,6 +12,7 @@
 
 #include "cli/cli.hpp"
 #include "miner/core/error.hpp"
+#include "miner/core/text.hpp"
 #include "miner/core/json_io.hpp"
 #include "miner/core/sha256.hpp"
 #include "miner/world/astar.hpp"
@@ -30,12 +31,11 @@ namespace {
 /// took back; fourth campaign: ".BT" and ".txt" got JSON too).
 const CLI::Validator kMapOutput(
     [](std::string& text) -> std::string {
-      const auto ends = [&](const char* suffix) {
-        const std::string x(suffix);
-        return text.size() >= x.size() && text.compare(text.size() - x.size(), x.size(), x) == 0;
-      };
-      if (ends(".json") || ends(".bt")) return "";
-      if (ends(".ot")) return text + ": MINER writes OctoMaps as .bt only (.ot is read, not written)";
+      // An option taken as the value ("--out --json") is named by the parse-complete check, as
+      // suffix_output does, not blamed on its suffix.
+      if (text.rfind("--", 0) == 0) return "";
+      if (ends_with(text, ".json") || ends_with(text, ".bt")) return "";
+      if (ends_with(text, ".ot")) return text + ": MINER writes OctoMaps as .bt only (.ot is read, not written)";
       return text + " must end in .json (a miner-map-v1 file) or .bt (an OctoMap binary tree): the suffix chooses "
                     "what is written";
     },
@@ -416,19 +416,25 @@ void add_map_commands(CLI::App& app, std::ostream& out) {
     // 20, fourth campaign: `--fov 0 60` passed the [0, 360] check and failed later, exit 1).
     if (!(scan->fov[0] > 0.0 && scan->fov[0] <= 360.0))
       throw CLI::ValidationError("--fov", "the horizontal field of view must lie in (0, 360] degrees, got " +
-                                              std::to_string(scan->fov[0]));
+                                              short_number(scan->fov[0]));
     if (!(scan->fov[1] >= 0.0 && scan->fov[1] < 180.0))
       throw CLI::ValidationError("--fov", "the vertical field of view must lie in [0, 180) degrees, got " +
-                                              std::to_string(scan->fov[1]));
-    // The turns at the first and last pose alone cast 4 x 360 / h_fov poses of these rays: over
+                                              short_number(scan->fov[1]));
+    // The first and last pose alone (with their turns unless --no-spin) cast these rays: over
     // the bound a scan may cast, the options are at fault whatever the path (fifth campaign).
-    const double spin_rays = 4.0 * 360.0 / scan->fov[0] * scan->rays[0] * static_cast<double>(scan->rays[1]);
-    if (spin_rays > world::kMaxScanRays)
-      throw CLI::ValidationError("--rays", "with --fov " + std::to_string(scan->fov[0]) + " the turns at the ends alone cast " +
-                                               std::to_string(spin_rays) + " rays, more than the " +
-                                               std::to_string(world::kMaxScanRays) + " a scan may");
+    world::ScanOptions ends = scan->scan;
+    ends.h_rays = scan->rays[0];
+    ends.v_rays = scan->rays[1];
+    ends.h_fov_deg = scan->fov[0];
+    const double end_rays = world::scan_ray_bound(ends, 0.0);
+    if (end_rays > world::kMaxScanRays) {
+      std::ostringstream os;
+      os << "with --fov " << scan->fov[0] << (ends.spin_at_ends ? " the first and last pose with their turns" : " the first and last pose")
+         << " alone cast " << end_rays << " rays, more than the " << world::kMaxScanRays << " a scan may";
+      throw CLI::ValidationError("--rays", os.str());
+    }
     if (scan->scan.noise > 0.5 * scan->scan.range)
-      throw CLI::ValidationError("--noise", "must be at most half of --range (" + std::to_string(scan->scan.range) +
+      throw CLI::ValidationError("--noise", "must be at most half of --range (" + short_number(scan->scan.range) +
                                                 " m)");
     run_scan(*scan, out);
   });

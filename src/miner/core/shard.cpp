@@ -33,7 +33,12 @@ void require_complete_parts(const std::vector<Json>& tags, const std::vector<std
   std::vector<bool> seen(static_cast<std::size_t>(n), false);
   for (std::size_t p = 0; p < tags.size(); ++p) {
     const int index = tags[p].at("index").get<int>();
-    if (tags[p].at("count").get<int>() != n || index < 0 || index >= n)
+    const int count = tags[p].at("count").get<int>();
+    // A part numbered outside its own count was edited, not drawn from another split.
+    if (index < 0 || index >= count)
+      throw Error(names[p] + ": says it is part " + std::to_string(index) + " of " + std::to_string(count) +
+                  ": a part's index must lie in [0, " + std::to_string(count) + ")");
+    if (count != n)
       // Plain words (fifth campaign: "splits dataset merge: the dataset differently").
       throw Error(names[p] + ": is part " + std::to_string(index) + " of " + std::to_string(tags[p].at("count").get<int>()) +
                   ", but " + names.front() + " is a part of " + std::to_string(n) + ": the parts come from different splits");

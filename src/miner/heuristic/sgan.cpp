@@ -264,8 +264,8 @@ struct Sgan::Impl {
   /// Starts a query's input (the sparse list is rebuilt by set_input).
   void begin_input() { sparse.clear(); }
 
-  /// Voxel (x, y, z), index v, of the input: E/2 = e, S = s, N = noise, P bits pass[0..2] (when
-  /// the network reads P); cond1 = (E/2, S[, P]) and, with the own kernels (never with P), N on
+  /// Voxel (x, y, z), index v, of the input: E/2 = e, S = s, N = noise, the blocked bits
+  /// 1 - P_a in pass[0..2] (when the network reads P); cond1 = (E/2, S[, P]) and, with the own kernels (never with P), N on
   /// the padded grid and (e, s) in the sparse list when nonzero; else x0 = (cond1, N) channels-last.
   void set_input(int x, int y, int z, std::size_t v, float e, float s, float noise, const float* pass = nullptr) {
     if (own_kernels) {
@@ -714,7 +714,8 @@ std::vector<float> Sgan::predict(const std::vector<std::uint8_t>& environment, c
   g.begin_input();
   g.for_voxels([&](int x, int y, int z, std::size_t v) {
     float p[3] = {0.0F, 0.0F, 0.0F};
-    for (int a = 0; a < pc; ++a) p[a] = static_cast<float>((passability[v] >> a) & 1U);
+    // The network reads the blocked bits 1 - P_a (train.py's to_inputs): 0 on free cells.
+    for (int a = 0; a < pc; ++a) p[a] = 1.0F - static_cast<float>((passability[v] >> a) & 1U);
     g.set_input(x, y, z, v, scale * static_cast<float>(environment[v]), static_cast<float>(state[v]),
                 static_cast<float>(rng.normal_ziggurat()), p);
   });

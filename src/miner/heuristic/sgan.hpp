@@ -46,7 +46,8 @@ struct SganArchitecture {
   double environment_scale = 0.5;   ///< E levels 0/1/2 enter the network as E * scale
   double threshold = 0.5;           ///< cell in the raw region iff R >= threshold
   /// 3 when the network reads channel P (grid.hpp: whether each cell's free space joins its
-  /// faces across x, y, z) beside E and S in every condition c_k; 0 for the networks before it.
+  /// faces across x, y, z), as the blocked bits 1 - P_a, beside E and S in every condition c_k;
+  /// 0 for the networks before it.
   int passability_channels = 0;
 };
 
@@ -83,8 +84,9 @@ class Sgan {
   /// One query at a time per object (the buffers are reused). Inputs: the
   /// environment already scaled, the state, the noise — and dims.prod() probabilities out.
   /// `scale` is sigma (ignored, and may be empty, when the network has no scale channels);
-  /// `passability` the P bits x, y, z as 0/1, channel after channel (3 x dims.prod(); ignored,
-  /// and may be empty, when the network has no passability channels).
+  /// `passability` the network's P input, the blocked bits 1 - P_a for a = x, y, z as 0/1,
+  /// channel after channel (3 x dims.prod(); ignored, and may be empty, when the network has no
+  /// passability channels).
   std::vector<float> forward(const std::vector<float>& environment_scaled, const std::vector<float>& state,
                              const std::vector<float>& noise, const std::vector<float>& scale = {},
                              const std::vector<float>& passability = {}) const;

@@ -10,6 +10,7 @@
 #include <ceres/ceres.h>
 
 #include "miner/core/error.hpp"
+#include "miner/core/text.hpp"
 
 namespace miner::traj {
 
@@ -247,8 +248,8 @@ AllocationResult optimise_allocation(const MincoProblem& problem, const Allocati
     if (summary.termination_type == ceres::FAILURE &&
         summary.message.rfind("Initial cost and jacobian evaluation failed", 0) == 0)
       throw Error("allocation: the optimiser could not evaluate the objective J + rho sum T or its gradient at the "
-                  "start (Ceres: " + summary.message + "): rho " + std::to_string(o.rho) + " and the limits (v_max " +
-                  std::to_string(o.limits.v_max) + ", a_max " + std::to_string(o.limits.a_max) +
+                  "start (Ceres: " + summary.message + "): rho " + short_number(o.rho) + " and the limits (v_max " +
+                  short_number(o.limits.v_max) + ", a_max " + short_number(o.limits.a_max) +
                   ") put it beyond double precision; use a smaller rho or tighter limits, or give durations");
     for (std::size_t i = 0; i < M; ++i) T[i] = std::exp(tau[i]);
     Evaluation e;

@@ -9,6 +9,7 @@
 #include <filesystem>
 
 #include "miner/core/error.hpp"
+#include "miner/core/text.hpp"
 #include "miner/core/sha256.hpp"
 #include "miner/world/octree_io.hpp"
 #include "miner/world/voxel_grid.hpp"
@@ -344,11 +345,7 @@ Map Map::from_json(const Json& doc, const std::string& origin) {
 }
 
 Map Map::load(const std::string& path) {
-  const auto ends_with = [&](const std::string& suffix) {
-    return path.size() >= suffix.size() &&
-           path.compare(path.size() - suffix.size(), suffix.size(), suffix) == 0;
-  };
-  if (ends_with(".bt") || ends_with(".ot")) return load_octomap(path);
+  if (ends_with(path, ".bt") || ends_with(path, ".ot")) return load_octomap(path);
   const std::string bytes = read_file_bytes(path);
   // Formats MINER reads elsewhere, recognised by their first bytes, are named as such instead
   // of as malformed JSON (issue 20, fourth campaign: an OctoMap named .BT got the JSON
@@ -441,7 +438,7 @@ void Map::save(const std::string& path) const {
   // issue 20: a ".ot" path got JSON that load() then read as an OctoMap and refused.
   if (path.size() >= 3 && path.compare(path.size() - 3, 3, ".ot") == 0)
     throw Error(path + ": MINER writes OctoMaps as .bt (binary occupancy) only, not .ot: name the output .bt or .json");
-  if (path.size() >= 3 && path.compare(path.size() - 3, 3, ".bt") == 0) {
+  if (ends_with(path, ".bt")) {
     save_octomap(path);
   } else if (source_ && source_->file.empty()) {
     // The voxels first, then the document that names them: a reader never sees a reference to a

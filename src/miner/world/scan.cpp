@@ -7,6 +7,7 @@
 #include <octomap/OcTree.h>
 
 #include "miner/core/error.hpp"
+#include "miner/core/text.hpp"
 #include "miner/core/rng.hpp"
 #include "miner/world/octree_leaves.hpp"
 
@@ -63,7 +64,7 @@ void validate_scan(const ScanOptions& o, const Map& map, const std::vector<Eigen
   check(o.h_rays >= 1 && o.h_rays <= 100000, "horizontal rays", "must lie in [1, 100000]");
   check(o.v_rays >= 1 && o.v_rays <= 100000, "vertical rays", "must lie in [1, 100000]");
   check(std::isfinite(o.noise) && o.noise >= 0.0 && o.noise <= 0.5 * o.range, "noise",
-        "must lie in [0, range / 2] m (noise " + std::to_string(o.noise) + " m, range " + std::to_string(o.range) +
+        "must lie in [0, range / 2] m (noise " + short_number(o.noise) + " m, range " + short_number(o.range) +
             " m): lower the noise or raise the range");
   check(std::isfinite(o.dropout) && o.dropout >= 0.0 && o.dropout < 1.0, "dropout", "must lie in [0, 1)");
   check(std::isfinite(o.spacing) && o.spacing > 0.0, "spacing", "must be positive");
@@ -78,7 +79,7 @@ void validate_scan(const ScanOptions& o, const Map& map, const std::vector<Eigen
       throw Error("scan path point " + std::to_string(i) + " " + format_point(path[i]) + " lies outside the map bounds");
     if (i > 0) length += (path[i] - path[i - 1]).norm();
   }
-  const double rays = (std::floor(length / o.spacing) + 4.0 * 360.0 / o.h_fov_deg) * o.h_rays * static_cast<double>(o.v_rays);
+  const double rays = scan_ray_bound(o, length);
   if (rays > kMaxRays) {
     std::ostringstream os;
     os << "scan: " << rays << " rays (poses every " << o.spacing << " m over " << length << " m, " << o.h_rays << " x "
@@ -105,6 +106,13 @@ void validate_scan(const ScanOptions& o, const Map& map, const std::vector<Eigen
        << " m from the origin) outside OctoMap's 32768 voxels; use a coarser resolution";
     throw Error(os.str());
   }
+}
+
+double scan_ray_bound(const ScanOptions& o, double length) {
+  const double per_pose = static_cast<double>(o.h_rays) * static_cast<double>(o.v_rays);
+  const double poses = std::floor(length / o.spacing) + 2.0;  // resample_path: every spacing, and the end
+  const double turn = o.spin_at_ends ? 2.0 * std::ceil(o.h_rays * 360.0 / o.h_fov_deg) * o.v_rays : 0.0;
+  return poses * per_pose + turn;
 }
 
 ScanResult scan_map(const Map& map, const std::vector<Eigen::Vector3d>& path, const ScanOptions& o) {

@@ -58,6 +58,12 @@ struct ScanResult {
 /// point inside the map's bounds); throws miner::Error. Bounded work: at most 1e8 rays.
 void validate_scan(const ScanOptions& options, const Map& map, const std::vector<Eigen::Vector3d>& path);
 
+/// Most rays a scan casts along a route of `length` m: h_rays x v_rays at every pose (one each
+/// `spacing` m, both ends included) and, with spin_at_ends, the full turn's
+/// ceil(h_rays 360 / h_fov) x v_rays at the first and the last pose. validate_scan bounds it
+/// by kMaxScanRays; the CLI checks the options alone with length 0 (the ends' poses).
+double scan_ray_bound(const ScanOptions& options, double length);
+
 /// Flies the sensor along `path` (a polyline) through `map` and builds the scan.
 ScanResult scan_map(const Map& map, const std::vector<Eigen::Vector3d>& path, const ScanOptions& options);
 

@@ -6,7 +6,8 @@ conditional discriminators, one judging R against S (connectivity) and one again
 Generator (width w, grid n^3 with n divisible by 8; "encoded at several scales", the
 conditions c_k = maxpool_k([E/2, S]) enter at every scale; the 1/8 level sees the whole
 grid, so every cell knows where both start and goal are; with passability_channels = 3 the
-conditions are [E/2, S, Px, Py, Pz], the P bits of the dataset, wherever [E/2, S] stands below):
+conditions are [E/2, S, Bx, By, Bz] wherever [E/2, S] stands below, B_a = 1 - P_a the dataset's
+passability bits inverted: 1 where the cell's free space does not join its faces across a):
     x   = [E/2, S, N]                                   3 x n^3
     a1  = relu(conv3(x))                                w  x n^3
     a2  = relu(conv3_stride2(a1))                       2w x (n/2)^3
@@ -80,8 +81,8 @@ class Generator(nn.Module):
 
     def logits(self, env, state, noise, scale=None, passability=None):
         """env: E/2 in {0, 0.5, 1}; state: S in {0, 1}; noise: N(0, 1); each B x 1 x n^3;
-        scale: sigma, B x scale_channels (None when scale_channels is 0); passability: the P
-        bits x, y, z as 0/1, B x 3 x n^3 (None when passability_channels is 0)."""
+        scale: sigma, B x scale_channels (None when scale_channels is 0); passability: the
+        blocked bits 1 - P_a, a = x, y, z, B x 3 x n^3 (None when passability_channels is 0)."""
         c = self.convs
         cond1 = torch.cat([env, state] + ([passability] if self.passability_channels else []), 1)
         c2, c4, c8 = (F.max_pool3d(cond1, k) for k in (2, 4, 8))

@@ -1,4 +1,4 @@
-"""cites: REQ-HEUR-010 REQ-HEUR-013
+"""cites: REQ-HEUR-010 REQ-HEUR-013 REQ-HEUR-015
 
 The training symmetries map a query to a query of the same
 metric geometry. Run by ctest: python3 src/python/sgan/test_augment.py

@@ -172,14 +172,16 @@ def balanced_first(family, n):
 
 def to_inputs(batch):
     """uint8 [B, C, n, n, n] (numpy or torch; C = 3: E, S, T, or 4 with P) -> (E/2, S, T, solid)
-    float tensors [B, 1, n, n, n] and the P bits x, y, z as 0/1 [B, 3, n, n, n] (None when C = 3)."""
+    float tensors [B, 1, n, n, n] and the blocked bits 1 - P_a for a = x, y, z as 0/1 [B, 3, n, n, n]
+    (None when C = 3): 0 on free cells, so the input stays sparse like E and S, and max-pooled to
+    the coarse conditions it means "some cell here is blocked across a" (a wall's orientation)."""
     u = torch.from_numpy(batch) if isinstance(batch, np.ndarray) else batch
     t = u[:, 0:3].float()
     env, state, target = t[:, 0:1], t[:, 1:2], t[:, 2:3]
     passability = None
     if u.shape[1] > 3:
         p = u[:, 3:4]
-        passability = torch.cat([((p >> a) & 1).float() for a in range(3)], 1)
+        passability = torch.cat([1.0 - ((p >> a) & 1).float() for a in range(3)], 1)
     return env * 0.5, state, target, (env == 2).float(), passability
 
 

@@ -16,6 +16,9 @@ TEST_CASE("Parts of one split join: others are refused naming the part in plain 
   // Fifth campaign: "splits dataset merge: the dataset differently".
   CHECK_THROWS_WITH(miner::require_complete_parts({tag(0, 2), tag(1, 3)}, {"a", "b"}, "dataset merge: the dataset"),
                     Contains("b: is part 1 of 3, but a is a part of 2: the parts come from different splits"));
+  // Session 23 review: an index outside its own count was called "different splits".
+  CHECK_THROWS_WITH(miner::require_complete_parts({tag(0, 2), tag(5, 2)}, {"a", "b"}, "merge: the campaign"),
+                    Contains("b: says it is part 5 of 2: a part's index must lie in [0, 2)"));
   CHECK(miner::parse_shard("1/4") == std::pair<int, int>{1, 4});
   CHECK_THROWS_AS(miner::parse_shard("4/4"), miner::Error);
 }

@@ -181,6 +181,33 @@ TEST_CASE("The 16^3 network (fixtures/sgan/grid16) agrees with PyTorch on both k
     CHECK(heuristic::Sgan::load(dir + "lofo/without-" + f + ".bin").architecture().dims == Eigen::Vector3i(16, 16, 16));
 }
 
+TEST_CASE("The network reading P (fixtures/sgan/passability) agrees with PyTorch, and reads P", "[REQ-HEUR-005][REQ-HEUR-015]") {
+  const std::string dir = kFixtures + "passability/";
+  const heuristic::Sgan g = heuristic::Sgan::load(dir + "sgan.bin");
+  CHECK(g.architecture().passability_channels == 3);
+  CHECK_FALSE(g.own_kernels());  // MINER's own first layer takes (E/2, S, N) only
+  const std::vector<double> errors = heuristic::reference_errors(g, dir + "reference.bin");
+  REQUIRE(errors.size() >= 1);
+  for (double e : errors) CHECK(e <= heuristic::kReferenceTolerance);
+  // P is read: the same E, S and noise with every cell blocked across x give another region.
+  const heuristic::TensorFile ref = heuristic::read_tensor_file(dir + "reference.bin", "sgan-reference");
+  const Eigen::Vector3i d = g.architecture().dims;
+  const std::size_t n = static_cast<std::size_t>(d.prod());
+  const std::vector<int> grid{d.z(), d.y(), d.x()};
+  std::vector<float> blocked = ref.at("0.passability", {3, d.z(), d.y(), d.x()}).values;
+  const std::vector<float> env = ref.at("0.environment", grid).values, state = ref.at("0.state", grid).values,
+                           noise = ref.at("0.noise", grid).values, scale = ref.at("0.scale", {3}).values;
+  const std::vector<float> as_given = g.forward(env, state, noise, scale, blocked);
+  std::fill(blocked.begin(), blocked.begin() + static_cast<std::ptrdiff_t>(n), 1.0F);
+  const std::vector<float> all_blocked = g.forward(env, state, noise, scale, blocked);
+  double moved = 0.0;
+  for (std::size_t v = 0; v < n; ++v) moved = std::max(moved, static_cast<double>(std::fabs(as_given[v] - all_blocked[v])));
+  CHECK(moved > 1e-3);
+  CHECK_THROWS_WITH(g.forward(env, state, noise, scale), Contains("the network reads P"));
+  for (const char* f : {"sim", "indoor", "cluttered", "rooms", "forest", "multilevel", "scan"})
+    CHECK(heuristic::Sgan::load(dir + "lofo/without-" + f + ".bin").architecture().passability_channels == 3);
+}
+
 TEST_CASE("The same inputs and seed give the same region bytes", "[REQ-HEUR-005]") {
   const heuristic::Sgan g = heuristic::Sgan::builtin();
   const auto n = static_cast<std::size_t>(g.architecture().dims.prod());

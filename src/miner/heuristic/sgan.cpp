@@ -252,10 +252,13 @@ struct Sgan::Impl {
   dnnl::eltwise_forward sigmoid;        // R = sigmoid(logits), in place on out
   memory out_memory;
   // MINER's own kernels for enc1 and dec1's skip part (sgan_kernels.hpp; width 8 and
-  // Sgan::Kernels::kFastest): N, E/2 and S on a padded grid, the nonzero voxels of E/2 and S, and a1
-  // channels-last on the padded grid, which enc2 (oneDNN) reads with padding 0.
+  // Sgan::Kernels::kFastest): N and the conditions (E/2, S[, the blocked bits]) on a padded grid,
+  // the voxels where a condition is nonzero, and a1 channels-last on the padded grid, which enc2
+  // (oneDNN) reads with padding 0.
   bool own_kernels = false;
-  std::vector<float> noise_padded, environment_padded, state_padded, a1_padded;
+  std::vector<float> noise_padded, a1_padded;
+  std::vector<std::vector<float>> condition_padded;  // one planar padded grid per condition
+  std::vector<const float*> condition_pointers;
   std::vector<kernels::SparseInput> sparse;
   std::vector<float> first_weights, first_bias, skip_weights;
   std::array<Conv, kConvs> conv;
@@ -265,16 +268,23 @@ struct Sgan::Impl {
   void begin_input() { sparse.clear(); }
 
   /// Voxel (x, y, z), index v, of the input: E/2 = e, S = s, N = noise, the blocked bits
-  /// 1 - P_a in pass[0..2] (when the network reads P); cond1 = (E/2, S[, P]) and, with the own kernels (never with P), N on
-  /// the padded grid and (e, s) in the sparse list when nonzero; else x0 = (cond1, N) channels-last.
+  /// 1 - P_a in pass[0..2] (when the network reads P); cond1 = (E/2, S[, B]) and, with the own
+  /// kernels, N and cond1 on the padded grid and cond1 in the sparse list when nonzero; else
+  /// x0 = (cond1, N) channels-last.
   void set_input(int x, int y, int z, std::size_t v, float e, float s, float noise, const float* pass = nullptr) {
     if (own_kernels) {
       const Eigen::Vector3i d = cond1.dims;
       const int padded = ((z + 1) * (d.y() + 2) + y + 1) * (d.x() + 2) + x + 1;
-      noise_padded[static_cast<std::size_t>(padded)] = noise;
-      environment_padded[static_cast<std::size_t>(padded)] = e;
-      state_padded[static_cast<std::size_t>(padded)] = s;
-      if (e != 0.0f || s != 0.0f) sparse.push_back({padded, e, s});
+      const auto p = static_cast<std::size_t>(padded);
+      noise_padded[p] = noise;
+      kernels::SparseInput in{padded, {e, s, 0.0F, 0.0F, 0.0F}};
+      for (int a = 0; a < arch.passability_channels; ++a) in.condition[2 + a] = pass[a];
+      bool nonzero = false;
+      for (std::size_t c = 0; c < condition_padded.size(); ++c) {
+        condition_padded[c][p] = in.condition[c];
+        nonzero = nonzero || in.condition[c] != 0.0F;
+      }
+      if (nonzero) sparse.push_back(in);
     } else {
       const auto c = static_cast<std::size_t>(x0.channels);
       x0.data[c * v] = e;
@@ -382,14 +392,14 @@ void Sgan::Impl::build(const TensorFile& f, Sgan::Kernels which) {
   const Eigen::Vector3i n1 = arch.dims, n2 = n1 / 2, n4 = n1 / 4, n8 = n1 / 8;
   // The condition channels c_k: E/2, S and P's three bits when the network reads them.
   const int nc = 2 + arch.passability_channels;
-  // MINER's own first-layer kernel takes exactly (E/2, S, N): networks reading P run oneDNN's.
-  own_kernels = which == Sgan::Kernels::kFastest && w == kernels::kWidth && arch.passability_channels == 0;
+  own_kernels = which == Sgan::Kernels::kFastest && w == kernels::kWidth && nc <= kernels::kMaxConditions;
   const Eigen::Vector3i padded = n1 + Eigen::Vector3i::Constant(2);
   if (own_kernels) {
     noise_padded.assign(static_cast<std::size_t>(padded.prod()), 0.0f);
     a1_padded.assign(static_cast<std::size_t>(padded.prod()) * kernels::kWidth, 0.0f);
-    environment_padded.assign(static_cast<std::size_t>(padded.prod()), 0.0f);
-    state_padded.assign(static_cast<std::size_t>(padded.prod()), 0.0f);
+    condition_padded.assign(static_cast<std::size_t>(nc), std::vector<float>(static_cast<std::size_t>(padded.prod()), 0.0f));
+    condition_pointers.clear();
+    for (const auto& plane : condition_padded) condition_pointers.push_back(plane.data());
   }
   x0 = Activation(nc + 1, own_kernels ? Eigen::Vector3i(0, 0, 0) : n1);  // oneDNN's enc1 input only
   cond1 = Activation(nc, n1);
@@ -647,8 +657,8 @@ std::vector<float> Sgan::Impl::run() {
   const Eigen::Vector3i n1 = g.out.dims;
   const int dims[3] = {n1.x(), n1.y(), n1.z()};
   if (g.own_kernels)
-    kernels::first_layer(dims, g.noise_padded.data(), g.sparse, g.first_weights.data(), g.first_bias.data(),
-                         g.a1_padded.data());
+    kernels::first_layer(dims, g.cond1.channels, g.noise_padded.data(), g.sparse, g.first_weights.data(),
+                         g.first_bias.data(), g.a1_padded.data());
   else
     run(0);  // a1
   run(1);  // a2
@@ -676,7 +686,7 @@ std::vector<float> Sgan::Impl::run() {
   if (g.own_kernels) {
     const std::size_t plane = static_cast<std::size_t>(n1.x() * n1.y());
     for (int z = 0; z < n1.z(); ++z) g.logit_base_plane(z, g.out.data.data() + static_cast<std::size_t>(z) * plane);
-    kernels::last_layer_skip(dims, g.a1_padded.data(), g.environment_padded.data(), g.state_padded.data(),
+    kernels::last_layer_skip(dims, g.cond1.channels, g.a1_padded.data(), g.condition_pointers.data(),
                              g.skip_weights.data(), g.out.data.data());
     g.sigmoid.execute(stream, {{DNNL_ARG_SRC, g.out_memory}, {DNNL_ARG_DST, g.out_memory}});
     stream.wait();  // R

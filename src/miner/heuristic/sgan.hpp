@@ -12,7 +12,8 @@
 ///     d2 = relu(conv3([up2(d3), a2, c2]))    2w x (n/2)^3
 ///     R  = sigmoid(conv3([up2(d2), a1, E/2, S]))
 /// The convolutions run in oneDNN (channels-last activations, weights reordered once to the
-/// kernel's preferred layout), except enc1 and dec1's skip part at width 8 (sgan_kernels.hpp);
+/// kernel's preferred layout), except enc1 and dec1's skip part at width 8 (sgan_kernels.hpp,
+/// with 2 conditions or 5 for a network reading P);
 /// a decoder layer's up-sampled input is convolved on its own coarse grid (parity kernels);
 /// pooling and concatenation are copies done here.
 /// Weights come from a `miner-tensors-v1` file of kind "sgan-weights" (tensor_file.hpp);

@@ -46,20 +46,21 @@ void clear_border(const int n[3], int c, float* padded) {
 // reads input v + (dx, dy, dz) at tap t, so an input u reaches the outputs u - (dx, dy, dz).
 
 MINER_KERNEL_CLONES
-void first_layer(const int n[3], const float* noise_padded, const std::vector<SparseInput>& sparse,
+void first_layer(const int n[3], int conditions, const float* noise_padded, const std::vector<SparseInput>& sparse,
                  const float* weights, const float* bias, float* a1_padded) {
   const int nx = n[0], ny = n[1], nz = n[2];
   const std::ptrdiff_t px = nx + 2, pxy = px * (ny + 2);
   std::fill(a1_padded, a1_padded + pxy * (nz + 2) * kWidth, 0.0f);
-  v8 wn[27], we[27], ws[27];
+  const int nc = std::clamp(conditions, 2, kMaxConditions), cin = nc + 1;
+  v8 wn[27], wc[kMaxConditions][27];
   for (int t = 0; t < 27; ++t)
     for (int o = 0; o < kWidth; ++o) {
-      we[t][o] = weights[(o * 3 + 0) * 27 + t];
-      ws[t][o] = weights[(o * 3 + 1) * 27 + t];
-      wn[t][o] = weights[(o * 3 + 2) * 27 + t];
+      for (int c = 0; c < nc; ++c) wc[c][t][o] = weights[(o * cin + c) * 27 + t];
+      wn[t][o] = weights[(o * cin + nc) * 27 + t];
     }
-  // E/2 and S, scattered from their nonzero voxels to the 27 voxels that read each, border
-  // voxels included (cleared below).
+  // The conditions, scattered from their nonzero voxels to the 27 voxels that read each, border
+  // voxels included (cleared below). E/2 and S first, summed as one expression as before the
+  // blocked bits came, so a 2-condition network gives the same bytes.
   std::ptrdiff_t off[27];
   for (int t = 0; t < 27; ++t) off[t] = (t / 9 - 1) * pxy + (t / 3 % 3 - 1) * px + (t % 3 - 1);
   for (const SparseInput& s : sparse)
@@ -67,7 +68,9 @@ void first_layer(const int n[3], const float* noise_padded, const std::vector<Sp
       float* dst = a1_padded + (s.padded - off[t]) * kWidth;
       v8 cur;
       load8(cur, dst);
-      cur += s.environment * we[t] + s.state * ws[t];
+      v8 add = s.condition[0] * wc[0][t] + s.condition[1] * wc[1][t];
+      for (int c = 2; c < nc; ++c) add += s.condition[c] * wc[c][t];
+      cur += add;
       std::memcpy(dst, &cur, sizeof cur);
     }
   clear_border(n, kWidth, a1_padded);
@@ -100,16 +103,16 @@ void first_layer(const int n[3], const float* noise_padded, const std::vector<Sp
 }
 
 MINER_KERNEL_CLONES
-void last_layer_skip(const int n[3], const float* a1_padded, const float* environment_padded,
-                     const float* state_padded, const float* skip_weights, float* logits) {
+void last_layer_skip(const int n[3], int conditions, const float* a1_padded, const float* const* condition_padded,
+                     const float* skip_weights, float* logits) {
   const int nx = n[0], ny = n[1], nz = n[2];
   const std::ptrdiff_t px = nx + 2, pxy = px * (ny + 2);
+  const int nc = std::clamp(conditions, 2, kMaxConditions);
   v8 wa[27];
-  float we[27], ws[27];
+  float wc[kMaxConditions][27];
   for (int t = 0; t < 27; ++t) {
     for (int c = 0; c < kWidth; ++c) wa[t][c] = skip_weights[c * 27 + t];
-    we[t] = skip_weights[kWidth * 27 + t];
-    ws[t] = skip_weights[(kWidth + 1) * 27 + t];
+    for (int c = 0; c < nc; ++c) wc[c][t] = skip_weights[(kWidth + c) * 27 + t];
   }
   std::ptrdiff_t tap[27];
   for (int t = 0; t < 27; ++t) tap[t] = (t / 9 - 1) * pxy + (t / 3 % 3 - 1) * px + (t % 3 - 1);
@@ -120,17 +123,23 @@ void last_layer_skip(const int n[3], const float* a1_padded, const float* enviro
     for (int y = 0; y < ny; ++y) {
       const std::ptrdiff_t row = (z + 1) * pxy + (y + 1) * px + 1;  // padded index of (0, y, z)
       const float* arow = a1_padded + row * kWidth;
-      const float* erow = environment_padded + row;
-      const float* strow = state_padded + row;
+      const float* erow = condition_padded[0] + row;
+      const float* strow = condition_padded[1] + row;
       float* out = logits + (static_cast<std::ptrdiff_t>(z) * ny + y) * nx;
       for (int x = 0; x + 8 <= nx; x += 8) {
         v8 acc[8] = {};
-        v8 sparse_part = {};  // E/2 and S: the 8 voxels in the lanes
+        v8 sparse_part = {};  // the conditions: the 8 voxels in the lanes
         for (int t = 0; t < 27; ++t) {
           v8 e, st;
           load8(e, erow + x + tap[t]);
           load8(st, strow + x + tap[t]);
-          sparse_part += e * we[t] + st * ws[t];
+          v8 add = e * wc[0][t] + st * wc[1][t];  // E/2 and S as one expression (same bytes as before P)
+          for (int c = 2; c < nc; ++c) {
+            v8 b;
+            load8(b, condition_padded[c] + row + x + tap[t]);
+            add += b * wc[c][t];
+          }
+          sparse_part += add;
         }
         for (int t = 0; t < 27; ++t) {
           const v8 w = wa[t];

@@ -183,12 +183,17 @@ TEST_CASE("The 16^3 network (fixtures/sgan/grid16) agrees with PyTorch on both k
 
 TEST_CASE("The network reading P (fixtures/sgan/passability) agrees with PyTorch, and reads P", "[REQ-HEUR-005][REQ-HEUR-015]") {
   const std::string dir = kFixtures + "passability/";
-  const heuristic::Sgan g = heuristic::Sgan::load(dir + "sgan.bin");
+  const std::string blob = miner::read_file_bytes(dir + "sgan.bin");
+  const heuristic::Sgan g = heuristic::Sgan::from_bytes(blob, "passability");
+  const heuristic::Sgan onednn = heuristic::Sgan::from_bytes(blob, "passability", heuristic::Sgan::Kernels::kOneDnn);
   CHECK(g.architecture().passability_channels == 3);
-  CHECK_FALSE(g.own_kernels());  // MINER's own first layer takes (E/2, S, N) only
-  const std::vector<double> errors = heuristic::reference_errors(g, dir + "reference.bin");
-  REQUIRE(errors.size() >= 1);
-  for (double e : errors) CHECK(e <= heuristic::kReferenceTolerance);
+  CHECK(g.own_kernels());  // MINER's sparse first and last layers take the blocked bits too
+  CHECK_FALSE(onednn.own_kernels());
+  for (const heuristic::Sgan* net : {&g, &onednn}) {
+    const std::vector<double> errors = heuristic::reference_errors(*net, dir + "reference.bin");
+    REQUIRE(errors.size() >= 1);
+    for (double e : errors) CHECK(e <= heuristic::kReferenceTolerance);
+  }
   // P is read: the same E, S and noise with every cell blocked across x give another region.
   const heuristic::TensorFile ref = heuristic::read_tensor_file(dir + "reference.bin", "sgan-reference");
   const Eigen::Vector3i d = g.architecture().dims;

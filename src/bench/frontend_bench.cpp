@@ -529,6 +529,16 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
                   (mine.contains(key) ? mine.at(key).dump() : std::string("absent")) + " in the one and " +
                   (common.contains(key) ? common.at(key).dump() : std::string("absent")) + " in the other");
     }
+    // The planner list is per-shard JSON (its summaries), so its names are compared on their own:
+    // a part of other --planners is another campaign, not an incomplete one (fifth campaign).
+    const auto planner_names = [](const nlohmann::json& part) {
+      nlohmann::json list = nlohmann::json::array();
+      for (const auto& s : part.at("planners")) list.push_back(s.at("planner"));
+      return list;
+    };
+    if (planner_names(parts[p]) != planner_names(parts.front()))
+      throw Error("merge: " + names[p] + " and " + names.front() + " are different campaigns: their planners are " +
+                  planner_names(parts[p]).dump() + " and " + planner_names(parts.front()).dump());
     tags.push_back(parts[p].at("shard"));
   }
   require_complete_parts(tags, names, "merge: the campaign");

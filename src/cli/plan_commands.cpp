@@ -1,4 +1,6 @@
 // `miner plan` and `miner region astar` (REQ-PLAN-*, REQ-CLI-004).
+#include <cctype>
+#include <filesystem>
 #include <iomanip>
 #include <memory>
 #include <optional>
@@ -198,7 +200,20 @@ void add_plan_commands(CLI::App& app, std::ostream& out) {
   p->add_option("--region", po->region,
                 "miner's region: sgan (the network, filtered), astar (the A*-dilated oracle) or a "
                 "miner-region-v1 file")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {
+            // "ASTAR" or "Sgan" is a source in the wrong case, not a file that cannot be opened
+            // (fifth campaign). A file of that name, if there is one, is still read.
+            std::string lower = text;
+            for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+            std::error_code ec;
+            if (lower != text && (lower == "astar" || lower == "sgan") && !std::filesystem::exists(text, ec))
+              return text + " is neither a region file nor a source: the sources are written in lower case (" +
+                     lower + ")";
+            return "";
+          },
+          "sgan|astar|FILE"));
   p->add_option("--weights", po->weights, "sGAN weights file (default: the shipped fixtures/sgan/sgan.bin)");
   p->add_flag("--strict-bridge", po->strict_bridge,
               "miner, --region sgan: filter step 5, a collision-free way from start to goal inside the region "

@@ -79,7 +79,8 @@ HeuristicBenchResult run_heuristic_bench(const HeuristicBenchOptions& o, std::os
     // (issue 20, fourth campaign).
     if (static_cast<std::size_t>(o.samples) > f.split.size())
       throw Error(o.samples_option + " " + std::to_string(o.samples) + ": " + data + ": split '" + o.split + "' has only " +
-                  std::to_string(f.split.size()) + " samples (give at most that many, or 0 for all)");
+                  std::to_string(f.split.size()) + " samples (give at most that many, or " +
+                  (o.samples_option == "--samples" ? "0 for all)" : "leave the option out for all)"));
     if (o.samples > 0) f.split.resize(static_cast<std::size_t>(o.samples));
     const Eigen::Vector3i dims(meta["dims"][0].get<int>(), meta["dims"][1].get<int>(), meta["dims"][2].get<int>());
     if (dims != sgan.architecture().dims)

@@ -156,14 +156,24 @@ PaperBenchResult run_paper_bench(const PaperBenchOptions& o, const std::string& 
   // bench heuristic's --samples). The count is the one dataset.json records; the folder itself
   // is checked whole when it is read.
   if (!o.heuristic_data.empty() && o.heuristic_samples_given) {
+    // The samples the folder holds are its test shards' (a part of a sharded dataset records the
+    // whole split's count but holds only its own shards).
     const Json meta = read_json_file(o.heuristic_data + "/dataset.json");
-    const Json* count = nullptr;
-    if (meta.is_object() && meta.contains("splits") && meta["splits"].is_object() && meta["splits"].contains("test") &&
-        meta["splits"]["test"].is_object() && meta["splits"]["test"].contains("count"))
-      count = &meta["splits"]["test"]["count"];
-    if (count && count->is_number_unsigned() && count->get<std::uint64_t>() < static_cast<std::uint64_t>(o.heuristic_samples))
+    std::uint64_t held = 0;
+    bool readable = meta.is_object() && meta.contains("splits") && meta["splits"].is_object() &&
+                    meta["splits"].contains("test") && meta["splits"]["test"].is_object() &&
+                    meta["splits"]["test"].contains("shards") && meta["splits"]["test"]["shards"].is_array();
+    if (readable)
+      for (const Json& shard : meta["splits"]["test"]["shards"]) {
+        if (!shard.is_object() || !shard.contains("count") || !shard["count"].is_number_unsigned()) {
+          readable = false;
+          break;
+        }
+        held += shard["count"].get<std::uint64_t>();
+      }
+    if (readable && held < static_cast<std::uint64_t>(o.heuristic_samples))
       throw Error("--heuristic-samples " + std::to_string(o.heuristic_samples) + ": " + o.heuristic_data +
-                  ": split 'test' has only " + std::to_string(count->get<std::uint64_t>()) +
+                  ": split 'test' has only " + std::to_string(held) +
                   " samples (give at most that many, or leave the option out to measure them all)");
   }
   const auto t0 = Clock::now();

@@ -227,7 +227,9 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
       ->check(kIterationsRange);
   pc->add_option("--weights", p->bench.weights, "sGAN weights (default: the shipped ones)");
   pc->add_option("--heuristic-data", p->bench.heuristic_data, "a `miner dataset` folder (default: generate unseen maps)");
-  pc->add_option("--heuristic-samples", p->bench.heuristic_samples, "unseen maps for the heuristic table (with --heuristic-data: its first N test samples; default all)")
+  pc->add_option("--heuristic-samples", p->bench.heuristic_samples,
+                 "unseen maps generated for the heuristic table (with --heuristic-data: its first N test "
+                 "samples, all of them when not given)")
       ->capture_default_str()->check(integer_in(1, 100000));
   pc->add_option("--heuristic-iterations", p->bench.heuristic_iterations, "MINER vs RRT* budget per heuristic query")
       ->capture_default_str()->check(kIterationsRange);

@@ -240,7 +240,7 @@ struct Sgan::Impl {
   Activation x0, cond1, a1, c2, a2, cat2, c4, a3, cat3, c8, a4, sigma, cat4, m1, m2, d3, d2, catd1, out;
   // The decoder's convolutions split in two: the up-sampled source's part on its coarse grid
   // (UpsampledPart: m2 for dec3, d3 for dec2, d2 for dec1) and the skip inputs' part (cat3,
-  // cat2, [a1, E/2, S]) on the fine grid, which adds the first (oneDNN's sum post-op; for dec1
+  // cat2, [a1, E/2, S[, B]]) on the fine grid, which adds the first (oneDNN's sum post-op; for dec1
   // in shift_sum_plane). Nothing up-sampled is ever copied.
   std::array<UpsampledPart, 3> up;
   // The last layer streams plane by plane (catd1 is one plane of its input, taps a ring of three

@@ -54,9 +54,9 @@ struct SganArchitecture {
 
 class Sgan {
  public:
-  /// Which kernels run the two full-resolution layers (enc1 with its 3 input channels, dec1
-  /// with its one output channel): kFastest uses MINER's own (sgan_kernels.hpp: the sparse
-  /// inputs E/2 and S scattered, the dense ones gathered) for a width-8 network, oneDNN's
+  /// Which kernels run the two full-resolution layers (enc1 with its 3 or 6 input channels,
+  /// dec1 with its one output channel): kFastest uses MINER's own (sgan_kernels.hpp: the sparse
+  /// conditions E/2, S[, B] scattered, the dense ones gathered) for a width-8 network, oneDNN's
   /// otherwise; kOneDnn always oneDNN's (the tests compare the two).
   enum class Kernels { kFastest, kOneDnn };
 
@@ -81,9 +81,9 @@ class Sgan {
   /// Whether MINER's own kernels run enc1 and dec1 (see Kernels).
   bool own_kernels() const;
 
-  /// R = G(N | E, S) on the grid: three inputs of dims.prod() floats (x fastest) — the
-  /// One query at a time per object (the buffers are reused). Inputs: the
-  /// environment already scaled, the state, the noise — and dims.prod() probabilities out.
+  /// R = G(N | E, S[, B]) on the grid. One query at a time per object (the buffers are
+  /// reused). Inputs of dims.prod() floats each (x fastest): the environment already scaled,
+  /// the state, the noise; dims.prod() probabilities out.
   /// `scale` is sigma (ignored, and may be empty, when the network has no scale channels);
   /// `passability` the network's P input, the blocked bits 1 - P_a for a = x, y, z as 0/1,
   /// channel after channel (3 x dims.prod(); ignored, and may be empty, when the network has no

@@ -1,11 +1,12 @@
 #pragma once
 /// \file
 /// MINER's own kernels for the sGAN generator's two full-resolution layers at width 8 (the
-/// shipped network), where oneDNN's are least efficient (3 input channels into enc1; one
+/// shipped network), where oneDNN's are least efficient (3 or 6 input channels into enc1; one
 /// output channel out of dec1). Both read zero-padded grids, so every voxel takes the same
 /// path (zero padding is the convolutions' padding 1), and both skip the work that the
-/// inputs E/2 and S make zero: those two channels are constant over most of the grid and zero
-/// on 70-80 % of it, so their taps are scattered from the nonzero voxels only, while the
+/// conditions (E/2, S and, for a network reading P, the blocked bits) make zero: they are
+/// constant over most of the grid and zero on 70-80 % of it, so their taps are scattered from
+/// the nonzero voxels only, while the
 /// dense channels (the noise N into enc1, a1 into dec1) are gathered. Compiled for
 /// x86-64-v4 (AVX-512), x86-64-v3 (AVX2 + FMA) and the baseline, picked at load time by the
 /// CPU (GCC target_clones): bytes are the same for the same machine, as oneDNN's are.

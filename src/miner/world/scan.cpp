@@ -111,8 +111,9 @@ void validate_scan(const ScanOptions& o, const Map& map, const std::vector<Eigen
 double scan_ray_bound(const ScanOptions& o, double length) {
   const double per_pose = static_cast<double>(o.h_rays) * static_cast<double>(o.v_rays);
   const double poses = std::floor(length / o.spacing) + 2.0;  // resample_path: every spacing, and the end
-  const double turn = o.spin_at_ends ? 2.0 * std::ceil(o.h_rays * 360.0 / o.h_fov_deg) * o.v_rays : 0.0;
-  return poses * per_pose + turn;
+  // A turning end pose casts its full circle instead of its field of view (scan_map).
+  const double turn_pose = std::ceil(o.h_rays * 360.0 / o.h_fov_deg) * static_cast<double>(o.v_rays);
+  return poses * per_pose + (o.spin_at_ends ? 2.0 * (turn_pose - per_pose) : 0.0);
 }
 
 ScanResult scan_map(const Map& map, const std::vector<Eigen::Vector3d>& path, const ScanOptions& o) {

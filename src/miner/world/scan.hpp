@@ -59,8 +59,8 @@ struct ScanResult {
 void validate_scan(const ScanOptions& options, const Map& map, const std::vector<Eigen::Vector3d>& path);
 
 /// Most rays a scan casts along a route of `length` m: h_rays x v_rays at every pose (one each
-/// `spacing` m, both ends included) and, with spin_at_ends, the full turn's
-/// ceil(h_rays 360 / h_fov) x v_rays at the first and the last pose. validate_scan bounds it
+/// `spacing` m, both ends included), except that with spin_at_ends the first and the last pose
+/// cast the full turn's ceil(h_rays 360 / h_fov) x v_rays instead. validate_scan bounds it
 /// by kMaxScanRays; the CLI checks the options alone with length 0 (the ends' poses).
 double scan_ray_bound(const ScanOptions& options, double length);
 

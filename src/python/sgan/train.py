@@ -92,8 +92,8 @@ def cell_of(lo, hi, dims, p):
 
 
 def pool_samples(x, index, meta, pool):
-    """uint8 [N, 3, nz, ny, nx] on the dataset's grid -> the same on the grid of dims / pool
-    (see `pool` above); meta["dims"] is updated."""
+    """uint8 [N, C, nz, ny, nx] on the dataset's grid (C = 4: E, S, T, P) -> uint8 [N, 3, ...] (E, S,
+    T; P is dropped) on the grid of dims / pool (see `pool` above); meta["dims"] is updated."""
     n, ch, nz, ny, nx = x.shape
     if nx % pool or ny % pool or nz % pool:
         raise SystemExit(f"train: --pool {pool} does not divide the grid {meta['dims']}")
@@ -114,7 +114,7 @@ def pool_samples(x, index, meta, pool):
 
 
 def load_split(data, split, pool=1):
-    """One folder's split: (meta, uint8 [N, 3, nz, ny, nx], float32 sigma [N, 3]), on the
+    """One folder's split: (meta, uint8 [N, 4, nz, ny, nx] (E, S, T, P), float32 sigma [N, 3]), on the
     dataset's grid or, with pool > 1, on the coarser one of pool_samples."""
     path = os.path.join(data, "dataset.json")
     if not os.path.isfile(path):
@@ -211,7 +211,8 @@ AXIS_ORDERS = [(0, 1, 2), (1, 0, 2), (0, 2, 1), (2, 1, 0), (1, 2, 0), (2, 0, 1)]
 
 
 def augment(batch, sigma, code, swap_xy, cube=False):
-    """Applies per sample the symmetry code to uint8 [B, 3, nz, ny, nx] and its sigma [B, 3]
+    """Applies per sample the symmetry code to uint8 [B, C, nz, ny, nx] (P's bits, channel 3, turned
+    with the axes) and its sigma [B, 3]
     (code: an int tensor [B] on the batch's device). Bit 0: mirror x, bit 1: mirror y; without
     cube, bit 2: swap x and y (when swap_xy); with cube, bit 2: mirror z and code >> 3 in 0..5
     picks the axis order AXIS_ORDERS[code >> 3], sigma permuted with it."""

@@ -107,7 +107,7 @@ TEST_CASE("Bad scan settings are refused naming the setting", "[REQ-WORLD-016]")
   refuses(o, path, "scan resolution: 1e-05 m is outside the resolutions a map may have");
   o = ScanOptions();
   o.resolution = 0.02;
-  o.h_rays = 10000;
+  o.h_rays = 20000;  // 2e6 rays a pose, 4 poses at most (scan_ray_bound): 8e6 rays of up to ~2.5 m at 2 cm
   o.v_rays = 100;
   refuses(o, path, "would walk");
   // A map 400 m from the origin at 1 cm: beyond OctoMap's 16-bit keys.

@@ -153,25 +153,10 @@ PaperBenchResult run_paper_bench(const PaperBenchOptions& o, const std::string& 
   if (o.heuristic_samples < 1) throw Error("bench paper: --heuristic-samples must be >= 1");
   // More heuristic samples than the given folder's test split holds is refused before any run,
   // naming this command's option (session 23 review: it failed after every other table, naming
-  // bench heuristic's --samples). The count is the one dataset.json records; the folder itself
-  // is checked whole when it is read.
+  // bench heuristic's --samples). The count is the test shards' the folder holds.
   if (!o.heuristic_data.empty() && o.heuristic_samples_given) {
-    // The samples the folder holds are its test shards' (a part of a sharded dataset records the
-    // whole split's count but holds only its own shards).
-    const Json meta = read_json_file(o.heuristic_data + "/dataset.json");
-    std::uint64_t held = 0;
-    bool readable = meta.is_object() && meta.contains("splits") && meta["splits"].is_object() &&
-                    meta["splits"].contains("test") && meta["splits"]["test"].is_object() &&
-                    meta["splits"]["test"].contains("shards") && meta["splits"]["test"]["shards"].is_array();
-    if (readable)
-      for (const Json& shard : meta["splits"]["test"]["shards"]) {
-        if (!shard.is_object() || !shard.contains("count") || !shard["count"].is_number_unsigned()) {
-          readable = false;
-          break;
-        }
-        held += shard["count"].get<std::uint64_t>();
-      }
-    if (readable && held < static_cast<std::uint64_t>(o.heuristic_samples))
+    const std::size_t held = heuristic::split_samples_held(o.heuristic_data, "test");
+    if (held < static_cast<std::size_t>(o.heuristic_samples))
       throw Error("--heuristic-samples " + std::to_string(o.heuristic_samples) + ": " + o.heuristic_data +
                   ": split 'test' has only " + std::to_string(held) +
                   " samples (give at most that many, or leave the option out to measure them all)");

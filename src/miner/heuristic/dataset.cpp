@@ -475,11 +475,26 @@ Json merge_dataset_parts(const std::vector<std::string>& parts, const std::strin
   return doc;
 }
 
-std::vector<Sample> read_split(const std::string& dir, const std::string& split) {
+namespace {
+
+/// The index of split `split` in kSplits; throws naming it when it is none of them.
+int split_index(const std::string& split) {
   const int sp = static_cast<int>(std::find_if(std::begin(kSplits), std::end(kSplits),
                                                [&](const char* s) { return split == s; }) -
                                   std::begin(kSplits));
   if (sp == 3) throw Error("dataset: no split \"" + split + "\" (train, val, test)");
+  return sp;
+}
+
+}  // namespace
+
+std::size_t split_samples_held(const std::string& dir, const std::string& split) {
+  const int sp = split_index(split);
+  return read_layout(read_json_file(dir + "/dataset.json"), dir + "/dataset.json").splits[sp].samples_here;
+}
+
+std::vector<Sample> read_split(const std::string& dir, const std::string& split) {
+  const int sp = split_index(split);
   const DatasetLayout L = read_layout(read_json_file(dir + "/dataset.json"), dir + "/dataset.json");
   const SplitLayout& S = L.splits[sp];
   const std::vector<Json> index = read_index(dir, S, L.seed);

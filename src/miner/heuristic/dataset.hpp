@@ -92,6 +92,10 @@ Json write_dataset(const DatasetOptions& o, const std::string& dir, std::ostream
 /// naming the mismatch or the missing part; `dir` is written as a whole.
 Json merge_dataset_parts(const std::vector<std::string>& parts, const std::string& dir);
 
+/// The samples the folder holds of split `split`, from dataset.json alone (checked as read_split
+/// checks it; a part of a sharded dataset holds only its own shards' samples).
+std::size_t split_samples_held(const std::string& dir, const std::string& split);
+
 /// Reads split `split` back: one Sample per record (metadata from the index).
 std::vector<Sample> read_split(const std::string& dir, const std::string& split);
 

@@ -111,10 +111,6 @@ void encode_voxels(const world::Map& map, const Eigen::Vector3i& dims, double ra
   }
 }
 
-}  // namespace
-
-namespace {
-
 /// The sub-cells (bit x + 4 y + 16 z of kPassabilitySubcells^3) whose centres lie in the closed
 /// box g, for the cell `cell`.
 std::uint64_t subcells_inside(const world::Box& cell, const world::Box& g) {

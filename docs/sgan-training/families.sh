@@ -15,6 +15,9 @@
 #        runs at once, 178 s (session 19)
 #   bash docs/sgan-training/families.sh passability [cuda] -> runs-pass/all, runs-pass/without-F: the shipped
 #        recipe with the network reading channel P (dataset v2; session 24)
+#   bash docs/sgan-training/families.sh data-mixed [miner] -> fam-mixed/, then
+#   bash docs/sgan-training/families.sh mixed  [cuda]    -> runs-mixed/all, runs-mixed/without-F: the
+#        passability recipe with the `mixed` family in every run (domain randomisation; session 25)
 set -euo pipefail
 families=(sim indoor cluttered rooms forest multilevel scan)
 declare -A count=([sim]=2000 [indoor]=1200 [cluttered]=2000 [rooms]=2000 [forest]=2000 [multilevel]=1500 [scan]=700)
@@ -92,6 +95,26 @@ case "${1:-}" in
     train_bg runs-pass/all-e20 runs-pass-all-e20.log 8 20 "" "${all[@]}"  # session 20's longer recipe
     lofo_bg runs-pass ""
     wait ;;
-  *) echo "usage: $0 data [miner] | train [cuda] | cube [cuda] | longer [cuda] | grid16 [cuda] | passability [cuda]" >&2
+  data-mixed)
+    # Session 25: the `mixed` family (REQ-WORLD-020), the other families' parts at random, with
+    # the seeds of `data` (2 cores: ~7 min).
+    miner=${2:-build/release/miner}
+    "$miner" dataset --preset mixed --count 2000 --test-count 40 --seed 11 --jobs 2 --quiet --out fam-mixed ;;
+  mixed)
+    # Session 25: domain randomisation. The passability recipe with fam-mixed (`data-mixed`)
+    # added to every run: all eight families 16 epochs, and each of the seven named families held
+    # out in turn (8 epochs), so the leave-one-out networks still never see the family they are
+    # measured on. Each run writes a checkpoint after every epoch (a run cut short by a time
+    # limit is exported from it with --resume and --epochs of the epochs done).
+    device=${2:-cuda}
+    mkdir -p ckpt-mixed
+    train_bg runs-mixed/all runs-mixed-all.log 8 16 "--checkpoint ckpt-mixed/all.pt" "${all[@]}" fam-mixed
+    for held in "${families[@]}"; do
+      rest=(); for f in "${families[@]}"; do [ "$f" != "$held" ] && rest+=("fam-$f"); done
+      train_bg "runs-mixed/without-$held" "runs-mixed-without-$held.log" 8 8 "--checkpoint ckpt-mixed/without-$held.pt" \
+        "${rest[@]}" fam-mixed
+    done
+    wait ;;
+  *) echo "usage: $0 data [miner] | data-mixed [miner] | train [cuda] | cube [cuda] | longer [cuda] | grid16 [cuda] | passability [cuda] | mixed [cuda]" >&2
      exit 2 ;;
 esac

@@ -33,11 +33,11 @@ std::string fixture_path(const std::string& name) {
 
 }  // namespace
 
-TEST_CASE("Generated maps and their A* paths match the goldens", "[REQ-WORLD-009][REQ-WORLD-011][REQ-WORLD-007][REQ-HARNESS-002]") {
+TEST_CASE("Generated maps and their A* paths match the goldens", "[REQ-WORLD-009][REQ-WORLD-011][REQ-WORLD-020][REQ-WORLD-007][REQ-HARNESS-002]") {
   // Map coordinates are quantised decimals (exact match); path costs are sums of a few
   // hundred terms (abs 1e-9 m covers a different summation order).
   const miner::testing::Tolerance tol{1e-9, 0.0};
-  for (const auto& [preset, seed] : std::vector<std::pair<std::string, std::uint64_t>>{{"sim", 1}, {"indoor", 1}, {"cluttered", 1}, {"rooms", 1}, {"forest", 3}, {"multilevel", 3}}) {
+  for (const auto& [preset, seed] : std::vector<std::pair<std::string, std::uint64_t>>{{"sim", 1}, {"indoor", 1}, {"cluttered", 1}, {"rooms", 1}, {"forest", 3}, {"multilevel", 3}, {"mixed", 1}}) {
     const Map map = generate_map(generator_preset(preset), seed);
     const nlohmann::json actual = {{"map", map.to_json()}, {"astar", astar_summary(map)}};
     MINER_REQUIRE_GOLDEN("world/" + preset + "-seed-" + std::to_string(seed) + ".json", actual, tol);

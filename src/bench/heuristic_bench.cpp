@@ -110,6 +110,8 @@ HeuristicBenchResult run_heuristic_bench(const HeuristicBenchOptions& o, std::os
       rec.connected = q.report.connected;
       rec.safe = q.report.safe;
       rec.raw_cells = q.report.raw_cells;
+      rec.threshold = q.report.threshold;
+      rec.widened = q.report.threshold < sgan.architecture().threshold;
       rec.cells = q.report.cells;
       rec.bridge_cells = q.report.bridge_cells;
       rec.strict_cells = q.report.strict_cells;
@@ -119,7 +121,7 @@ HeuristicBenchResult run_heuristic_bench(const HeuristicBenchOptions& o, std::os
       const world::VoxelGrid voxels(map, preset.robot_radius);
       const plan::HeuristicRegion raw(map.bounds(), sgan.architecture().dims,
                                       std::vector<double>(q.probabilities.begin(), q.probabilities.end()),
-                                      sgan.architecture().threshold, "sgan-raw");
+                                      q.report.threshold, "sgan-raw");  // the rule's (REQ-HEUR-016)
       const heuristic::StrictQuality raw_strict = heuristic::strict_quality(map, voxels, raw, s.start, s.goal);
       const heuristic::StrictQuality strict = heuristic::strict_quality(map, voxels, q.region, s.start, s.goal);
       const plan::HeuristicRegion truth(map.bounds(), sgan.architecture().dims,
@@ -157,9 +159,10 @@ namespace {
 
 /// Quality, timing and planner figures over a set of samples (all, or one family's).
 nlohmann::json quality_json(const std::vector<HeuristicSampleRecord>& samples, bool planners) {
-  std::vector<double> inference, region, raw_cells, cells, filter;
+  std::vector<double> inference, region, raw_cells, cells, filter, thresholds;
   std::size_t bridged = 0, strict_bridged = 0;
   for (const auto& s : samples) {
+    thresholds.push_back(s.threshold);
     inference.push_back(s.inference_ms);
     filter.push_back(s.filter_ms);
     strict_bridged += s.strict_cells > 0 ? 1 : 0;
@@ -185,6 +188,8 @@ nlohmann::json quality_json(const std::vector<HeuristicSampleRecord>& samples, b
                       {"connectivity_rate_strict_truth", rate(samples, &R::truth_connected_strict)},
                       {"safety_rate_strict_truth", rate(samples, &R::truth_safe_strict)},
                       {"bridged_rate", share(bridged)},
+                      {"threshold_median", num(median(thresholds))},
+                      {"widened_rate", rate(samples, &R::widened)},
                       {"raw_cells_median", num(median(raw_cells))},
                       {"cells_median", num(median(cells))},
                       {"strict_bridged_rate", share(strict_bridged)},

@@ -43,6 +43,10 @@ struct HeuristicSampleRecord {
   /// network would score.
   bool truth_connected_strict = false, truth_safe_strict = false;
   std::size_t raw_cells = 0, cells = 0, bridge_cells = 0;
+  /// Step 1's threshold for this query and whether the widest rule lowered it below the
+  /// weights' own (REQ-HEUR-016).
+  double threshold = 0.0;
+  bool widened = false;
   std::size_t strict_cells = 0;     ///< filter step 5: cells added
   bool strict_witness = false;      ///< step 5 found a checked polyline inside H
   double filter_ms = 0.0;

@@ -301,9 +301,11 @@ ResolvedQuery resolve_query(const QueryOptions& q) {
   const double radius = q.radius >= 0.0 ? q.radius : (map.query() ? map.query()->robot_radius : 0.0);
   // A stored query's fault names the map file and the field (issue 20, fourth campaign: "start
   // ... lies inside obstacle 0" named neither).
-  if (q.start.empty()) map.require_free(start, radius, q.map + ": query.start");
-  if (q.goal.empty()) map.require_free(goal, radius, q.map + ": query.goal");
-  return {std::move(map), start, goal, radius};
+  const std::string start_name = q.start.empty() ? q.map + ": query.start" : "--start";
+  const std::string goal_name = q.goal.empty() ? q.map + ": query.goal" : "--goal";
+  if (q.start.empty()) map.require_free(start, radius, start_name);
+  if (q.goal.empty()) map.require_free(goal, radius, goal_name);
+  return {std::move(map), start, goal, radius, start_name, goal_name};
 }
 
 void add_output_options(CLI::App* cmd, OutputOptions& o) {

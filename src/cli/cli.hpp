@@ -152,6 +152,8 @@ struct ResolvedQuery {
   Eigen::Vector3d start;
   Eigen::Vector3d goal;
   double radius = 0.0;
+  /// Where each end came from, for messages: "map.json: query.start" or "--start".
+  std::string start_name, goal_name;
 };
 /// Loads the map and fills start/goal/radius; throws miner::Error if the map has no
 /// query and --start/--goal are missing.

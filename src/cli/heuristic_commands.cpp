@@ -106,7 +106,7 @@ void add_heuristic_commands(CLI::App& app, std::ostream& out) {
   d->add_option("--val-fraction", o->dataset.val_fraction, "share of --count kept for validation")->capture_default_str()
       ->check(finite_in(0.0, 0.99));
   d->add_option("--seed", o->dataset.seed, "master seed")->capture_default_str()->check(kUnsigned64);
-  d->add_option("--preset", o->dataset.preset, "map preset (sim, indoor, cluttered, rooms, forest, multilevel, scan)")->capture_default_str()->check(kMapPreset);
+  d->add_option("--preset", o->dataset.preset, "map preset (sim, indoor, cluttered, rooms, forest, multilevel, mixed, scan)")->capture_default_str()->check(kMapPreset);
   d->add_option("--dims", o->dims, "heuristic grid nx ny nz")->expected(3)->capture_default_str()->check(integer_in(4, 256));
   d->add_option("--dilation", o->dataset.dilation, "cells around start, goal and path cells (1: 3x3x3)")->capture_default_str()
       ->check(integer_in(0, plan::HeuristicRegion::kMaxDilation));

@@ -208,7 +208,7 @@ void run_astar(const AstarOptions& o, std::ostream& out) {
   const Eigen::Vector3d& goal = q.goal;
   const double radius = q.radius;
   const world::VoxelGrid grid(map, radius);
-  const world::GridPath path = world::astar(map, grid, start, goal);
+  const world::GridPath path = world::astar(map, grid, start, goal, q.start_name, q.goal_name);
 
   Json points = Json::array();
   for (const auto& p : path.points) points.push_back(vec3_json(p));
@@ -254,7 +254,7 @@ void run_scan(const ScanCliOptions& o, std::ostream& out) {
   if (options.body_radius < 0.0) options.body_radius = q.radius;
   // The sensor flies the A* path of the query (the route a mapping flight would take).
   const world::VoxelGrid grid(q.map, q.radius);
-  const world::GridPath route = world::astar(q.map, grid, q.start, q.goal);
+  const world::GridPath route = world::astar(q.map, grid, q.start, q.goal, q.start_name, q.goal_name);
   const world::ScanResult scan = world::scan_map(q.map, route.points, options);
   // Read back from the bytes and both files written as one: a failure leaves both as they were.
   const Map scanned = Map::from_voxels({world::parse_octree(scan.bt, o.out), world::UnknownPolicy::kOccupied,
@@ -338,10 +338,10 @@ void add_map_commands(CLI::App& app, std::ostream& out) {
   map->require_subcommand(1);
 
   auto gen = std::make_shared<GenOptions>();
-  CLI::App* g = map->add_subcommand("gen", "generate a seeded map (presets: sim, indoor, cluttered, rooms, forest, multilevel, scan)");
+  CLI::App* g = map->add_subcommand("gen", "generate a seeded map (presets: sim, indoor, cluttered, rooms, forest, multilevel, mixed, scan)");
   g->add_option("--preset", gen->preset,
                 "map preset: sim (100 m, paper Sec. V-B), indoor (10 m site, Sec. V-D), a family drawing its "
-                "size per map: cluttered, rooms, forest, multilevel, or scan: the voxels a simulated mapping run "
+                "size per map: cluttered, rooms, forest, multilevel, mixed (their parts at random), or scan: the voxels a simulated mapping run "
                 "leaves over a map of another preset (a .json gets its .bt beside it)")
       ->capture_default_str()->check(kMapPreset);
   g->add_option("--base", gen->base, "scan: the preset the mapping run flies over (default: drawn per map)")

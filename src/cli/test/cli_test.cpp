@@ -63,6 +63,26 @@ const char* kPillarMap = R"({"format": "miner-map-v1",
   "bounds": {"min": [0,0,0], "max": [10,10,10]}, "resolution": 1.0,
   "obstacles": [{"type": "box", "min": [4,4,0], "max": [6,6,10]}]})";
 
+/// A command line the CLI must refuse: its exit code and a part of its message.
+struct Refusal {
+  std::vector<std::string> args;
+  int code;
+  std::string message;
+};
+
+/// Runs each refusal: the exit code, the message, and the program's "miner: " prefix.
+void check_refusals(const std::vector<Refusal>& cases) {
+  for (const auto& c : cases) {
+    const Run r = miner_cli(c.args);
+    std::string line;
+    for (const std::string& a : c.args) line += (line.empty() ? "" : " ") + a;
+    INFO("miner " << line << "\nexpected message: " << c.message << "\nstderr: " << r.err);
+    CHECK(r.code == c.code);
+    CHECK_THAT(r.err, Contains(c.message));
+    CHECK_THAT(r.err, Contains("miner: "));
+  }
+}
+
 }  // namespace
 
 TEST_CASE("miner --help and --version exit 0 and no command is a usage error", "[REQ-CLI-001][REQ-CLI-002]") {
@@ -180,12 +200,7 @@ TEST_CASE("map convert goes to OctoMap and back", "[REQ-CLI-001][REQ-WORLD-003]"
 
 TEST_CASE("Bad input: each case names what is wrong and exits non-zero", "[REQ-CLI-002][REQ-WORLD-002][REQ-WORLD-010]") {
   const std::string map = write("pillar-bad.json", kPillarMap);
-  struct Case {
-    std::vector<std::string> args;
-    int code;
-    std::string message;
-  };
-  const std::vector<Case> cases = {
+  const std::vector<Refusal> cases = {
       {{"astar", "--map", dir() + "/nope.json"}, 1, "nope.json: cannot open file"},
       {{"astar", "--map", write("malformed.json", "{\"format\": ")}, 1, "malformed JSON"},
       {{"astar", "--map", write("tag.json", R"({"format": "miner-map-v0"})")}, 1, "unknown format tag"},
@@ -227,13 +242,7 @@ TEST_CASE("Bad input: each case names what is wrong and exits non-zero", "[REQ-C
       {{"bench", "frontend", "--map", map, "--planners"}, 2, "--planners: needs 1 value, got none"},
       {{"map", "info", "--map", write("garbage.bt", "not an octree")}, 1, "not an OctoMap file"},
   };
-  for (const auto& c : cases) {
-    const Run r = miner_cli(c.args);
-    INFO("args: " << c.args.at(0) << " ... expected message: " << c.message << "\nstderr: " << r.err);
-    CHECK(r.code == c.code);
-    CHECK_THAT(r.err, Contains(c.message));
-    CHECK_THAT(r.err, Contains("miner: "));
-  }
+  check_refusals(cases);
   // A zero written with a tiny exponent is still zero, not an underflow.
   CHECK(miner_cli({"astar", "--map", map, "--start", "1", "1", "1", "--goal", "2", "2", "2", "--radius", "0e-400"}).code == 0);
 }
@@ -250,12 +259,7 @@ TEST_CASE("Options a run would not read, clamped values and mismatched suffixes 
   const std::string two_tests = dir() + "/two-tests";
   REQUIRE(miner_cli({"dataset", "--preset", "indoor", "--count", "1", "--test-count", "2", "--quiet", "--out", two_tests})
               .code == 0);
-  struct Case {
-    std::vector<std::string> args;
-    int code;
-    std::string message;
-  };
-  const std::vector<Case> cases = {
+  const std::vector<Refusal> cases = {
       {{"astar", "--map", map, "--unknown", "free"}, 2, "--unknown: " + map + " is a map of boxes, with no voxels"},
       {{"map", "info", "--map", map, "--unknown", "occupied"}, 2, "no unknown space"},
       {{"plan", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5", "--planner", "rrtstar", "--tree"}, 2,
@@ -319,12 +323,7 @@ TEST_CASE("Options a run would not read, clamped values and mismatched suffixes 
          "query": {"start": [5,5,5], "goal": [9,9,9], "robot_radius": 0.1}})")},
        1, "query-in-4th.json: query.start (5, 5, 5) lies inside obstacle 0"},
   };
-  for (const auto& c : cases) {
-    const Run r = miner_cli(c.args);
-    INFO("args: " << c.args.at(0) << " " << c.args.at(1) << " ... expected message: " << c.message << "\nstderr: " << r.err);
-    CHECK(r.code == c.code);
-    CHECK_THAT(r.err, Contains(c.message));
-  }
+  check_refusals(cases);
   // --help wins over anything else on the line.
   const Run help = miner_cli({"astar", "--help", "--radius", "-5"});
   CHECK(help.code == 0);
@@ -340,12 +339,12 @@ TEST_CASE("Fifth campaign: empty shards, coinciding ends, far clouds and shard p
   std::string far = "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
   far += "1 1 1\n1600 1600 5\n";
   const std::string cloud = write("far-5th.ply", far);
-  struct Case {
-    std::vector<std::string> args;
-    int code;
-    std::string message;
-  };
-  const std::vector<Case> cases = {
+  // The start is 0.87 m from the box, yet its 1 m cell meets the box grown by the radius.
+  const std::string blocked_cell = write("blocked-cell-5th.json", R"({"format": "miner-map-v1",
+    "bounds": {"min": [0,0,0], "max": [10,10,10]}, "resolution": 1.0,
+    "obstacles": [{"type": "box", "min": [2,2,2], "max": [3,3,3]}],
+    "query": {"start": [1.5,1.5,1.5], "goal": [8.5,8.5,8.5], "robot_radius": 0.2}})");
+  const std::vector<Refusal> cases = {
       {{"bench", "frontend", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5", "--planners", "rrtstar",
         "--runs", "1", "--shard", "1/2", "--json"},
        2, "--shard 1/2: with --runs 1 this shard holds no run"},
@@ -370,13 +369,12 @@ TEST_CASE("Fifth campaign: empty shards, coinciding ends, far clouds and shard p
        "the clouds and their sensor origins span (0, 0, 0) - (1600, 1600, 5)"},
       // A fault the command finds in its own options reads as a usage error, like the parser's.
       {{"astar", "--map", map, "--unknown", "free"}, 2, "miner: usage error: --unknown:"},
+      // An end free on the map but in a blocked grid cell named neither the file nor the option.
+      {{"astar", "--map", blocked_cell}, 1, "blocked-cell-5th.json: query.start (1.5, 1.5, 1.5) lies in an occupied grid cell"},
+      {{"astar", "--map", blocked_cell, "--start", "8.5", "1.5", "1.5", "--goal", "1.5", "1.5", "1.5"}, 1,
+       "--goal (1.5, 1.5, 1.5) lies in an occupied grid cell"},
   };
-  for (const auto& c : cases) {
-    const Run r = miner_cli(c.args);
-    INFO("args: " << c.args.at(0) << " " << c.args.at(1) << " ... expected message: " << c.message << "\nstderr: " << r.err);
-    CHECK(r.code == c.code);
-    CHECK_THAT(r.err, Contains(c.message));
-  }
+  check_refusals(cases);
   const Run far_run = miner_cli({"map", "import", "--cloud", cloud, "--origin", "0", "0", "0", "--resolution", "0.1",
                                  "--out", dir() + "/i5.bt"});
   CHECK_THAT(far_run.err, Contains("more than the") && Contains("a map may have"));

@@ -32,7 +32,94 @@ void for_neighbours(const Eigen::Vector3i& dims, const Eigen::Vector3i& c, F&& f
       }
 }
 
+/// A chain's step from cell u to its neighbour v: v not solid and, with channel P, every axis
+/// the step moves along passable in both cells.
+bool step_allowed(const std::vector<std::uint8_t>& env, const std::vector<std::uint8_t>& passability,
+                  const Eigen::Vector3i& cu, std::size_t u, const Eigen::Vector3i& cv, std::size_t v) {
+  if (env[v] == kSolid) return false;
+  if (passability.empty()) return true;
+  std::uint8_t along = 0;
+  for (int a = 0; a < 3; ++a)
+    if (cv[a] != cu[a]) along |= static_cast<std::uint8_t>(1u << a);
+  return (passability[u] & along) == along && (passability[v] & along) == along;
+}
+
+/// Whether a chain of allowed steps through cells with R >= t joins start and goal (both
+/// ends with R >= t): a breadth-first search over those cells alone.
+bool chain_at(const std::vector<float>& p, const std::vector<std::uint8_t>& env,
+              const std::vector<std::uint8_t>& passability, const Eigen::Vector3i& dims, std::size_t is, std::size_t ig,
+              double t) {
+  if (!(p[is] >= t) || !(p[ig] >= t)) return false;
+  std::vector<std::uint8_t> seen(p.size(), 0);
+  std::vector<std::size_t> queue{is};
+  seen[is] = 1;
+  for (std::size_t head = 0; head < queue.size(); ++head) {
+    const std::size_t u = queue[head];
+    if (u == ig) return true;
+    const Eigen::Vector3i cu = cell_coords(dims, u);
+    for_neighbours(dims, cu, [&](const Eigen::Vector3i& cv, std::size_t v) {
+      if (!seen[v] && p[v] >= t && step_allowed(env, passability, cu, u, cv, v)) {
+        seen[v] = 1;
+        queue.push_back(v);
+      }
+    });
+  }
+  return false;
+}
+
 }  // namespace
+
+std::optional<float> widest_threshold(const std::vector<float>& p, const std::vector<std::uint8_t>& env,
+                                      const Eigen::Vector3i& dims, const Eigen::Vector3i& start_cell,
+                                      const Eigen::Vector3i& goal_cell, const std::vector<std::uint8_t>& passability) {
+  const auto n = static_cast<std::size_t>(dims.prod());
+  if (p.size() != n || env.size() != n || (!passability.empty() && passability.size() != n))
+    throw Error("region filter: grids of different sizes");
+  const std::size_t is = cell_index(dims, start_cell.x(), start_cell.y(), start_cell.z());
+  const std::size_t ig = cell_index(dims, goal_cell.x(), goal_cell.y(), goal_cell.z());
+  if (env[is] == kSolid || env[ig] == kSolid) return std::nullopt;
+  // best[v]: the largest bottleneck of a chain from the start to v found so far; a max-heap
+  // settles cells in decreasing bottleneck, so the goal's first pop is its widest chain.
+  std::vector<float> best(n, -1.0f);
+  std::vector<std::uint8_t> settled(n, 0);
+  using Item = std::pair<float, std::size_t>;
+  std::priority_queue<Item> open;
+  best[is] = p[is];
+  open.emplace(p[is], is);
+  while (!open.empty()) {
+    const float b = open.top().first;
+    const std::size_t u = open.top().second;
+    open.pop();
+    if (settled[u]) continue;
+    settled[u] = 1;
+    if (u == ig) return b;
+    const Eigen::Vector3i cu = cell_coords(dims, u);
+    for_neighbours(dims, cu, [&](const Eigen::Vector3i& cv, std::size_t v) {
+      if (settled[v] || !step_allowed(env, passability, cu, u, cv, v)) return;
+      const float w = std::min(b, p[v]);
+      if (w > best[v]) {
+        best[v] = w;
+        open.emplace(w, v);
+      }
+    });
+  }
+  return std::nullopt;
+}
+
+double region_threshold(const std::vector<float>& p, const std::vector<std::uint8_t>& env, const Eigen::Vector3i& dims,
+                        const Eigen::Vector3i& start_cell, const Eigen::Vector3i& goal_cell, double threshold,
+                        bool widest, const std::vector<std::uint8_t>& passability) {
+  if (!widest) return threshold;
+  const std::size_t is = cell_index(dims, start_cell.x(), start_cell.y(), start_cell.z());
+  const std::size_t ig = cell_index(dims, goal_cell.x(), goal_cell.y(), goal_cell.z());
+  // Most queries: the fixed threshold's cells already hold a chain (a search of those alone).
+  if (env[is] != kSolid && env[ig] != kSolid && chain_at(p, env, passability, dims, is, ig, threshold)) return threshold;
+  std::optional<float> w = widest_threshold(p, env, dims, start_cell, goal_cell, passability);
+  // P is decided on sub-cells: a door narrower than one may leave no chain through it; then
+  // the chain is sought without P.
+  if (!w && !passability.empty()) w = widest_threshold(p, env, dims, start_cell, goal_cell);
+  return w ? std::min(threshold, static_cast<double>(*w)) : threshold;
+}
 
 FilteredRegion filter_region(const std::vector<float>& p, const std::vector<std::uint8_t>& env,
                              const Eigen::Vector3i& dims, const Eigen::Vector3i& start_cell,
@@ -43,6 +130,7 @@ FilteredRegion filter_region(const std::vector<float>& p, const std::vector<std:
   FilterReport& r = out.report;
   std::vector<std::uint8_t> mask(n, 0);
   for (std::size_t i = 0; i < n; ++i) mask[i] = p[i] >= threshold ? 1 : 0;
+  r.threshold = threshold;
   r.raw_cells = static_cast<std::size_t>(std::count(mask.begin(), mask.end(), 1));
   r.raw_safe = solid_cells_in(mask, env) == 0;
   const std::size_t is = cell_index(dims, start_cell.x(), start_cell.y(), start_cell.z());
@@ -152,7 +240,11 @@ HeuristicQuery query_region(const Sgan& sgan, const world::Map& map, const Eigen
   std::vector<float> prob = sgan.predict(env, state, encoded.passability, b, robot_radius, rng);
   const double inference_ms = elapsed_ms(t0);
   t0 = std::chrono::steady_clock::now();
-  FilteredRegion f = filter_region(prob, env, dims, cell_of(b, dims, start), cell_of(b, dims, goal), arch.threshold);
+  const Eigen::Vector3i start_cell = cell_of(b, dims, start), goal_cell = cell_of(b, dims, goal);
+  const double threshold =
+      region_threshold(prob, env, dims, start_cell, goal_cell, arch.threshold, arch.threshold_rule == ThresholdRule::kWidest,
+                       encoded.passability);
+  FilteredRegion f = filter_region(prob, env, dims, start_cell, goal_cell, threshold);
   std::vector<Eigen::Vector3d> witness;
   if (filter && strict) {
     StrictBridgeReport s = strict_bridge(map, robot_radius, dims, env, f.mask, start, goal);
@@ -172,7 +264,7 @@ HeuristicQuery query_region(const Sgan& sgan, const world::Map& map, const Eigen
     for (std::size_t i = 0; i < prob.size(); ++i) probabilities[i] = static_cast<double>(prob[i]);
   }
   const double filter_ms = elapsed_ms(t0);
-  plan::HeuristicRegion region(b, dims, std::move(probabilities), filter ? 0.5 : arch.threshold,
+  plan::HeuristicRegion region(b, dims, std::move(probabilities), filter ? 0.5 : threshold,
                                filter ? "sgan-filtered" : "sgan-raw");
   return {std::move(region), std::move(prob), std::move(env), f.report, std::move(witness), encode_ms, inference_ms,
           filter_ms};

@@ -4,7 +4,8 @@
 /// and a query, run the sGAN, threshold, filter, hand the region to the MINER sampler.
 ///
 /// The filter (REQ-HEUR-007), on the heuristic grid (grid.hpp):
-///   1. threshold: raw H = {cells with R >= threshold};
+///   1. threshold: raw H = {cells with R >= threshold}, the threshold fixed or, with the
+///      weights' rule "widest" (REQ-HEUR-016), lowered to the widest start-goal chain's;
 ///   2. safety: drop the solid cells; add the start and goal cells (never solid: the query
 ///      points are free for the robot radius);
 ///   3. islands: keep only the 26-connected components that hold the start or the goal cell;
@@ -39,6 +40,7 @@ namespace miner::heuristic {
 class Sgan;
 
 struct FilterReport {
+  double threshold = 0.0;          ///< the threshold step 1 used (the rule's, REQ-HEUR-016)
   std::size_t raw_cells = 0;       ///< cells with R >= threshold
   bool raw_connected = false;      ///< REQ-HEUR-004 on the raw cells
   bool raw_safe = false;
@@ -63,6 +65,26 @@ struct FilteredRegion {
 FilteredRegion filter_region(const std::vector<float>& probabilities, const std::vector<std::uint8_t>& environment,
                              const Eigen::Vector3i& dims, const Eigen::Vector3i& start_cell,
                              const Eigen::Vector3i& goal_cell, double threshold);
+
+/// The widest-path threshold (REQ-HEUR-016): the largest t such that the non-solid cells with
+/// R >= t join the start cell to the goal cell (26-connected), i.e. the maximum over chains of
+/// non-solid cells from start to goal of the smallest R on the chain (both ends included).
+/// nullopt when no chain of non-solid cells joins them (or an end is solid). With channel P
+/// (`passability` not empty, grid.hpp) a step that moves along axis a needs bit a in both of
+/// its cells, so the chain does not cross a wall cell where its free space does not.
+/// A modified Dijkstra (each cell settled once, at its best bottleneck): O(n log n).
+std::optional<float> widest_threshold(const std::vector<float>& probabilities, const std::vector<std::uint8_t>& environment,
+                                      const Eigen::Vector3i& dims, const Eigen::Vector3i& start_cell,
+                                      const Eigen::Vector3i& goal_cell,
+                                      const std::vector<std::uint8_t>& passability = {});
+
+/// Step 1's threshold for the architecture's rule: the fixed threshold t0, or with the rule
+/// "widest" min(t0, widest_threshold) (t0 when no chain exists), so the raw region joins start
+/// and goal on the grid whenever the non-solid cells do, and is the fixed rule's when that
+/// already does.
+double region_threshold(const std::vector<float>& probabilities, const std::vector<std::uint8_t>& environment,
+                        const Eigen::Vector3i& dims, const Eigen::Vector3i& start_cell, const Eigen::Vector3i& goal_cell,
+                        double threshold, bool widest, const std::vector<std::uint8_t>& passability = {});
 
 /// One heuristic query (Alg. 1 lines 2-3) for `map` and a start and goal.
 struct HeuristicQuery {

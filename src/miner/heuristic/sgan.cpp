@@ -350,8 +350,8 @@ void Sgan::Impl::build(const TensorFile& f, Sgan::Kernels which) {
   for (const char* key : {"final", "training"})
     if (a.has(key) && !a.at(key).value().is_object()) a.at(key).fail("must be an object (the training record)");
   const JsonField ar = a.at("architecture");
-  ar.only_keys({"name", "width", "dims", "environment_scale", "threshold", "layers", "scale_channels", "scale_divisor",
-                "passability_channels"});
+  ar.only_keys({"name", "width", "dims", "environment_scale", "threshold", "threshold_rule", "layers", "scale_channels",
+                "scale_divisor", "passability_channels"});
   if (ar.at("name").string() != "sgan-unet4") ar.at("name").fail("unknown architecture (expected sgan-unet4)");
   if (ar.has("layers")) {  // optional (the tensors name the layers); when given it must be right
     const std::vector<std::string> expected{"enc1", "enc2", "enc3", "enc4", "mid1", "mid2", "dec3", "dec2", "dec1"};
@@ -373,6 +373,12 @@ void Sgan::Impl::build(const TensorFile& f, Sgan::Kernels which) {
   if (!(arch.environment_scale > 0.0)) ar.at("environment_scale").fail("must be positive");
   arch.threshold = ar.at("threshold").number();
   if (!(arch.threshold > 0.0 && arch.threshold < 1.0)) ar.at("threshold").fail("must be in (0, 1)");
+  // Absent in the files written before the widest rule (REQ-HEUR-016): fixed.
+  if (ar.has("threshold_rule")) {
+    const std::string rule = ar.at("threshold_rule").string();
+    if (rule == "widest") arch.threshold_rule = ThresholdRule::kWidest;
+    else if (rule != "fixed") ar.at("threshold_rule").fail("must be \"fixed\" or \"widest\", not \"" + rule + "\"");
+  }
   // Absent in the files written before the scale input (one family, one scale).
   arch.scale_channels = ar.has("scale_channels") ? ar.at("scale_channels").integer() : 0;
   if (arch.scale_channels != 0 && arch.scale_channels != 3) ar.at("scale_channels").fail("must be 0 or 3 (x, y, z)");

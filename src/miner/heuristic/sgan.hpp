@@ -36,6 +36,10 @@ class Rng;
 
 namespace miner::heuristic {
 
+/// How step 1 of the filter thresholds R (REQ-HEUR-016): at the fixed threshold, or at the
+/// smaller of it and the widest start-goal chain's bottleneck (region_filter.hpp).
+enum class ThresholdRule { kFixed, kWidest };
+
 struct SganArchitecture {
   int width = 8;
   /// 3 when the network is told its cells' metric size (issue 16 item 2): sigma, per axis
@@ -46,6 +50,8 @@ struct SganArchitecture {
   Eigen::Vector3i dims = plan::HeuristicRegion::default_dims();  ///< nx, ny, nz; each divisible by 8
   double environment_scale = 0.5;   ///< E levels 0/1/2 enter the network as E * scale
   double threshold = 0.5;           ///< cell in the raw region iff R >= threshold
+  /// "threshold_rule" in the file ("fixed" when absent, or "widest").
+  ThresholdRule threshold_rule = ThresholdRule::kFixed;
   /// 3 when the network reads channel P (grid.hpp: whether each cell's free space joins its
   /// faces across x, y, z), as the blocked bits 1 - P_a, beside E and S in every condition c_k;
   /// 0 for the networks before it.

@@ -92,9 +92,9 @@ double octile_distance(const Eigen::Vector3i& a, const Eigen::Vector3i& b, doubl
 }
 
 GridPath astar(const Map& map, const VoxelGrid& grid, const Eigen::Vector3d& start,
-               const Eigen::Vector3d& goal) {
-  const Eigen::Vector3i s = endpoint_cell(map, grid, start, "start");
-  const Eigen::Vector3i g = endpoint_cell(map, grid, goal, "goal");
+               const Eigen::Vector3d& goal, const std::string& start_name, const std::string& goal_name) {
+  const Eigen::Vector3i s = endpoint_cell(map, grid, start, start_name);
+  const Eigen::Vector3i g = endpoint_cell(map, grid, goal, goal_name);
   // Index arithmetic in the inner loop: A* runs inside every generated map's solvability
   // check and every dataset sample, so this loop is most of their cost.
   const std::array<GridMove, 26> moves = grid_moves(grid.dims());

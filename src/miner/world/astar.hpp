@@ -58,9 +58,11 @@ inline bool block_free(const Grid& grid, std::size_t from, const GridMove& m) {
 ///
 /// Throws miner::Error if start or goal is out of bounds, in collision (naming the
 /// obstacle) or in an occupied grid cell, and miner::NoSolution if the goal's cell
-/// is not reachable from the start's.
+/// is not reachable from the start's. Those messages call the ends `start_name` and
+/// `goal_name` (a command passes where they came from: "map.json: query.start", "--goal").
 GridPath astar(const Map& map, const VoxelGrid& grid, const Eigen::Vector3d& start,
-               const Eigen::Vector3d& goal);
+               const Eigen::Vector3d& goal, const std::string& start_name = "start",
+               const std::string& goal_name = "goal");
 
 /// The grid distance between two cells ignoring obstacles (the consistent heuristic):
 /// res * (sqrt3 d3 + sqrt2 (d2 - d3) + (d1 - d2)) for sorted |deltas| d1 >= d2 >= d3.

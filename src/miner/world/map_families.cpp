@@ -1,5 +1,5 @@
 // Map families beyond the paper's presets (REQ-WORLD-011): cluttered, rooms, forest,
-// multilevel. Each draws its obstacles and query for bounds and a resolution that the
+// multilevel; and mixed (REQ-WORLD-020), their parts at random. Each draws its obstacles and query for bounds and a resolution that the
 // caller (generate_map) drew per map, so one family spans sizes and aspect ratios.
 #include <algorithm>
 #include <cmath>
@@ -315,7 +315,138 @@ FamilyDraw multilevel(const GeneratorPreset& p, Rng& rng, const Box& bounds) {
   return d;
 }
 
+// -------------------------------------------------------------------- mixed
+/// Structural primitives at random (domain randomisation, REQ-WORLD-020): slabs across any
+/// axis, as thin as 0.1 m, with openings of any size from a squeeze to a gap, those across the
+/// query's axis standing between start and goal; free boxes; rods (pillars, beams) along any
+/// axis. No layout of a named family, only its parts, so that a network trained with it meets
+/// walls with doors, floors with holes and trunks in every orientation and scale.
+FamilyDraw mixed(const GeneratorPreset& p, Rng& rng, const Box& bounds) {
+  constexpr double kMinSlabRoom = 6.0;  // an axis shorter than this gets no slab across it, m
+  const Eigen::Vector3d e = bounds.extent();
+  const double size = std::cbrt(e.prod());
+  const double margin = 2.0 * p.robot_radius;
+  const double passage = 2.0 * p.robot_radius + 0.3;  // the narrowest opening a slab is sure to have, m
+  FamilyDraw d;
+  d.query.robot_radius = p.robot_radius;
+  // The query's axis: the longest one half the time, any other with room for slabs otherwise.
+  int axis_q = 0;
+  e.maxCoeff(&axis_q);
+  if (rng.uniform01() < 0.5) {
+    const int k = static_cast<int>(rng.uniform_index(3));
+    if (e[k] >= kMinSlabRoom) axis_q = k;
+  }
+  Eigen::Vector3d lo_frac(0.1, 0.1, 0.1), hi_frac(0.9, 0.9, 0.9);
+  lo_frac[axis_q] = 0.03;
+  hi_frac[axis_q] = 0.1;
+  d.query.start = inside(bounds, point_at(rng, bounds, lo_frac, hi_frac), margin);
+  lo_frac[axis_q] = 0.9;
+  hi_frac[axis_q] = 0.97;
+  d.query.goal = inside(bounds, point_at(rng, bounds, lo_frac, hi_frac), margin);
+  const double keep_free = std::max(2.0 * p.robot_radius, 0.5);
+
+  const int slabs = static_cast<int>(rng.uniform_index(5));  // 0-4
+  for (int s = 0; s < slabs; ++s) {
+    int axis = rng.uniform01() < 0.6 ? axis_q : static_cast<int>(rng.uniform_index(3));
+    if (e[axis] < kMinSlabRoom) axis = axis_q;
+    if (e[axis] < kMinSlabRoom) continue;
+    const int ua = (axis + 1) % 3, va = (axis + 2) % 3;
+    const double t = rng.uniform(0.1, 0.6);
+    const double w = bounds.min[axis] + q(rng.uniform(0.2, 0.8) * e[axis]);
+    // The slab spans the whole plane, or (a partition, an overhang) part of it.
+    double u0 = bounds.min[ua], u1 = bounds.max[ua], v0 = bounds.min[va], v1 = bounds.max[va];
+    if (rng.uniform01() < 0.3) {  // from one end of the plane
+      const double len = q(rng.uniform(0.3, 1.0) * e[ua]);
+      if (rng.uniform01() < 0.5) u1 = u0 + len; else u0 = u1 - len;
+    }
+    std::vector<Box> openings;
+    const int n_open = 1 + static_cast<int>(rng.uniform_index(3));  // 1-3
+    for (int o = 0; o < n_open; ++o) {
+      // The first opening lets the robot through; the others may be narrower than it.
+      const double lo_side = o == 0 ? passage : 0.2;
+      Eigen::Vector3d side, c;
+      side[axis] = 2.0 * t;
+      c[axis] = w;
+      for (int k : {ua, va}) {
+        side[k] = std::min(e[k], rng.uniform(lo_side, std::max(lo_side, 0.35 * e[k])));
+        c[k] = bounds.min[k] + rng.uniform(0.5 * side[k], e[k] - 0.5 * side[k]);
+      }
+      openings.push_back(make_box(c - 0.5 * side, c + 0.5 * side));
+    }
+    std::vector<Box> pieces;
+    slab_with_openings(pieces, axis, w - 0.5 * t, w + 0.5 * t, u0, u1, v0, v1, openings);
+    for (Box& piece : pieces) add_clear(d.obstacles, piece, bounds, d.query, keep_free);
+  }
+  const int boxes = static_cast<int>(rng.uniform_index(31));  // 0-30 free boxes
+  for (int b = 0; b < boxes; ++b) {
+    Eigen::Vector3d side, lo;
+    for (int k = 0; k < 3; ++k) side[k] = std::min(rng.uniform(0.04, 0.2) * size, e[k]);
+    for (int k = 0; k < 3; ++k) lo[k] = bounds.min[k] + rng.uniform(0.0, e[k] - side[k]);
+    add_clear(d.obstacles, make_box(lo, lo + side), bounds, d.query, keep_free);
+  }
+  const int rods = static_cast<int>(rng.uniform_index(41));  // 0-40 pillars and beams
+  for (int r = 0; r < rods; ++r) {
+    const int along = rng.uniform01() < 0.5 ? 2 : static_cast<int>(rng.uniform_index(3));
+    const double t = rng.uniform(0.15, 0.6);
+    Eigen::Vector3d lo, hi;
+    for (int k = 0; k < 3; ++k) {
+      if (k == along) {
+        const double len = rng.uniform(0.4, 1.0) * e[k];
+        lo[k] = bounds.min[k] + rng.uniform(0.0, e[k] - len);
+        hi[k] = lo[k] + len;
+      } else {
+        lo[k] = bounds.min[k] + rng.uniform(0.0, std::max(0.0, e[k] - t));
+        hi[k] = lo[k] + t;
+      }
+    }
+    add_clear(d.obstacles, make_box(lo, hi), bounds, d.query, keep_free);
+  }
+  return d;
+}
+
 }  // namespace
+
+/// Boxes covering the rectangle [u0, u1] x [v0, v1] of the plane across `axis` (thickness
+/// [w0, w1] along it) less the given openings (rectangles in the same plane): the plane is cut
+/// at every opening edge and each piece outside every opening becomes one box.
+void slab_with_openings(std::vector<Box>& out, int axis, double w0, double w1, double u0, double u1, double v0,
+                        double v1, const std::vector<Box>& openings) {
+  const int ua = (axis + 1) % 3, va = (axis + 2) % 3;
+  std::vector<double> us{u0, u1}, vs{v0, v1};
+  for (const Box& o : openings) {
+    us.insert(us.end(), {std::clamp(o.min[ua], u0, u1), std::clamp(o.max[ua], u0, u1)});
+    vs.insert(vs.end(), {std::clamp(o.min[va], v0, v1), std::clamp(o.max[va], v0, v1)});
+  }
+  std::sort(us.begin(), us.end());
+  us.erase(std::unique(us.begin(), us.end()), us.end());
+  std::sort(vs.begin(), vs.end());
+  vs.erase(std::unique(vs.begin(), vs.end()), vs.end());
+  for (std::size_t j = 0; j + 1 < vs.size(); ++j) {
+    std::size_t i = 0;
+    while (i + 1 < us.size()) {  // one box per run of pieces outside every opening
+      const auto open = [&](std::size_t k) {
+        const double uc = 0.5 * (us[k] + us[k + 1]), vc = 0.5 * (vs[j] + vs[j + 1]);
+        return std::any_of(openings.begin(), openings.end(), [&](const Box& o) {
+          return uc > o.min[ua] && uc < o.max[ua] && vc > o.min[va] && vc < o.max[va];
+        });
+      };
+      if (open(i)) {
+        ++i;
+        continue;
+      }
+      const std::size_t i0 = i;
+      while (i + 1 < us.size() && !open(i)) ++i;
+      Eigen::Vector3d lo, hi;
+      lo[axis] = w0;
+      hi[axis] = w1;
+      lo[ua] = us[i0];
+      hi[ua] = us[i];
+      lo[va] = vs[j];
+      hi[va] = vs[j + 1];
+      out.push_back(make_box(lo, hi));
+    }
+  }
+}
 
 FamilyDraw draw_family(const GeneratorPreset& preset, Rng& rng, const Box& bounds, std::optional<int> obstacles) {
   if (preset.name == "cluttered") return cluttered(preset, rng, bounds, obstacles);
@@ -323,6 +454,7 @@ FamilyDraw draw_family(const GeneratorPreset& preset, Rng& rng, const Box& bound
   if (obstacles) throw Error("obstacles: preset \"" + preset.name + "\" has no obstacle count to override");
   if (preset.name == "rooms") return rooms(preset, rng, bounds);
   if (preset.name == "multilevel") return multilevel(preset, rng, bounds);
+  if (preset.name == "mixed") return mixed(preset, rng, bounds);
   throw Error("preset: \"" + preset.name + "\" is not a map family");
 }
 

@@ -101,7 +101,7 @@ std::vector<Box> indoor_obstacles(Rng& rng, const GeneratorPreset& p, int count,
 }  // namespace
 
 std::vector<std::string> generator_preset_names() {
-  return {"sim", "indoor", "cluttered", "rooms", "forest", "multilevel", "scan"};
+  return {"sim", "indoor", "cluttered", "rooms", "forest", "multilevel", "mixed", "scan"};
 }
 
 bool is_family(const GeneratorPreset& preset) { return !preset.resolutions.empty(); }
@@ -146,6 +146,7 @@ GeneratorPreset generator_preset(const std::string& name) {
   if (name == "rooms") return family(name, {20, 15, 3}, {60, 40, 4.5}, {0.1, 0.2}, 0.2);
   if (name == "forest") return family(name, {20, 20, 8}, {150, 150, 25}, {0.2, 0.25, 0.5, 1.0}, 0.3);
   if (name == "multilevel") return family(name, {20, 20, 7}, {50, 50, 16}, {0.1, 0.2, 0.25, 0.5}, 0.25);
+  if (name == "mixed") return family(name, {8, 8, 3}, {100, 100, 40}, {0.1, 0.2, 0.25, 0.5, 1.0}, 0.25);
   if (name == "scan") {
     // Bounds, resolution and query come from each map's base and its mapping run; the radius
     // is the smallest of the bases' (REQ-WORLD-019).
@@ -219,9 +220,9 @@ void check_overrides(const GeneratorPreset& preset, const GeneratorOverrides& ov
     for (const auto& [given, name] : {std::pair{overrides.size.has_value(), "size"}, {overrides.resolution.has_value(), "resolution"}})
       if (given)
         throw Error(std::string(name) + ": preset \"" + drawn + "\" has fixed bounds and resolution; "
-                    "the map families (cluttered, rooms, forest, multilevel) and scans over them take them");
-  // Rooms and multilevel maps draw their walls and floors, not a count of obstacles.
-  if (overrides.obstacles && (drawn == "rooms" || drawn == "multilevel"))
+                    "the map families (cluttered, rooms, forest, multilevel, mixed) and scans over them take them");
+  // Rooms, multilevel and mixed maps draw their walls and floors, not a count of obstacles.
+  if (overrides.obstacles && (drawn == "rooms" || drawn == "multilevel" || drawn == "mixed"))
     throw Error("obstacles: preset \"" + drawn + "\" has no obstacle count to override");
   if (overrides.size) {
     const Eigen::Vector3d& s = *overrides.size;

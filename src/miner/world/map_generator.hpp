@@ -13,7 +13,10 @@
 ///  - "forest": 20-150 m, thin trunks (0.2-0.6 m) with branches, 3-9 per 100 m^2;
 ///  - "multilevel": 2-4 storeys of slabs with stair/atrium openings, bridges across
 ///    them, overhangs, partition walls and a roof, start on the ground floor and goal
-///    on the top one.
+///    on the top one;
+///  - "mixed" (REQ-WORLD-020): 8-100 x 8-100 x 3-40 m, the families' parts at random:
+///    slabs across any axis with openings, free boxes, pillars and beams (domain
+///    randomisation for the learned heuristic).
 /// And "scan" (REQ-WORLD-019, scan_family.cpp): the voxel map a simulated mapping run
 /// leaves over a map of another preset (free, occupied, unknown; bounded by what it saw).
 /// Every generated map carries its query (start, goal, robot radius) and is checked to
@@ -100,6 +103,11 @@ struct FamilyDraw {
 };
 FamilyDraw draw_family(const GeneratorPreset& preset, Rng& rng, const Box& bounds,
                        std::optional<int> obstacles);
+/// Boxes covering the rectangle [u0, u1] x [v0, v1] of the plane across `axis` (u and v the
+/// next two axes in turn), [w0, w1] thick along it, less the `openings` (boxes whose extent
+/// in u and v cuts the plane; their extent along `axis` is ignored): "mixed"'s slabs.
+void slab_with_openings(std::vector<Box>& out, int axis, double w0, double w1, double u0, double u1, double v0,
+                        double v1, const std::vector<Box>& openings);
 
 }  // namespace detail
 

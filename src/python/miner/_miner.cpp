@@ -94,7 +94,7 @@ PYBIND11_MODULE(_miner, m) {
       .def_static("generate", [](const std::string& preset, std::uint64_t seed) {
             return std::make_shared<miner::world::Map>(miner::world::generate_map(miner::world::generator_preset(preset), seed));
           }, py::arg("preset") = "sim", py::arg("seed") = 1,
-          "A seeded map of a preset: sim, indoor, cluttered, rooms, forest, multilevel, scan.")
+          "A seeded map of a preset: sim, indoor, cluttered, rooms, forest, multilevel, mixed, scan.")
       .def("save", &miner::world::Map::save, py::arg("path"))
       .def("to_json", [](const miner::world::Map& map) { return map.to_json().dump(2); })
       .def_property_readonly("bounds", [](const miner::world::Map& map) {

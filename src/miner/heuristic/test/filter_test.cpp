@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "miner/core/rng.hpp"
 #include "miner/heuristic/grid.hpp"
 #include "miner/heuristic/region_filter.hpp"
 #include "miner/heuristic/sgan.hpp"
@@ -114,4 +115,116 @@ TEST_CASE("The bridge takes the chain the generator rates higher when lengths ti
   CHECK(g.in(f, 4, 2, 2));         // the cheaper chain: cost 1 + (1 - 0.4)
   CHECK_FALSE(g.in(f, 4, 0, 0));   // not the hole of cost 2 (lower index: the tie-break pick)
   CHECK(f.report.safe);
+}
+
+namespace {
+
+/// The test's own statement of REQ-HEUR-016's chain: a breadth-first search over the cells
+/// with R >= t, stepping to any of the 26 neighbours that is not solid and, with P, whose
+/// axes of motion are passable in both cells.
+bool chain_exists(const std::vector<float>& p, const std::vector<std::uint8_t>& env, const std::vector<std::uint8_t>& pass,
+                  const Eigen::Vector3i& dims, const Eigen::Vector3i& s, const Eigen::Vector3i& g, float t) {
+  const auto idx = [&](const Eigen::Vector3i& c) { return heuristic::cell_index(dims, c.x(), c.y(), c.z()); };
+  const auto ok = [&](const Eigen::Vector3i& c) { return env[idx(c)] != heuristic::kSolid && p[idx(c)] >= t; };
+  if (!ok(s) || !ok(g)) return false;
+  std::vector<char> seen(p.size(), 0);
+  std::vector<Eigen::Vector3i> queue{s};
+  seen[idx(s)] = 1;
+  for (std::size_t h = 0; h < queue.size(); ++h) {
+    const Eigen::Vector3i u = queue[h];
+    if (u == g) return true;
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const Eigen::Vector3i d(dx, dy, dz), v = u + d;
+          if (d == Eigen::Vector3i::Zero() || (v.array() < 0).any() || (v.array() >= dims.array()).any()) continue;
+          if (seen[idx(v)] || !ok(v)) continue;
+          bool passable = true;
+          for (int a = 0; a < 3 && !pass.empty(); ++a)
+            if (d[a] != 0) passable = passable && (pass[idx(u)] >> a & 1) && (pass[idx(v)] >> a & 1);
+          if (!passable) continue;
+          seen[idx(v)] = 1;
+          queue.push_back(v);
+        }
+  }
+  return false;
+}
+
+}  // namespace
+
+TEST_CASE("The widest threshold is the largest one whose cells still join start and goal", "[REQ-HEUR-016]") {
+  // Random grids with solid cells and, half the time, random P bits: the widest threshold must
+  // be one of the grid's values at which a chain exists, and none above it may have one.
+  miner::Rng rng(16);
+  const Eigen::Vector3i dims(6, 5, 4);
+  const auto n = static_cast<std::size_t>(dims.prod());
+  int found = 0, none = 0, with_p = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    std::vector<float> p(n);
+    std::vector<std::uint8_t> env(n), pass;
+    for (std::size_t i = 0; i < n; ++i) {
+      p[i] = static_cast<float>(rng.uniform01());
+      env[i] = rng.uniform01() < 0.25 ? heuristic::kSolid : (rng.uniform01() < 0.5 ? heuristic::kPartial : heuristic::kFree);
+    }
+    if (trial % 2) {
+      pass.resize(n);
+      for (std::size_t i = 0; i < n; ++i) pass[i] = static_cast<std::uint8_t>(rng.uniform_index(8));
+      ++with_p;
+    }
+    const Eigen::Vector3i s(0, static_cast<int>(rng.uniform_index(5)), 0), g(5, static_cast<int>(rng.uniform_index(5)), 3);
+    const std::optional<float> w = heuristic::widest_threshold(p, env, dims, s, g, pass);
+    INFO("trial " << trial);
+    if (!w) {
+      ++none;
+      CHECK_FALSE(chain_exists(p, env, pass, dims, s, g, 0.0f));
+      continue;
+    }
+    ++found;
+    CHECK(std::find(p.begin(), p.end(), *w) != p.end());
+    CHECK(chain_exists(p, env, pass, dims, s, g, *w));
+    CHECK_FALSE(chain_exists(p, env, pass, dims, s, g, std::nextafter(*w, 2.0f)));
+    // The rule: the fixed threshold when its cells hold a chain, the widest one below it otherwise.
+    for (const double t0 : {0.05, 0.3, 0.9}) {
+      const double t = heuristic::region_threshold(p, env, dims, s, g, t0, true, pass);
+      CHECK(t == std::min(t0, static_cast<double>(*w)));
+      CHECK(heuristic::region_threshold(p, env, dims, s, g, t0, false, pass) == t0);
+    }
+  }
+  // Both outcomes, with and without P, are exercised.
+  CHECK(found >= 50);
+  CHECK(none >= 10);
+  CHECK(with_p == 150);
+}
+
+TEST_CASE("With the widest rule the raw region joins start and goal whenever non-solid cells do", "[REQ-HEUR-016]") {
+  // A wall of solid cells at x = 4 with one partial cell, rated low by the network: the fixed
+  // threshold leaves start and goal apart; the widest rule lowers it to that cell's value.
+  Grid g;
+  for (int i = 0; i < 8; ++i)
+    for (int j = 0; j < 4; ++j)
+      for (int k = 0; k < 4; ++k) g.set_p(i, j, k, i == 4 ? 0.0f : 0.8f);
+  for (int j = 0; j < 4; ++j)
+    for (int k = 0; k < 4; ++k) g.solid(4, j, k);
+  g.env[heuristic::cell_index(kDims, 4, 2, 1)] = heuristic::kPartial;
+  g.set_p(4, 2, 1, 0.03f);
+  const double t = heuristic::region_threshold(g.p, g.env, kDims, {0, 1, 1}, {7, 1, 1}, 0.2, true);
+  CHECK(t == Approx(0.03f));
+  const auto f = heuristic::filter_region(g.p, g.env, kDims, {0, 1, 1}, {7, 1, 1}, t);
+  CHECK(f.report.raw_connected);
+  CHECK(f.report.threshold == t);
+  CHECK(f.report.bridge_cells == 0);
+  // P says the gap cell is blocked across x: no chain respects it, so the rule falls back to
+  // the chain without P (a door narrower than a sub-cell).
+  std::vector<std::uint8_t> pass(g.p.size(), heuristic::kPassAll);
+  pass[heuristic::cell_index(kDims, 4, 2, 1)] = heuristic::kPassY | heuristic::kPassZ;
+  CHECK_FALSE(heuristic::widest_threshold(g.p, g.env, kDims, {0, 1, 1}, {7, 1, 1}, pass));
+  CHECK(heuristic::region_threshold(g.p, g.env, kDims, {0, 1, 1}, {7, 1, 1}, 0.2, true, pass) == Approx(0.03f));
+  // A closed wall: no chain, the fixed threshold stays.
+  g.env[heuristic::cell_index(kDims, 4, 2, 1)] = heuristic::kSolid;
+  CHECK(heuristic::region_threshold(g.p, g.env, kDims, {0, 1, 1}, {7, 1, 1}, 0.2, true) == 0.2);
+  // A second gap the network rates higher wins, though it is farther.
+  g.env[heuristic::cell_index(kDims, 4, 2, 1)] = heuristic::kPartial;
+  g.env[heuristic::cell_index(kDims, 4, 3, 3)] = heuristic::kPartial;
+  g.set_p(4, 3, 3, 0.1f);
+  CHECK(heuristic::region_threshold(g.p, g.env, kDims, {0, 1, 1}, {7, 1, 1}, 0.2, true) == Approx(0.1f));
 }

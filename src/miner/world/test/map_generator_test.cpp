@@ -1,9 +1,12 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 
 #include "miner/core/error.hpp"
 #include "miner/core/json_io.hpp"
+#include "miner/core/rng.hpp"
 #include "miner/world/astar.hpp"
 #include "miner/world/map_generator.hpp"
 #include "miner/world/voxel_grid.hpp"
@@ -67,7 +70,7 @@ TEST_CASE("Indoor maps: 15-20 pillars of 0.6 x 1.2 m on the floor and a 1 m hoop
 
 TEST_CASE("Generator input errors: unknown preset, negative count, impossible clutter", "[REQ-WORLD-009]") {
   CHECK_THROWS_WITH(generator_preset("swamp"),
-                    Contains("unknown map preset \"swamp\" (known: sim, indoor, cluttered, rooms, forest, multilevel, scan)"));
+                    Contains("unknown map preset \"swamp\" (known: sim, indoor, cluttered, rooms, forest, multilevel, mixed, scan)"));
   CHECK_THROWS_WITH(generate_map(generator_preset("sim"), 1, -3), Contains("obstacles: count must not be negative"));
   const Map empty = generate_map(generator_preset("sim"), 1, 0);
   CHECK(empty.obstacles().empty());
@@ -149,6 +152,104 @@ TEST_CASE("Family shapes: rooms are flat with walls and doors, multilevel spans 
   const double area = forest.bounds().extent().x() * forest.bounds().extent().y();
   CHECK(trunks >= 3.0 * area / 100.0 - 1);
   CHECK(trunks <= 9.0 * area / 100.0 + 1);
+}
+
+TEST_CASE("Mixed slabs: the pieces cover the plane less its openings, each point once", "[REQ-WORLD-020]") {
+  // Random slabs across each axis with 0-4 openings (some overlapping, some past the plane's
+  // edge), on the 0.05 m quantum the generator rounds to; points on a finer lattice, off
+  // every edge, must be covered by exactly one piece outside the openings and by none inside.
+  miner::Rng rng(20);
+  const auto q = [](double x) { return std::round(x / 0.05) * 0.05; };
+  for (int trial = 0; trial < 60; ++trial) {
+    const int axis = trial % 3, ua = (axis + 1) % 3, va = (axis + 2) % 3;
+    const double u0 = q(rng.uniform(-2, 2)), u1 = u0 + q(rng.uniform(1, 6)), v0 = q(rng.uniform(-2, 2)),
+                 v1 = v0 + q(rng.uniform(1, 6));
+    std::vector<Box> openings;
+    const int n = static_cast<int>(rng.uniform_index(5));
+    for (int o = 0; o < n; ++o) {
+      Eigen::Vector3d lo, hi;
+      lo[axis] = -1;
+      hi[axis] = 1;
+      lo[ua] = q(rng.uniform(u0 - 1, u1));
+      hi[ua] = lo[ua] + q(rng.uniform(0.05, 3));
+      lo[va] = q(rng.uniform(v0 - 1, v1));
+      hi[va] = lo[va] + q(rng.uniform(0.05, 3));
+      openings.push_back({lo, hi});
+    }
+    std::vector<Box> pieces;
+    detail::slab_with_openings(pieces, axis, -0.1, 0.1, u0, u1, v0, v1, openings);
+    INFO("trial " << trial << ", " << n << " openings, " << pieces.size() << " pieces");
+    for (double u = u0 + 0.0125; u < u1; u += 0.025) {
+      for (double v = v0 + 0.0125; v < v1; v += 0.025) {
+        Eigen::Vector3d p;
+        p[axis] = 0.0;
+        p[ua] = u;
+        p[va] = v;
+        const bool open = std::any_of(openings.begin(), openings.end(), [&](const Box& o) {
+          return u > o.min[ua] && u < o.max[ua] && v > o.min[va] && v < o.max[va];
+        });
+        const auto covered = std::count_if(pieces.begin(), pieces.end(), [&](const Box& b) {
+          return (p.array() > b.min.array()).all() && (p.array() < b.max.array()).all();
+        });
+        if (covered != (open ? 0 : 1)) FAIL("point (" << u << ", " << v << "): open " << open << ", covered " << covered);
+      }
+    }
+    for (const Box& b : pieces) {
+      CHECK(b.min[axis] == Approx(-0.1));
+      CHECK(b.max[axis] == Approx(0.1));
+    }
+  }
+}
+
+TEST_CASE("Mixed maps: slabs across every axis with passable openings, rods, a free solvable query, the same bytes", "[REQ-WORLD-020]") {
+  const GeneratorPreset p = generator_preset("mixed");
+  REQUIRE(is_family(p));
+  GeneratorOverrides coarse;
+  coarse.resolution = 0.5;
+  std::array<int, 3> slab_pieces{0, 0, 0};  // boxes thin (<= 0.6 m) across one axis only
+  int thin_slabs = 0, rods = 0, blocked_lines = 0;
+  std::vector<Eigen::Vector3d> extents;
+  for (std::uint64_t seed = 1; seed <= 16; ++seed) {
+    INFO("seed " << seed);
+    const Map map = generate_map(p, seed, coarse);
+    if (seed == 1) CHECK(miner::dump_json(map.to_json()) == miner::dump_json(generate_map(p, seed, coarse).to_json()));
+    const Eigen::Vector3d e = map.bounds().extent();
+    extents.push_back(e);
+    CHECK((e.array() >= p.min_extent.array() - 1e-9).all());
+    CHECK((e.array() <= p.bounds.max.array() + 1e-9).all());
+    REQUIRE(map.query());
+    const auto& qr = *map.query();
+    CHECK(qr.robot_radius == p.robot_radius);
+    CHECK(map.is_free(qr.start, qr.robot_radius));
+    CHECK(map.is_free(qr.goal, qr.robot_radius));
+    // Start and goal lie near opposite faces across one axis.
+    const Eigen::Vector3d apart = (qr.goal - qr.start).cwiseQuotient(e);
+    CHECK(apart.maxCoeff() >= 0.7);
+    const VoxelGrid grid(map, qr.robot_radius);
+    CHECK_NOTHROW(astar(map, grid, qr.start, qr.goal));
+    blocked_lines += !map.segment_free(qr.start, qr.goal, qr.robot_radius);
+    for (const Box& b : map.obstacles()) {
+      CHECK(map.bounds().contains(b.min));
+      CHECK(map.bounds().contains(b.max));
+      const Eigen::Vector3d x = b.extent();
+      const auto thin = static_cast<int>((x.array() <= 0.6 + 1e-9).count());
+      if (thin == 1) {
+        int k = 0;
+        x.minCoeff(&k);
+        ++slab_pieces[static_cast<std::size_t>(k)];
+        thin_slabs += x[k] <= 0.2 + 1e-9;
+      }
+      rods += thin == 2 && x.maxCoeff() >= 2.0;
+    }
+  }
+  CHECK(extents[0] != extents[1]);  // the size is drawn per map
+  // Every axis gets slabs, some thinner than any resolution a map of its size draws but the
+  // finest; rods stand and lie; the straight line is blocked on most maps (a structure stands
+  // between start and goal) yet A* gets through every one (above).
+  for (int k = 0; k < 3; ++k) CHECK(slab_pieces[static_cast<std::size_t>(k)] >= 1);
+  CHECK(thin_slabs >= 1);
+  CHECK(rods >= 16);
+  CHECK(blocked_lines >= 8);
 }
 
 TEST_CASE("Family overrides: size, resolution and count: bad overrides are refused", "[REQ-WORLD-011]") {

@@ -18,6 +18,7 @@
 #include "miner/core/error.hpp"
 #include "miner/core/json_io.hpp"
 #include "miner/core/rng.hpp"
+#include "miner/heuristic/grid.hpp"
 #include "miner/heuristic/sgan.hpp"
 #include "miner/heuristic/tensor_file.hpp"
 
@@ -84,6 +85,30 @@ std::string with_tensor_edited(const std::string& blob, const std::string& name,
   return blob.substr(0, 8) + std::string(reinterpret_cast<const char*>(&n), 4) + h + data;
 }
 
+/// Channel P for E levels as the network would get it (grid.hpp): free cells pass every axis,
+/// solid ones none, partial ones the bits `partial` says; empty for a network that does not
+/// read P.
+std::vector<std::uint8_t> passability_for(const heuristic::Sgan& g, const std::vector<std::uint8_t>& env,
+                                          std::uint8_t partial = 7) {
+  if (g.architecture().passability_channels == 0) return {};
+  std::vector<std::uint8_t> p(env.size());
+  for (std::size_t i = 0; i < env.size(); ++i) p[i] = env[i] == 0 ? 7 : env[i] == 2 ? 0 : partial;
+  return p;
+}
+
+/// The same as the network's forward() input: the blocked bits 1 - P_a, a = x, y, z, as 3 planes.
+std::vector<float> blocked_for(const heuristic::Sgan& g, const std::vector<float>& env_half,
+                               std::uint8_t partial = 7) {
+  if (g.architecture().passability_channels == 0) return {};
+  const std::size_t n = env_half.size();
+  std::vector<float> b(3 * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint8_t p = env_half[i] == 0.0f ? 7 : env_half[i] == 1.0f ? 0 : partial;
+    for (std::size_t a = 0; a < 3; ++a) b[a * n + i] = (p >> a & 1) ? 0.0f : 1.0f;
+  }
+  return b;
+}
+
 }  // namespace
 
 TEST_CASE("The shipped generator agrees with the PyTorch reference tensors to 1e-4", "[REQ-HEUR-005]") {
@@ -133,7 +158,7 @@ TEST_CASE("Weights that overflow a layer give an error naming the file, never a 
   env[5] = 1;
   state[0] = state[cells - 1] = 1;
   miner::Rng rng(1);
-  CHECK_THROWS_WITH(g.predict(env, state, {}, miner::world::Box{{0, 0, 0}, {10, 10, 5}}, 0.2, rng),
+  CHECK_THROWS_WITH(g.predict(env, state, passability_for(g, env), miner::world::Box{{0, 0, 0}, {10, 10, 5}}, 0.2, rng),
                     Contains("huge.bin") && Contains("not a probability"));
 }
 
@@ -158,7 +183,10 @@ TEST_CASE("MINER's own kernels and oneDNN's agree with each other and with PyTor
   state[n / 3] = state[2 * n / 3] = state[0] = state[n - 1] = 1.0f;
   const std::vector<float> scale = fast.architecture().scale_channels ? std::vector<float>{0.5f, 0.4f, -0.2f}
                                                                       : std::vector<float>{};
-  const std::vector<float> a = fast.forward(env, state, noise, scale), b = last.forward(env, state, noise, scale);
+  // Partial cells blocked across x (a wall's bits), so P's planes are not all zero.
+  const std::vector<float> blocked = blocked_for(fast, env, heuristic::kPassY | heuristic::kPassZ);
+  const std::vector<float> a = fast.forward(env, state, noise, scale, blocked),
+                           b = last.forward(env, state, noise, scale, blocked);
   double worst = 0.0;
   for (std::size_t v = 0; v < n; ++v) worst = std::max(worst, static_cast<double>(std::fabs(a[v] - b[v])));
   CHECK(worst <= 1e-5);
@@ -221,8 +249,9 @@ TEST_CASE("The same inputs and seed give the same region bytes", "[REQ-HEUR-005]
   s[5] = s[n - 9] = 1;
   const miner::world::Box bounds{Eigen::Vector3d::Zero(), Eigen::Vector3d(100, 100, 40)};
   miner::Rng r1(3, 1), r2(3, 1), r3(4, 1);
-  const auto a = g.predict(e, s, {}, bounds, 0.5, r1), b = g.predict(e, s, {}, bounds, 0.5, r2),
-             c = g.predict(e, s, {}, bounds, 0.5, r3);
+  const std::vector<std::uint8_t> p = passability_for(g, e, heuristic::kPassX);
+  const auto a = g.predict(e, s, p, bounds, 0.5, r1), b = g.predict(e, s, p, bounds, 0.5, r2),
+             c = g.predict(e, s, p, bounds, 0.5, r3);
   CHECK(a == b);
   CHECK(a != c);  // the noise enters the network
   for (float v : a) REQUIRE((v >= 0.0f && v <= 1.0f));
@@ -254,10 +283,11 @@ TEST_CASE("The network is told its cells' metric size: sigma = log2(cell / radiu
   miner::Rng r1(3, 1), r2(3, 1);
   const miner::world::Box small{Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(10.0)};
   const miner::world::Box large{Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(200.0)};
-  CHECK(g.predict(e, s, {}, small, 0.3, r1) != g.predict(e, s, {}, large, 0.3, r2));
+  const std::vector<std::uint8_t> p = passability_for(g, e);
+  CHECK(g.predict(e, s, p, small, 0.3, r1) != g.predict(e, s, p, large, 0.3, r2));
   // A forward call with the wrong number of scale values is refused.
   std::vector<float> env(n, 0.0f), st(n, 0.0f), noise(n, 0.0f);
-  CHECK_THROWS_WITH(g.forward(env, st, noise, {0.1f}), Contains("scale input of 3"));
+  CHECK_THROWS_WITH(g.forward(env, st, noise, {0.1f}, blocked_for(g, env)), Contains("scale input of 3"));
 }
 
 TEST_CASE("A missing, truncated, altered or mismatched weights file is refused naming the fault", "[REQ-HEUR-006]") {
@@ -328,11 +358,15 @@ TEST_CASE("A missing, truncated, altered or mismatched weights file is refused n
     refuses([](miner::Json& h) { h["meta"]["architecture"]["environment_scale"] = -1e300; }, "environment_scale: must be in [0, 1]");
     refuses([](miner::Json& h) { h["meta"]["architecture"]["threshold_rule"] = "widset"; },
             "meta.architecture.threshold_rule: must be \"fixed\" or \"widest\", not \"widset\"");
-    miner::Json widest = header;
+    miner::Json widest = header, fixed = header, absent = header;
     widest["meta"]["architecture"]["threshold_rule"] = "widest";
+    fixed["meta"]["architecture"]["threshold_rule"] = "fixed";
+    absent["meta"]["architecture"].erase("threshold_rule");
     CHECK(heuristic::Sgan::from_bytes(rewritten(widest), "widest.bin").architecture().threshold_rule ==
           heuristic::ThresholdRule::kWidest);
-    CHECK(heuristic::Sgan::from_bytes(rewritten(header), "same.bin").architecture().threshold_rule ==
+    CHECK(heuristic::Sgan::from_bytes(rewritten(fixed), "fixed.bin").architecture().threshold_rule ==
+          heuristic::ThresholdRule::kFixed);
+    CHECK(heuristic::Sgan::from_bytes(rewritten(absent), "absent.bin").architecture().threshold_rule ==
           heuristic::ThresholdRule::kFixed);
   }
   // Non-finite weights are refused before anything runs.

@@ -378,6 +378,24 @@ TEST_CASE("Fifth campaign: empty shards, coinciding ends, far clouds and shard p
   const Run far_run = miner_cli({"map", "import", "--cloud", cloud, "--origin", "0", "0", "0", "--resolution", "0.1",
                                  "--out", dir() + "/i5.bt"});
   CHECK_THAT(far_run.err, Contains("more than the") && Contains("a map may have"));
+  // A scenario's planning_margin_m and a waypoint leg through an obstacle are named with the
+  // file and the key (fifth campaign: "within the robot radius 5.3", "path segment 0 ... is
+  // itself in collision", neither naming the scenario).
+  const std::string room = write("room-5th-map.json", R"({"format": "miner-map-v1", "bounds": {"min": [0,0,0], "max": [4,4,2]},
+    "resolution": 0.25, "obstacles": [{"type": "box", "min": [1.5,1.5,0], "max": [2.5,2.5,2]}]})");
+  const std::string margin = write("margin-5th.json", R"({"format": "miner-scenario-v1", "name": "m", "map": "room-5th-map.json",
+    "start": [0.5, 0.5, 1], "goal": [0.5, 3.5, 1], "trajectory": {"order": 4, "v_max": 1.0, "a_max": 1.0},
+    "seed": 1, "planning_margin_m": 1.5})");
+  const std::string leg = write("leg-5th.json", R"({"format": "miner-scenario-v1", "name": "l", "map": "room-5th-map.json",
+    "start": [0.5, 0.5, 1], "goal": [0.5, 3.5, 1], "waypoints": [[3.5, 3.5, 1]], "trajectory": {"order": 4, "v_max": 1.0, "a_max": 1.0},
+    "seed": 1})");
+  check_refusals({
+      {{"fly", "--scenario", margin, "--out", dir() + "/margin-run"}, 1,
+       "margin-5th.json: start (0.5, 0.5, 1) has clearance 1.41421 m, less than the vehicle radius"},
+      {{"fly", "--scenario", leg, "--out", dir() + "/leg-run"}, 1,
+       "leg-5th.json: waypoints: the straight leg from start (0.5, 0.5, 1) to waypoints[0] (3.5, 3.5, 1) passes within"},
+  });
+  CHECK_FALSE(std::filesystem::exists(dir() + "/margin-run"));
   // A part of a sharded dataset is not measured as if it were the split.
   const std::string part = dir() + "/part-5th";
   REQUIRE(miner_cli({"dataset", "--preset", "indoor", "--count", "4", "--test-count", "2", "--shard-size", "1", "--shard",

@@ -17,7 +17,17 @@
 
 namespace miner {
 
+void require_path_without_nul(const std::string& path, const std::string& what) {
+  // The operating system reads a path up to its first NUL: "a.json\0junk" would open a.json
+  // (issue 20, fifth campaign: a path from a JSON field, written \u0000 there, was cut short).
+  const std::size_t nul = path.find('\0');
+  if (nul != std::string::npos)
+    throw Error(path + ": cannot open " + what + ": the path holds a NUL byte at offset " + std::to_string(nul) +
+                " (a path ends at its first NUL)");
+}
+
 std::string read_file_bytes(const std::string& path, const std::string& what) {
+  require_path_without_nul(path, what);
   // A device or a pipe (/dev/zero, a FIFO) would be read without end: only regular files.
   std::error_code ec;
   if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
@@ -285,6 +295,7 @@ void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& 
     for (const auto& [tmp, target] : moves) fs::remove(tmp, ec);
   };
   for (const auto& [path, content] : files) {
+    require_path_without_nul(path, "output file");
     const fs::path target(path);
     const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
     if (!fs::is_directory(dir, ec)) {
@@ -334,6 +345,7 @@ void write_file_atomic(const std::string& path, const std::string& content) { wr
 
 void write_folder_atomic(const std::string& path, const std::vector<std::pair<std::string, std::string>>& files) {
   namespace fs = std::filesystem;
+  require_path_without_nul(path, "output folder");
   const fs::path target = fs::path(path).lexically_normal();
   if (target.empty() || target.filename().empty()) throw Error(path + ": not a folder name");
   const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");

@@ -25,6 +25,9 @@ Json read_json_file(const std::string& path);
 /// prefix (what users see names their file and field, not the library's internals).
 std::string json_error_text(const std::exception& e);
 std::string read_file_bytes(const std::string& path, const std::string& what = "file");
+/// Throws miner::Error naming the path and the offset when it holds a NUL byte (the system
+/// would open the path cut there); read_file_bytes and the atomic writers call it.
+void require_path_without_nul(const std::string& path, const std::string& what);
 
 /// The first (i, j), i < j, with docs[i] == docs[j]; nullopt when all differ. A campaign's
 /// inputs given twice under two names (two files of one content, a map inlined once and

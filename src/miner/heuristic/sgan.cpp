@@ -387,7 +387,12 @@ void Sgan::Impl::build(const TensorFile& f, Sgan::Kernels which) {
     // inputs would be squashed to nothing or blown up.
     arch.scale_divisor = ar.at("scale_divisor").number_in(1.0, 64.0);
   } else if (ar.has("scale_divisor")) {
-    ar.at("scale_divisor").fail("is given without scale_channels");
+    // The two keys disagree; which one is wrong is the tensors' to say (mid1's input width):
+    // name both (issue 20, fifth campaign: "scale_channels: 0" was blamed on scale_divisor).
+    ar.at("scale_divisor").fail(std::string("is given, but scale_channels is ") +
+                                (ar.has("scale_channels") ? "0" : "absent") +
+                                ": a network without the scale input has no divisor (set scale_channels to 3 if the "
+                                "network was trained with the scale input, else drop scale_divisor)");
   }
   // Absent in the files written before channel P (dataset v1).
   arch.passability_channels = ar.has("passability_channels") ? ar.at("passability_channels").integer() : 0;

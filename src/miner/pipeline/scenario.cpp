@@ -4,9 +4,11 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <sstream>
 
 #include "miner/core/error.hpp"
 #include "miner/core/stopwatch.hpp"
+#include "miner/core/text.hpp"
 #include "miner/flight/flatness.hpp"
 #include "miner/heuristic/region_filter.hpp"
 #include "miner/heuristic/sgan.hpp"
@@ -388,6 +390,18 @@ ReferencePlan build_reference(const Scenario& s) {
                   " comes within the vehicle radius + planning margin (" + std::to_string(radius) +
                   " m) of an obstacle");
   } else {
+    // The ends must keep the radius the plan keeps; named with the scenario's keys (issue 20,
+    // fifth campaign: `planning_margin_m: 5` was reported as "within the robot radius 5.3").
+    for (const auto& [p, name] : {std::pair<Eigen::Vector3d, const char*>{s.start, "start"}, {s.goal, "goal"}}) {
+      const double c = s.map->clearance(p);
+      if (c < radius) {
+        std::ostringstream os;
+        os << s.origin << ": " << name << " " << format_point(p) << " has clearance " << short_number(c)
+           << " m, less than the vehicle radius " << short_number(s.vehicle.radius) << " m + planning_margin_m "
+           << short_number(s.planning_margin) << " m the plan keeps; lower planning_margin_m or move the " << name;
+        throw Error(os.str());
+      }
+    }
     Eigen::MatrixX3d path;
     if (s.waypoints) {
       r.source = "waypoints";
@@ -395,6 +409,22 @@ ReferencePlan build_reference(const Scenario& s) {
       path.row(0) = s.start.transpose();
       path.middleRows(1, s.waypoints->rows()) = *s.waypoints;
       path.row(path.rows() - 1) = s.goal.transpose();
+      // Collision repair moves a trajectory off obstacles around a free polyline: each leg must
+      // be one (issue 20, fifth campaign: a leg through an obstacle named no file or key).
+      const Eigen::Index legs = path.rows() - 1;
+      for (Eigen::Index i = 0; i < legs; ++i) {
+        const Eigen::Vector3d a = path.row(i).transpose(), b = path.row(i + 1).transpose();
+        if (!s.map->segment_free(a, b, radius)) {
+          const auto end = [&](Eigen::Index k) {
+            return k == 0 ? std::string("start") : k == legs ? std::string("goal") : "waypoints[" + std::to_string(k - 1) + "]";
+          };
+          std::ostringstream os;
+          os << s.origin << ": waypoints: the straight leg from " << end(i) << " " << format_point(a) << " to " << end(i + 1)
+             << " " << format_point(b) << " passes within the vehicle radius + planning margin (" << short_number(radius)
+             << " m) of an obstacle; waypoints must be joined by collision-free straight legs";
+          throw Error(os.str());
+        }
+      }
     } else {
       r.source = "planner";
       const auto problem = plan::PlanningProblem::make(*s.map, s.start, s.goal, radius);

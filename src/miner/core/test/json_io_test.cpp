@@ -204,3 +204,17 @@ TEST_CASE("only_keys refuses an unknown key, naming it and the known ones", "[RE
 TEST_CASE("dump_json writes two-space indented JSON with a trailing newline", "[REQ-CORE-003]") {
   CHECK(miner::dump_json(Json{{"a", 1}}) == "{\n  \"a\": 1\n}\n");
 }
+
+TEST_CASE("A path holding a NUL byte is refused, not opened cut short", "[REQ-CORE-003][REQ-CORE-004]") {
+  // "good.json\0junk" would open (or replace) good.json: the system reads a path up to its NUL.
+  const auto dir = temp_dir("nul_path");
+  const std::string good = (dir / "good.json").string();
+  miner::write_file_atomic(good, "{}\n");
+  const std::string cut = good + std::string(1, '\0') + "junk";
+  CHECK_THROWS_WITH(miner::read_file_bytes(cut, "map"),
+                    Contains("cannot open map: the path holds a NUL byte at offset " + std::to_string(good.size())));
+  CHECK_THROWS_WITH(miner::read_json_file(cut), Contains("NUL byte"));
+  CHECK_THROWS_WITH(miner::write_file_atomic(cut, "replaced\n"), Contains("cannot open output file") && Contains("NUL byte"));
+  CHECK_THROWS_WITH(miner::write_folder_atomic(cut, {{"a.txt", "x"}}), Contains("cannot open output folder") && Contains("NUL byte"));
+  CHECK(read_all(good) == "{}\n");  // nothing was written through the cut path
+}

@@ -97,7 +97,7 @@ case "${1:-}" in
     wait ;;
   data-mixed)
     # Session 25: the `mixed` family (REQ-WORLD-020), the other families' parts at random, with
-    # the seeds of `data` (2 cores: ~7 min).
+    # the seeds of `data` (2 cores: 4.7 min).
     miner=${2:-build/release/miner}
     "$miner" dataset --preset mixed --count 2000 --test-count 40 --seed 11 --jobs 2 --quiet --out fam-mixed ;;
   mixed)

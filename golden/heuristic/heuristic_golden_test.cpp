@@ -62,7 +62,7 @@ TEST_CASE("Golden: the shipped sGAN's region on fixture map sim-1", "[REQ-HEUR-0
   // while any one cell that moves by more than that fails.
   constexpr double kBlockTolerance = 1e-4;
   const Eigen::Vector3i dims = h.region.dims();
-  const double threshold = heuristic::Sgan::builtin().architecture().threshold;
+  const double threshold = r.threshold;  // the weights' rule's for this query (REQ-HEUR-016)
   std::vector<std::uint8_t> raw(h.probabilities.size()), filtered(h.probabilities.size());
   std::vector<double> blocks(static_cast<std::size_t>(dims.prod() / 64), 0.0);
   for (int z = 0; z < dims.z(); ++z)

@@ -41,7 +41,8 @@ struct HeuristicCliOptions {
 };
 
 Json report_json(const heuristic::FilterReport& r) {
-  return {{"raw_cells", r.raw_cells},         {"raw_connected", r.raw_connected}, {"raw_safe", r.raw_safe},
+  return {{"threshold", r.threshold},         // step 1's, by the weights' rule (REQ-HEUR-016)
+          {"raw_cells", r.raw_cells},         {"raw_connected", r.raw_connected}, {"raw_safe", r.raw_safe},
           {"solid_dropped", r.solid_dropped}, {"island_dropped", r.island_dropped}, {"bridge_cells", r.bridge_cells},
           {"cells", r.cells},                 {"connected", r.connected},           {"safe", r.safe}};
 }

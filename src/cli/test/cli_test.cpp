@@ -1389,6 +1389,9 @@ TEST_CASE("miner heuristic writes the filtered region and reports raw and filter
   const miner::Json doc = miner::parse_json(r.out, "stdout");
   CHECK(doc["filter"]["connected"] == true);
   CHECK(doc["filter"]["safe"] == true);
+  // Step 1's threshold, by the shipped weights' rule: at most their t0 (REQ-HEUR-016).
+  CHECK(doc["filter"]["threshold"].get<double>() > 0.0);
+  CHECK(doc["filter"]["threshold"].get<double>() <= miner::heuristic::Sgan::builtin().architecture().threshold);
   CHECK(doc["inference_ms"].get<double>() > 0.0);
   const auto loaded = miner::plan::HeuristicRegion::load(region);
   CHECK(loaded.source() == "sgan-filtered");

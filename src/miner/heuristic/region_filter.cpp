@@ -110,6 +110,9 @@ double region_threshold(const std::vector<float>& p, const std::vector<std::uint
                         const Eigen::Vector3i& start_cell, const Eigen::Vector3i& goal_cell, double threshold,
                         bool widest, const std::vector<std::uint8_t>& passability) {
   if (!widest) return threshold;
+  const auto n = static_cast<std::size_t>(dims.prod());
+  if (p.size() != n || env.size() != n || (!passability.empty() && passability.size() != n))
+    throw Error("region filter: grids of different sizes");
   const std::size_t is = cell_index(dims, start_cell.x(), start_cell.y(), start_cell.z());
   const std::size_t ig = cell_index(dims, goal_cell.x(), goal_cell.y(), goal_cell.z());
   // Most queries: the fixed threshold's cells already hold a chain (a search of those alone).
@@ -118,7 +121,11 @@ double region_threshold(const std::vector<float>& p, const std::vector<std::uint
   // P is decided on sub-cells: a door narrower than one may leave no chain through it; then
   // the chain is sought without P.
   if (!w && !passability.empty()) w = widest_threshold(p, env, dims, start_cell, goal_cell);
-  return w ? std::min(threshold, static_cast<double>(*w)) : threshold;
+  if (!w) return threshold;
+  // A chain whose weakest cell the network rates below kWidestFloor is no evidence (the
+  // sigmoid's saturated tail, down to exactly 0, which no region threshold may be): the
+  // threshold stops there and the filter's bridge (step 4) joins what it leaves apart.
+  return std::min(threshold, std::max(static_cast<double>(*w), kWidestFloor));
 }
 
 FilteredRegion filter_region(const std::vector<float>& p, const std::vector<std::uint8_t>& env,

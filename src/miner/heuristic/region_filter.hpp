@@ -78,10 +78,14 @@ std::optional<float> widest_threshold(const std::vector<float>& probabilities, c
                                       const Eigen::Vector3i& goal_cell,
                                       const std::vector<std::uint8_t>& passability = {});
 
+/// The lowest threshold the widest rule sets: a chain rated below 1e-4 somewhere is no
+/// evidence of a way through (the sigmoid's tail, down to exactly 0, which no threshold may be).
+inline constexpr double kWidestFloor = 1e-4;
+
 /// Step 1's threshold for the architecture's rule: the fixed threshold t0, or with the rule
-/// "widest" min(t0, widest_threshold) (t0 when no chain exists), so the raw region joins start
-/// and goal on the grid whenever the non-solid cells do, and is the fixed rule's when that
-/// already does.
+/// "widest" min(t0, max(widest_threshold, kWidestFloor)) (t0 when no chain exists), so the raw
+/// region joins start and goal on the grid whenever the non-solid cells do through cells rated
+/// at least kWidestFloor, and is the fixed rule's when that already does.
 double region_threshold(const std::vector<float>& probabilities, const std::vector<std::uint8_t>& environment,
                         const Eigen::Vector3i& dims, const Eigen::Vector3i& start_cell, const Eigen::Vector3i& goal_cell,
                         double threshold, bool widest, const std::vector<std::uint8_t>& passability = {});

@@ -335,14 +335,19 @@ constexpr double kEndpointTolerance = 1e-6;
 
 /// Refuses a reference that, with the hover after it, would fly longer than
 /// kMaxFlightSeconds: before its 1 ms sampling or any simulation (issue 20: unbounded work).
-void require_flight_length(const Scenario& s, const traj::PolynomialTrajectory& t) {
+/// `from_file`: the durations are the trajectory file's, not allocated from the limits, so the
+/// advice names them (fifth campaign: a 1e9 s file was told to raise v_max).
+void require_flight_length(const Scenario& s, const traj::PolynomialTrajectory& t, bool from_file = false) {
   const double total = t.total_duration() + s.hover_after_s;
-  if (!(total <= kMaxFlightSeconds))
-    throw Error(s.origin + ": the flight would last " + std::to_string(total) + " s (reference " +
-                std::to_string(t.total_duration()) + " s + hover " + std::to_string(s.hover_after_s) +
-                " s), more than the " + std::to_string(static_cast<int>(kMaxFlightSeconds)) +
-                " s a simulated flight may; raise trajectory.v_max / a_max (now " + std::to_string(s.limits.v_max) +
-                " m/s, " + std::to_string(s.limits.a_max) + " m/s^2) or shorten the route");
+  if (!(total <= kMaxFlightSeconds)) {
+    const std::string advice =
+        from_file ? "shorten the trajectory file's segment durations or the hover"
+                  : "raise trajectory.v_max / a_max (now " + short_number(s.limits.v_max) + " m/s, " +
+                        short_number(s.limits.a_max) + " m/s^2) or shorten the route";
+    throw Error(s.origin + ": the flight would last " + short_number(total) + " s (reference " +
+                short_number(t.total_duration()) + " s + hover " + short_number(s.hover_after_s) + " s), more than the " +
+                std::to_string(static_cast<int>(kMaxFlightSeconds)) + " s a simulated flight may; " + advice);
+  }
 }
 
 void check_envelope(const Scenario& s, const traj::PolynomialTrajectory& t) {
@@ -378,7 +383,7 @@ ReferencePlan build_reference(const Scenario& s) {
     r.path.resize(m + 1, 3);
     for (int i = 0; i < m; ++i) r.path.row(i) = r.trajectory.evaluate_segment(i, 0.0).transpose();
     r.path.row(m) = r.trajectory.evaluate(r.trajectory.total_duration()).transpose();
-    require_flight_length(s, r.trajectory);
+    require_flight_length(s, r.trajectory, true);
     const auto [v, a] = traj::trajectory_extremes(r.trajectory, kLimitSampleStep);
     if (v > s.limits.v_max * (1 + kLimitSlack) || a > s.limits.a_max * (1 + kLimitSlack))
       throw Error(s.origin + ": trajectory file: maximum speed " + std::to_string(v) + " m/s and acceleration " +

@@ -85,7 +85,15 @@ TrajectoryRequest request_from_json(const Json& doc, const std::string& origin, 
   if (method == "trapezoid") {
     // A command-line option the run would not use is a usage error (exit 2).
     if (rho_override) throw Error("--rho: only used with --allocate optimise", ExitCode::kUsage);
-    if (root.has("rho")) root.at("rho").fail("only used with \"allocation\": \"optimise\"");
+    if (root.has("rho")) {
+      // Overridden on the command line, the file's own request is not at fault: say which
+      // option made its rho unused (issue 20, fifth campaign: the advice blamed the file).
+      const bool overridden = !allocation_override.empty() && root.has("allocation") &&
+                              root.at("allocation").string() == "optimise";
+      root.at("rho").fail(overridden ? "only used with \"allocation\": \"optimise\", which --allocate trapezoid "
+                                       "replaces: drop --allocate to optimise with this rho, or drop rho from the file"
+                                     : "only used with \"allocation\": \"optimise\"");
+    }
     return r;
   }
   if (root.has("durations"))

@@ -223,6 +223,17 @@ TEST_CASE("A trajectory file that exceeds the limits or misses the start is refu
   CHECK(pipeline::build_reference(pipeline::scenario_from_json(doc, "s.json", kScenarios)).source == "file");
   doc["start"] = {5, 6, 3};
   expect_scenario_error(doc, "must start at start");
+  // A file whose durations make the flight too long is told to shorten them, not to raise the
+  // limits it was not allocated from (issue 20, fifth campaign).
+  miner::Json slow = miner::traj::answer_to_json(fast);
+  for (auto& d : slow["durations"]) d = d.get<double>() * 1e6;
+  slow.erase("cost");  // the coefficients over the new durations have another cost
+  slow.erase("allocation");
+  const std::string slow_path = temp_dir() + "/slow.json";
+  miner::write_file_atomic(slow_path, miner::dump_json(slow));
+  doc["start"] = {5, 5, 3};
+  doc["trajectory"] = {{"file", slow_path}, {"v_max", 2.0}, {"a_max", 2.0}};
+  expect_scenario_error(doc, "a simulated flight may; shorten the trajectory file's segment durations");
 }
 
 TEST_CASE("A run folder is replaced whole or not at all", "[REQ-CORE-004]") {

@@ -158,7 +158,7 @@ TEST_CASE("The widest threshold is the largest one whose cells still join start 
   miner::Rng rng(16);
   const Eigen::Vector3i dims(6, 5, 4);
   const auto n = static_cast<std::size_t>(dims.prod());
-  int found = 0, none = 0, with_p = 0;
+  int found = 0, none = 0;
   for (int trial = 0; trial < 300; ++trial) {
     std::vector<float> p(n);
     std::vector<std::uint8_t> env(n), pass;
@@ -169,7 +169,6 @@ TEST_CASE("The widest threshold is the largest one whose cells still join start 
     if (trial % 2) {
       pass.resize(n);
       for (std::size_t i = 0; i < n; ++i) pass[i] = static_cast<std::uint8_t>(rng.uniform_index(8));
-      ++with_p;
     }
     const Eigen::Vector3i s(0, static_cast<int>(rng.uniform_index(5)), 0), g(5, static_cast<int>(rng.uniform_index(5)), 3);
     const std::optional<float> w = heuristic::widest_threshold(p, env, dims, s, g, pass);
@@ -186,14 +185,13 @@ TEST_CASE("The widest threshold is the largest one whose cells still join start 
     // The rule: the fixed threshold when its cells hold a chain, the widest one below it otherwise.
     for (const double t0 : {0.05, 0.3, 0.9}) {
       const double t = heuristic::region_threshold(p, env, dims, s, g, t0, true, pass);
-      CHECK(t == std::min(t0, static_cast<double>(*w)));
+      CHECK(t == std::min(t0, std::max(static_cast<double>(*w), heuristic::kWidestFloor)));
       CHECK(heuristic::region_threshold(p, env, dims, s, g, t0, false, pass) == t0);
     }
   }
-  // Both outcomes, with and without P, are exercised.
+  // Both outcomes are exercised.
   CHECK(found >= 50);
   CHECK(none >= 10);
-  CHECK(with_p == 150);
 }
 
 TEST_CASE("With the widest rule the raw region joins start and goal whenever non-solid cells do", "[REQ-HEUR-016]") {
@@ -222,8 +220,14 @@ TEST_CASE("With the widest rule the raw region joins start and goal whenever non
   // A closed wall: no chain, the fixed threshold stays.
   g.env[heuristic::cell_index(kDims, 4, 2, 1)] = heuristic::kSolid;
   CHECK(heuristic::region_threshold(g.p, g.env, kDims, {0, 1, 1}, {7, 1, 1}, 0.2, true) == 0.2);
-  // A second gap the network rates higher wins, though it is farther.
+  // A gap rated 0 (the sigmoid's saturated tail) stops the threshold at the floor, never 0.
   g.env[heuristic::cell_index(kDims, 4, 2, 1)] = heuristic::kPartial;
+  g.set_p(4, 2, 1, 0.0f);
+  CHECK(heuristic::region_threshold(g.p, g.env, kDims, {0, 1, 1}, {7, 1, 1}, 0.2, true) == heuristic::kWidestFloor);
+  CHECK_THROWS_WITH(heuristic::region_threshold(g.p, std::vector<std::uint8_t>(5), kDims, {0, 1, 1}, {7, 1, 1}, 0.2, true),
+                    Catch::Matchers::Contains("grids of different sizes"));
+  g.set_p(4, 2, 1, 0.03f);
+  // A second gap the network rates higher wins, though it is farther.
   g.env[heuristic::cell_index(kDims, 4, 3, 3)] = heuristic::kPartial;
   g.set_p(4, 3, 3, 0.1f);
   CHECK(heuristic::region_threshold(g.p, g.env, kDims, {0, 1, 1}, {7, 1, 1}, 0.2, true) == Approx(0.1f));

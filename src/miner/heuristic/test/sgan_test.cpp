@@ -19,8 +19,10 @@
 #include "miner/core/json_io.hpp"
 #include "miner/core/rng.hpp"
 #include "miner/heuristic/grid.hpp"
+#include "miner/heuristic/region_filter.hpp"
 #include "miner/heuristic/sgan.hpp"
 #include "miner/heuristic/tensor_file.hpp"
+#include "miner/world/map_generator.hpp"
 
 using Catch::Matchers::Contains;
 namespace heuristic = miner::heuristic;
@@ -107,6 +109,22 @@ std::vector<float> blocked_for(const heuristic::Sgan& g, const std::vector<float
     for (std::size_t a = 0; a < 3; ++a) b[a * n + i] = (p >> a & 1) ? 0.0f : 1.0f;
   }
   return b;
+}
+
+/// The JSON header of a miner-tensors-v1 file's bytes.
+miner::Json header_of(const std::string& blob) {
+  const std::uint32_t n = static_cast<std::uint8_t>(blob[8]) | static_cast<std::uint8_t>(blob[9]) << 8 |
+                          static_cast<std::uint8_t>(blob[10]) << 16 |
+                          static_cast<std::uint32_t>(static_cast<std::uint8_t>(blob[11])) << 24;
+  return miner::parse_json(blob.substr(12, n), "header");
+}
+
+/// The same file's bytes with another header (the tensors' bytes and checksum kept).
+std::string with_header(const std::string& blob, const miner::Json& h) {
+  const std::string data = blob.substr(blob.size() - header_of(blob)["data_bytes"].get<std::size_t>());
+  const std::string text = h.dump();
+  const auto n = static_cast<std::uint32_t>(text.size());
+  return blob.substr(0, 8) + std::string(reinterpret_cast<const char*>(&n), 4) + text + data;
 }
 
 }  // namespace
@@ -329,17 +347,8 @@ TEST_CASE("A missing, truncated, altered or mismatched weights file is refused n
   // Issue 20: the header is strict. Unknown keys anywhere, a wrong layer list, tensors that
   // share bytes or leave bytes over, and an input scale the network never saw are refused.
   {
-    const miner::Json header = [&] {
-      const std::uint32_t n = static_cast<std::uint8_t>(good[8]) | static_cast<std::uint8_t>(good[9]) << 8 |
-                              static_cast<std::uint8_t>(good[10]) << 16 | static_cast<std::uint32_t>(static_cast<std::uint8_t>(good[11])) << 24;
-      return miner::parse_json(good.substr(12, n), "header");
-    }();
-    const std::string data = good.substr(good.size() - header["data_bytes"].get<std::size_t>());
-    const auto rewritten = [&](const miner::Json& h) {
-      const std::string text = h.dump();
-      const auto n = static_cast<std::uint32_t>(text.size());
-      return good.substr(0, 8) + std::string(reinterpret_cast<const char*>(&n), 4) + text + data;
-    };
+    const miner::Json header = header_of(good);
+    const auto rewritten = [&](const miner::Json& h) { return with_header(good, h); };
     const auto refuses = [&](const std::function<void(miner::Json&)>& edit, const std::string& message) {
       miner::Json h = header;
       edit(h);
@@ -384,4 +393,28 @@ TEST_CASE("A missing, truncated, altered or mismatched weights file is refused n
                                                             values),
                                                 "nan.bin"),
                     Contains("non-finite"));
+}
+
+TEST_CASE("A query thresholds by the weights' rule: widest lowers it until start and goal join", "[REQ-HEUR-016]") {
+  // The shipped network with its threshold raised to 0.99: at that t0 almost no cell is in the
+  // raw region, so the fixed rule leaves start and goal apart and the widest rule lowers t0 to
+  // the best chain's weakest cell, which the raw region then holds end to end.
+  const std::string good = miner::read_file_bytes(kFixtures + "sgan.bin");
+  const miner::world::Map map = miner::world::generate_map(miner::world::generator_preset("sim"), 1);
+  const auto& q = *map.query();
+  const auto query = [&](const char* rule) {
+    miner::Json h = header_of(good);
+    h["meta"]["architecture"]["threshold"] = 0.99;
+    h["meta"]["architecture"]["threshold_rule"] = rule;
+    return heuristic::query_region(heuristic::Sgan::from_bytes(with_header(good, h), rule), map, q.start, q.goal,
+                                   q.robot_radius, 1, false);
+  };
+  const heuristic::HeuristicQuery fixed = query("fixed"), widest = query("widest");
+  CHECK(fixed.report.threshold == 0.99);
+  CHECK_FALSE(fixed.report.raw_connected);
+  CHECK(widest.report.threshold < 0.99);
+  CHECK(widest.report.threshold >= heuristic::kWidestFloor);
+  CHECK(widest.report.raw_connected);
+  CHECK(widest.region.threshold() == widest.report.threshold);  // the raw region carries it
+  CHECK(fixed.probabilities == widest.probabilities);           // the same network output
 }

@@ -32,6 +32,14 @@ void for_neighbours(const Eigen::Vector3i& dims, const Eigen::Vector3i& c, F&& f
       }
 }
 
+/// Throws unless R, E and (when given) P each hold one value per cell of the grid.
+void require_one_grid(const std::vector<float>& p, const std::vector<std::uint8_t>& env,
+                      const std::vector<std::uint8_t>& passability, const Eigen::Vector3i& dims) {
+  const auto n = static_cast<std::size_t>(dims.prod());
+  if (p.size() != n || env.size() != n || (!passability.empty() && passability.size() != n))
+    throw Error("region filter: grids of different sizes");
+}
+
 /// A chain's step from cell u to its neighbour v: v not solid and, with channel P, every axis
 /// the step moves along passable in both cells.
 bool step_allowed(const std::vector<std::uint8_t>& env, const std::vector<std::uint8_t>& passability,
@@ -72,9 +80,8 @@ bool chain_at(const std::vector<float>& p, const std::vector<std::uint8_t>& env,
 std::optional<float> widest_threshold(const std::vector<float>& p, const std::vector<std::uint8_t>& env,
                                       const Eigen::Vector3i& dims, const Eigen::Vector3i& start_cell,
                                       const Eigen::Vector3i& goal_cell, const std::vector<std::uint8_t>& passability) {
+  require_one_grid(p, env, passability, dims);
   const auto n = static_cast<std::size_t>(dims.prod());
-  if (p.size() != n || env.size() != n || (!passability.empty() && passability.size() != n))
-    throw Error("region filter: grids of different sizes");
   const std::size_t is = cell_index(dims, start_cell.x(), start_cell.y(), start_cell.z());
   const std::size_t ig = cell_index(dims, goal_cell.x(), goal_cell.y(), goal_cell.z());
   if (env[is] == kSolid || env[ig] == kSolid) return std::nullopt;
@@ -110,9 +117,7 @@ double region_threshold(const std::vector<float>& p, const std::vector<std::uint
                         const Eigen::Vector3i& start_cell, const Eigen::Vector3i& goal_cell, double threshold,
                         bool widest, const std::vector<std::uint8_t>& passability) {
   if (!widest) return threshold;
-  const auto n = static_cast<std::size_t>(dims.prod());
-  if (p.size() != n || env.size() != n || (!passability.empty() && passability.size() != n))
-    throw Error("region filter: grids of different sizes");
+  require_one_grid(p, env, passability, dims);
   const std::size_t is = cell_index(dims, start_cell.x(), start_cell.y(), start_cell.z());
   const std::size_t ig = cell_index(dims, goal_cell.x(), goal_cell.y(), goal_cell.z());
   // Most queries: the fixed threshold's cells already hold a chain (a search of those alone).
@@ -131,8 +136,8 @@ double region_threshold(const std::vector<float>& p, const std::vector<std::uint
 FilteredRegion filter_region(const std::vector<float>& p, const std::vector<std::uint8_t>& env,
                              const Eigen::Vector3i& dims, const Eigen::Vector3i& start_cell,
                              const Eigen::Vector3i& goal_cell, double threshold) {
+  require_one_grid(p, env, {}, dims);
   const auto n = static_cast<std::size_t>(dims.prod());
-  if (p.size() != n || env.size() != n) throw Error("region filter: grids of different sizes");
   FilteredRegion out;
   FilterReport& r = out.report;
   std::vector<std::uint8_t> mask(n, 0);

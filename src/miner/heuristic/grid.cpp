@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <deque>
+#include <type_traits>
 
 #include "miner/world/map.hpp"
 
@@ -154,17 +155,49 @@ std::uint64_t subcells_in_grown_voxels(const world::VoxelObstacles& voxels, doub
   return blocked;
 }
 
+/// encode()'s working arrays, kept by each thread between calls (issue 16: made afresh, the
+/// ~300 kB of them were mapped and page-faulted on every query, which cost more than the
+/// encoding itself on the sim maps). Their contents never carry from one call to the next.
+struct EncodeScratch {
+  std::vector<world::Box> grown, local;
+  std::vector<std::pair<Eigen::Vector3i, Eigen::Vector3i>> range;
+  std::vector<std::uint32_t> offset, touching;
+  std::vector<std::pair<std::uint32_t, std::uint64_t>> box_blocked;
+
+  /// Gives back arrays grown past kKeptBytes (a huge map's), so that one such query does not
+  /// hold its memory for the thread's life.
+  void trim() {
+    constexpr std::size_t kKeptBytes = std::size_t{64} << 20;
+    auto trim_one = [](auto& v) {
+      if (v.capacity() * sizeof(v[0]) > kKeptBytes) std::remove_reference_t<decltype(v)>().swap(v);
+    };
+    trim_one(grown);
+    trim_one(local);
+    trim_one(range);
+    trim_one(offset);
+    trim_one(touching);
+    trim_one(box_blocked);
+  }
+};
+
 /// E, and P when `passability` is given (see grid.hpp).
 std::vector<std::uint8_t> encode(const world::Map& map, const Eigen::Vector3i& dims, double radius,
                                  std::vector<std::uint8_t>* passability) {
+  thread_local EncodeScratch scratch;
+  struct Trim {
+    EncodeScratch& s;
+    ~Trim() { s.trim(); }
+  } trim_on_exit{scratch};
   const world::Box& b = map.bounds();
   const Eigen::Vector3d c = cell_size(b, dims);
   const auto cells = static_cast<std::size_t>(dims.prod());
   std::vector<std::uint8_t> e(cells, kFree);
   // The grown obstacles and the cell range each one meets: cell i's closed box
   // [b + i c, b + (i+1) c] meets [g.min, g.max] iff (g.min - b)/c - 1 <= i <= (g.max - b)/c.
-  std::vector<world::Box> grown;
-  std::vector<std::pair<Eigen::Vector3i, Eigen::Vector3i>> range;
+  std::vector<world::Box>& grown = scratch.grown;
+  std::vector<std::pair<Eigen::Vector3i, Eigen::Vector3i>>& range = scratch.range;
+  grown.clear();
+  range.clear();
   for (const world::Box& o : map.obstacles()) {
     grown.push_back(o.inflated(radius));
     const world::Box& g = grown.back();
@@ -176,7 +209,8 @@ std::vector<std::uint8_t> encode(const world::Map& map, const Eigen::Vector3i& d
     range.emplace_back(lo, hi);
   }
   // Obstacles meeting each cell, as one flat list (offsets per cell): count, then fill.
-  std::vector<std::uint32_t> offset(cells + 1, 0);
+  std::vector<std::uint32_t>& offset = scratch.offset;
+  offset.assign(cells + 1, 0);
   const auto for_each_cell = [&](std::size_t o, auto&& f) {
     const auto& [lo, hi] = range[o];
     for (int k = lo.z(); k <= hi.z(); ++k)
@@ -185,14 +219,22 @@ std::vector<std::uint8_t> encode(const world::Map& map, const Eigen::Vector3i& d
   };
   for (std::size_t o = 0; o < grown.size(); ++o) for_each_cell(o, [&](std::size_t idx) { ++offset[idx + 1]; });
   for (std::size_t idx = 0; idx < cells; ++idx) offset[idx + 1] += offset[idx];
-  std::vector<std::uint32_t> touching(offset[cells]);
-  std::vector<std::uint32_t> fill(offset.begin(), offset.end() - 1);
+  std::vector<std::uint32_t>& touching = scratch.touching;
+  touching.resize(offset[cells]);
+  // Filled with offset[idx] as the cursor (from idx's start to its end, which is where idx + 1
+  // starts), then shifted back one cell: no second array of cells + 1 entries (issue 16: the
+  // query's large temporaries were mapped afresh, and page-faulted, on every call).
   for (std::size_t o = 0; o < grown.size(); ++o)
-    for_each_cell(o, [&](std::size_t idx) { touching[fill[idx]++] = static_cast<std::uint32_t>(o); });
+    for_each_cell(o, [&](std::size_t idx) { touching[offset[idx]++] = static_cast<std::uint32_t>(o); });
+  for (std::size_t idx = cells; idx > 0; --idx) offset[idx] = offset[idx - 1];
+  offset[0] = 0;
 
-  // Blocked sub-cells of each partial cell, for P (only when asked for).
-  std::vector<std::uint64_t> blocked(passability ? cells : 0, 0);
-  std::vector<world::Box> local;
+  // Blocked sub-cells of the partial cells the boxes meet, for P (only when asked for): (cell,
+  // mask) in increasing cell order, only for those cells (a mask per cell of the grid was 8
+  // bytes x 32^3, mapped and cleared on every query).
+  std::vector<std::pair<std::uint32_t, std::uint64_t>>& box_blocked = scratch.box_blocked;
+  box_blocked.clear();
+  std::vector<world::Box>& local = scratch.local;
   for (std::size_t idx = 0; idx < cells; ++idx) {
     if (offset[idx] == offset[idx + 1]) continue;
     e[idx] = kPartial;
@@ -214,19 +256,26 @@ std::vector<std::uint8_t> encode(const world::Map& map, const Eigen::Vector3i& d
     constexpr double kVolumeRounding = 1e-9;
     const bool could_fill = clipped_volume >= cell.extent().prod() * (1.0 - kVolumeRounding);
     if (inside_one || (local.size() > 1 && could_fill && box_covered(cell, local))) e[idx] = kSolid;
-    if (passability && e[idx] == kPartial)
-      for (const world::Box& g : local) blocked[idx] |= subcells_inside(cell, g);
+    if (passability && e[idx] == kPartial) {
+      std::uint64_t blocked = 0;
+      for (const world::Box& g : local) blocked |= subcells_inside(cell, g);
+      box_blocked.emplace_back(static_cast<std::uint32_t>(idx), blocked);
+    }
   }
   if (map.voxels()) encode_voxels(map, dims, radius, e);
   if (passability) {
     passability->assign(cells, 0);
+    std::size_t next = 0;  // box_blocked's entry for the next cell it holds
     for (std::size_t idx = 0; idx < cells; ++idx) {
+      std::uint64_t blocked = 0;
+      // An entry is passed even when the voxels made its cell solid.
+      if (next < box_blocked.size() && box_blocked[next].first == idx) blocked = box_blocked[next++].second;
       if (e[idx] == kFree) {
         (*passability)[idx] = kPassAll;
       } else if (e[idx] == kPartial) {
         if (map.voxels())
-          blocked[idx] |= subcells_in_grown_voxels(*map.voxels(), radius, cell_box(b, dims, cell_coords(dims, idx)));
-        (*passability)[idx] = passability_of(~blocked[idx]);
+          blocked |= subcells_in_grown_voxels(*map.voxels(), radius, cell_box(b, dims, cell_coords(dims, idx)));
+        (*passability)[idx] = passability_of(~blocked);
       }
     }
   }

@@ -298,6 +298,43 @@ struct Sgan::Impl {
     for (int a = 0; a < arch.passability_channels; ++a) cond1.data[c * v + 2 + static_cast<std::size_t>(a)] = pass[a];
   }
 
+  /// The dataset encoding as the own kernels' input (set_input's effect for every voxel, in one
+  /// pass without its per-voxel branching): E/2 = scale E, S, the blocked bits 1 - P_a when
+  /// the network reads P, and N drawn from `rng` in voxel order (x fastest).
+  void set_input_encoded(const std::uint8_t* environment, const std::uint8_t* state, const std::uint8_t* passability,
+                         float scale, Rng& rng) {
+    sparse.clear();
+    const Eigen::Vector3i d = cond1.dims;
+    const auto nc = static_cast<std::size_t>(cond1.channels);
+    const bool reads_p = arch.passability_channels != 0;
+    std::array<float*, kernels::kMaxConditions> planes{};
+    for (std::size_t c = 0; c < nc; ++c) planes[c] = condition_padded[c].data();
+    float* cond = cond1.data.data();
+    float* noise = noise_padded.data();
+    std::size_t v = 0;
+    for (int z = 0; z < d.z(); ++z)
+      for (int y = 0; y < d.y(); ++y) {
+        int padded = ((z + 1) * (d.y() + 2) + y + 1) * (d.x() + 2) + 1;
+        for (int x = 0; x < d.x(); ++x, ++v, ++padded) {
+          const auto p = static_cast<std::size_t>(padded);
+          noise[p] = static_cast<float>(rng.normal_ziggurat());
+          // The blocked bits: 0 on free cells (train.py's to_inputs).
+          const unsigned blocked = reads_p ? ~static_cast<unsigned>(passability[v]) & kPassAll : 0U;
+          kernels::SparseInput in{padded,
+                                  {scale * static_cast<float>(environment[v]), static_cast<float>(state[v]),
+                                   static_cast<float>(blocked & 1U), static_cast<float>((blocked >> 1) & 1U),
+                                   static_cast<float>((blocked >> 2) & 1U)}};
+          float* cv = cond + v * nc;
+          for (std::size_t c = 0; c < nc; ++c) {
+            planes[c][p] = in.condition[c];
+            cv[c] = in.condition[c];
+          }
+          // scale > 0 (checked at load), so E/2 is nonzero exactly where E is.
+          if ((environment[v] | state[v] | blocked) != 0) sparse.push_back(in);
+        }
+      }
+  }
+
   /// Calls f(x, y, z, v) for every voxel in index order (x fastest).
   template <class F>
   void for_voxels(F&& f) const {
@@ -720,6 +757,21 @@ std::vector<float> Sgan::Impl::run() {
   return g.out.data;
 }
 
+namespace {
+
+/// A probability outside [0, 1] or not a number means weights the network cannot carry (e.g.
+/// entries near FLT_MAX overflow a layer); the threshold would drop such cells silently and
+/// leave a 2-cell region (issue 20), so the answer is checked before it is returned.
+std::vector<float> checked_probabilities(const std::string& path, std::vector<float> r) {
+  for (std::size_t v = 0; v < r.size(); ++v)
+    if (!(r[v] >= 0.0F && r[v] <= 1.0F))
+      throw Error(path + ": the network's output at cell " + std::to_string(v) + " is " + std::to_string(r[v]) +
+                  ", not a probability: the weights overflow a layer (check the file's tensors)");
+  return r;
+}
+
+}  // namespace
+
 std::vector<float> Sgan::predict(const std::vector<std::uint8_t>& environment, const std::vector<std::uint8_t>& state,
                                  const std::vector<std::uint8_t>& passability, const world::Box& bounds,
                                  double robot_radius, Rng& rng) const {
@@ -732,6 +784,10 @@ std::vector<float> Sgan::predict(const std::vector<std::uint8_t>& environment, c
     throw Error("sgan: the network reads P: " + std::to_string(n) + " cells, given " + std::to_string(passability.size()));
   if (g.arch.scale_channels != 0) g.set_scale(scale_input(bounds, g.arch.dims, robot_radius, g.arch.scale_divisor));
   const auto scale = static_cast<float>(g.arch.environment_scale);
+  if (g.own_kernels) {
+    g.set_input_encoded(environment.data(), state.data(), passability.data(), scale, rng);
+    return checked_probabilities(g.path, g.run());
+  }
   g.begin_input();
   g.for_voxels([&](int x, int y, int z, std::size_t v) {
     float p[3] = {0.0F, 0.0F, 0.0F};
@@ -740,15 +796,7 @@ std::vector<float> Sgan::predict(const std::vector<std::uint8_t>& environment, c
     g.set_input(x, y, z, v, scale * static_cast<float>(environment[v]), static_cast<float>(state[v]),
                 static_cast<float>(rng.normal_ziggurat()), p);
   });
-  std::vector<float> r = g.run();
-  // A probability outside [0, 1] or not a number means weights the network cannot carry (e.g.
-  // entries near FLT_MAX overflow a layer); the threshold would drop such cells silently and
-  // leave a 2-cell region (issue 20), so the answer is checked before it is returned.
-  for (std::size_t v = 0; v < r.size(); ++v)
-    if (!(r[v] >= 0.0F && r[v] <= 1.0F))
-      throw Error(g.path + ": the network's output at cell " + std::to_string(v) + " is " + std::to_string(r[v]) +
-                  ", not a probability: the weights overflow a layer (check the file's tensors)");
-  return r;
+  return checked_probabilities(g.path, g.run());
 }
 
 std::vector<double> reference_errors(const Sgan& sgan, const std::string& reference_path) {

@@ -40,6 +40,48 @@ void clear_border(const int n[3], int c, float* padded) {
     }
 }
 
+/// first_layer's sparse part for NC conditions (a compile-time count: the channel loop unrolls).
+template <int NC>
+[[gnu::always_inline]] inline void scatter_conditions(const std::vector<SparseInput>& sparse,
+                                                      const v8 (&wc)[kMaxConditions][27], const std::ptrdiff_t (&off)[27],
+                                                      float* a1_padded) {
+  for (const SparseInput& s : sparse) {
+    float c[NC];
+    for (int k = 0; k < NC; ++k) c[k] = s.condition[k];
+    for (int t = 0; t < 27; ++t) {
+      float* dst = a1_padded + (s.padded - off[t]) * kWidth;
+      v8 cur;
+      load8(cur, dst);
+      v8 add = c[0] * wc[0][t] + c[1] * wc[1][t];
+      for (int k = 2; k < NC; ++k) add += c[k] * wc[k][t];
+      cur += add;
+      std::memcpy(dst, &cur, sizeof cur);
+    }
+  }
+}
+
+/// last_layer_skip's conditions for the 8 voxels from `at` (padded index) on: sum over taps t and
+/// conditions k of c_k[at + tap_t] W_k[t], E/2 and S as one expression (the bytes before P).
+template <int NC>
+[[gnu::always_inline]] inline void gather_conditions(v8& sum, const float* const* condition_padded, std::ptrdiff_t at,
+                                                     const std::ptrdiff_t (&tap)[27],
+                                                     const float (&wc)[kMaxConditions][27]) {
+  const float* planes[NC];
+  for (int k = 0; k < NC; ++k) planes[k] = condition_padded[k] + at;
+  for (int t = 0; t < 27; ++t) {
+    v8 e, st;
+    load8(e, planes[0] + tap[t]);
+    load8(st, planes[1] + tap[t]);
+    v8 add = e * wc[0][t] + st * wc[1][t];
+    for (int k = 2; k < NC; ++k) {
+      v8 b;
+      load8(b, planes[k] + tap[t]);
+      add += b * wc[k][t];
+    }
+    sum += add;
+  }
+}
+
 }  // namespace
 
 // Tap t = (dz + 1) 9 + (dy + 1) 3 + (dx + 1), as PyTorch's [kd][kh][kw] flattened. A voxel v
@@ -63,16 +105,10 @@ void first_layer(const int n[3], int conditions, const float* noise_padded, cons
   // blocked bits came, so a 2-condition network gives the same bytes.
   std::ptrdiff_t off[27];
   for (int t = 0; t < 27; ++t) off[t] = (t / 9 - 1) * pxy + (t / 3 % 3 - 1) * px + (t % 3 - 1);
-  for (const SparseInput& s : sparse)
-    for (int t = 0; t < 27; ++t) {
-      float* dst = a1_padded + (s.padded - off[t]) * kWidth;
-      v8 cur;
-      load8(cur, dst);
-      v8 add = s.condition[0] * wc[0][t] + s.condition[1] * wc[1][t];
-      for (int c = 2; c < nc; ++c) add += s.condition[c] * wc[c][t];
-      cur += add;
-      std::memcpy(dst, &cur, sizeof cur);
-    }
+  if (nc == 2)
+    scatter_conditions<2>(sparse, wc, off, a1_padded);
+  else
+    scatter_conditions<kMaxConditions>(sparse, wc, off, a1_padded);
   clear_border(n, kWidth, a1_padded);
   // N gathered for 8 voxels along x at a time (independent sums), the bias, ReLU.
   v8 b;
@@ -123,24 +159,14 @@ void last_layer_skip(const int n[3], int conditions, const float* a1_padded, con
     for (int y = 0; y < ny; ++y) {
       const std::ptrdiff_t row = (z + 1) * pxy + (y + 1) * px + 1;  // padded index of (0, y, z)
       const float* arow = a1_padded + row * kWidth;
-      const float* erow = condition_padded[0] + row;
-      const float* strow = condition_padded[1] + row;
       float* out = logits + (static_cast<std::ptrdiff_t>(z) * ny + y) * nx;
       for (int x = 0; x + 8 <= nx; x += 8) {
         v8 acc[8] = {};
         v8 sparse_part = {};  // the conditions: the 8 voxels in the lanes
-        for (int t = 0; t < 27; ++t) {
-          v8 e, st;
-          load8(e, erow + x + tap[t]);
-          load8(st, strow + x + tap[t]);
-          v8 add = e * wc[0][t] + st * wc[1][t];  // E/2 and S as one expression (same bytes as before P)
-          for (int c = 2; c < nc; ++c) {
-            v8 b;
-            load8(b, condition_padded[c] + row + x + tap[t]);
-            add += b * wc[c][t];
-          }
-          sparse_part += add;
-        }
+        if (nc == 2)
+          gather_conditions<2>(sparse_part, condition_padded, row + x, tap, wc);
+        else
+          gather_conditions<kMaxConditions>(sparse_part, condition_padded, row + x, tap, wc);
         for (int t = 0; t < 27; ++t) {
           const v8 w = wa[t];
           const float* p = arow + x * kWidth + off[t];

@@ -257,6 +257,7 @@ struct Sgan::Impl {
   // (oneDNN) reads with padding 0.
   bool own_kernels = false;
   std::vector<float> noise_padded, a1_padded;
+  std::vector<float> noise;  // a query's N, voxel order (predict)
   std::vector<std::vector<float>> condition_padded;  // one planar padded grid per condition
   std::vector<const float*> condition_pointers;
   std::vector<kernels::SparseInput> sparse;
@@ -300,9 +301,9 @@ struct Sgan::Impl {
 
   /// The dataset encoding as the own kernels' input (set_input's effect for every voxel, in one
   /// pass without its per-voxel branching): E/2 = scale E, S, the blocked bits 1 - P_a when
-  /// the network reads P, and N drawn from `rng` in voxel order (x fastest).
+  /// the network reads P, and N = noise (x fastest).
   void set_input_encoded(const std::uint8_t* environment, const std::uint8_t* state, const std::uint8_t* passability,
-                         float scale, Rng& rng) {
+                         float scale, const float* noise_in) {
     sparse.clear();
     const Eigen::Vector3i d = cond1.dims;
     const auto nc = static_cast<std::size_t>(cond1.channels);
@@ -317,7 +318,7 @@ struct Sgan::Impl {
         int padded = ((z + 1) * (d.y() + 2) + y + 1) * (d.x() + 2) + 1;
         for (int x = 0; x < d.x(); ++x, ++v, ++padded) {
           const auto p = static_cast<std::size_t>(padded);
-          noise[p] = static_cast<float>(rng.normal_ziggurat());
+          noise[p] = noise_in[v];
           // The blocked bits: 0 on free cells (train.py's to_inputs).
           const unsigned blocked = reads_p ? ~static_cast<unsigned>(passability[v]) & kPassAll : 0U;
           kernels::SparseInput in{padded,
@@ -784,8 +785,11 @@ std::vector<float> Sgan::predict(const std::vector<std::uint8_t>& environment, c
     throw Error("sgan: the network reads P: " + std::to_string(n) + " cells, given " + std::to_string(passability.size()));
   if (g.arch.scale_channels != 0) g.set_scale(scale_input(bounds, g.arch.dims, robot_radius, g.arch.scale_divisor));
   const auto scale = static_cast<float>(g.arch.environment_scale);
+  // N(0, 1) in voxel order (x fastest), one bulk draw of the query's stream.
+  g.noise.resize(n);
+  rng.fill_normal_ziggurat(g.noise.data(), n);
   if (g.own_kernels) {
-    g.set_input_encoded(environment.data(), state.data(), passability.data(), scale, rng);
+    g.set_input_encoded(environment.data(), state.data(), passability.data(), scale, g.noise.data());
     return checked_probabilities(g.path, g.run());
   }
   g.begin_input();
@@ -794,7 +798,7 @@ std::vector<float> Sgan::predict(const std::vector<std::uint8_t>& environment, c
     // The network reads the blocked bits 1 - P_a (train.py's to_inputs): 0 on free cells.
     for (int a = 0; a < pc; ++a) p[a] = 1.0F - static_cast<float>((passability[v] >> a) & 1U);
     g.set_input(x, y, z, v, scale * static_cast<float>(environment[v]), static_cast<float>(state[v]),
-                static_cast<float>(rng.normal_ziggurat()), p);
+                g.noise[v], p);
   });
   return checked_probabilities(g.path, g.run());
 }

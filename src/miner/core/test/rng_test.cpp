@@ -117,25 +117,24 @@ TEST_CASE("normal() draws its pairs independently: no correlation between the tw
   CHECK(frozen.normal() == Approx(0.97271450413705274).epsilon(1e-14));
 }
 
-TEST_CASE("normal_ziggurat() is N(0, 1): closed layers, moments, CDF and tail", "[REQ-CORE-001]") {
-  // The recurrence from (r, v) must close the top layer at area v (it is the whole check
-  // that the 256 layers are right); 1e-9 is far above the 1e-11 the doubles reach.
-  CHECK(std::fabs(miner::ziggurat_top_layer_area() - 1.0) < 1e-9);
-  Rng rng(4);
-  constexpr int kN = 400000;
-  std::vector<double> xs(kN);
+namespace {
+
+/// Checks that xs look like draws of N(0, 1): mean and variance within 5
+/// standard errors, Kolmogorov-Smirnov at alpha = 1e-6, the tail beyond the ziggurat's r
+/// (reached only through its tail branch) within 5 binomial sd and not empty.
+void check_standard_normal(std::vector<double> xs) {
+  const auto n = static_cast<double>(xs.size());
   double sum = 0.0, sum2 = 0.0;
-  int tail = 0;  // |x| > r = 3.6541528853610088, only reached through the tail branch
-  for (double& x : xs) {
-    x = rng.normal_ziggurat();
+  int tail = 0;  // |x| > r = 3.6541528853610088
+  for (double x : xs) {
     sum += x;
     sum2 += x * x;
     tail += std::fabs(x) > 3.6541528853610088;
   }
-  const double mean = sum / kN, var = sum2 / kN - mean * mean;
+  const double mean = sum / n, var = sum2 / n - mean * mean;
   // 5 standard errors: mean 1/sqrt(N), variance sqrt(2/N).
-  CHECK(std::fabs(mean) < 5.0 / std::sqrt(kN));
-  CHECK(std::fabs(var - 1.0) < 5.0 * std::sqrt(2.0 / kN));
+  CHECK(std::fabs(mean) < 5.0 / std::sqrt(n));
+  CHECK(std::fabs(var - 1.0) < 5.0 * std::sqrt(2.0 / n));
   // Kolmogorov-Smirnov against Phi: the critical value at alpha = 1e-6 is
   // sqrt(-ln(alpha / 2) / 2) / sqrt(N) = 2.78 / sqrt(N); a wrong layer or wedge shows as a
   // step in the empirical CDF far larger than that.
@@ -143,16 +142,67 @@ TEST_CASE("normal_ziggurat() is N(0, 1): closed layers, moments, CDF and tail", 
   double d = 0.0;
   for (std::size_t k = 0; k < xs.size(); ++k) {
     const double phi = 0.5 * std::erfc(-xs[k] / std::sqrt(2.0));
-    d = std::max({d, std::fabs(phi - static_cast<double>(k) / kN), std::fabs(phi - static_cast<double>(k + 1) / kN)});
+    d = std::max({d, std::fabs(phi - static_cast<double>(k) / n), std::fabs(phi - static_cast<double>(k + 1) / n)});
   }
-  CHECK(d < 2.78 / std::sqrt(kN));
+  CHECK(d < 2.78 / std::sqrt(n));
   // P(|x| > r) = erfc(r / sqrt 2) = 2.58e-4: ~103 of 400000, binomial sd ~10; 5 sd bounds.
   const double p_tail = std::erfc(3.6541528853610088 / std::sqrt(2.0));
-  const double sd = std::sqrt(kN * p_tail * (1.0 - p_tail));
-  CHECK(std::fabs(tail - kN * p_tail) < 5.0 * sd);
+  const double sd = std::sqrt(n * p_tail * (1.0 - p_tail));
+  CHECK(std::fabs(tail - n * p_tail) < 5.0 * sd);
   CHECK(tail > 0);
+  // Beyond the base layer's width x_0 = v / f(r) = 3.91 only the tail branch reaches: its
+  // count must match P(|x| > 3.95) = 7.8e-5 (~31 of 400000, sd ~5.6; 5 sd bounds). A draw
+  // that kept every core-or-not value (no tail, no wedge rejection) has none there.
+  int far = 0;
+  for (double x : xs) far += std::fabs(x) > 3.95;
+  const double p_far = std::erfc(3.95 / std::sqrt(2.0));
+  CHECK(std::fabs(far - n * p_far) < 5.0 * std::sqrt(n * p_far * (1.0 - p_far)));
+  CHECK(far > 0);
+}
+
+}  // namespace
+
+TEST_CASE("normal_ziggurat() is N(0, 1): closed layers, moments, CDF and tail", "[REQ-CORE-001]") {
+  // The recurrence from (r, v) must close the top layer at area v (it is the whole check
+  // that the 256 layers are right); 1e-9 is far above the 1e-11 the doubles reach.
+  CHECK(std::fabs(miner::ziggurat_top_layer_area() - 1.0) < 1e-9);
+  Rng rng(4);
+  std::vector<double> xs(400000);
+  for (double& x : xs) x = rng.normal_ziggurat();
+  check_standard_normal(xs);
   // Same seed, same numbers; not the polar method's sequence.
   Rng a(9), b(9), c(9);
   for (int i = 0; i < 100; ++i) REQUIRE(a.normal_ziggurat() == b.normal_ziggurat());
   CHECK(Rng(9).normal_ziggurat() != c.normal());
+}
+
+TEST_CASE("fill_normal_ziggurat() is N(0, 1) with neighbours independent, the same for a seed", "[REQ-CORE-001]") {
+  // Its first draws come from SplitMix64's sequence, not the engine: the same checks as
+  // normal_ziggurat(), in float.
+  Rng rng(4);
+  std::vector<float> fs(400000);
+  rng.fill_normal_ziggurat(fs.data(), fs.size());
+  std::vector<double> xs(fs.begin(), fs.end());
+  check_standard_normal(xs);
+  // Neighbours are independent (a counter stream with a bad increment would correlate them):
+  // lag-1 and lag-2 sample correlations within 6 standard errors 1/sqrt(N).
+  for (std::size_t lag : {std::size_t{1}, std::size_t{2}}) {
+    double sxy = 0.0, sxx = 0.0;
+    for (std::size_t k = 0; k + lag < fs.size(); ++k) {
+      sxy += static_cast<double>(fs[k]) * fs[k + lag];
+      sxx += static_cast<double>(fs[k]) * fs[k];
+    }
+    CHECK(std::fabs(sxy / sxx) < 6.0 / std::sqrt(static_cast<double>(fs.size())));
+  }
+  // Same seed and stream, same values; another stream, others; one call's values are not the
+  // next call's (each call draws its own key from the stream).
+  std::vector<float> a(1000), b(1000), c(1000), a2(1000);
+  Rng ra(9, 3), rb(9, 3), rc(9, 4);
+  ra.fill_normal_ziggurat(a.data(), a.size());
+  rb.fill_normal_ziggurat(b.data(), b.size());
+  rc.fill_normal_ziggurat(c.data(), c.size());
+  ra.fill_normal_ziggurat(a2.data(), a2.size());
+  CHECK(a == b);
+  CHECK(a != c);
+  CHECK(a != a2);
 }

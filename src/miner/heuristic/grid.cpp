@@ -6,6 +6,7 @@
 #include <deque>
 #include <type_traits>
 
+#include "miner/core/error.hpp"
 #include "miner/world/map.hpp"
 
 namespace miner::heuristic {
@@ -48,6 +49,10 @@ bool box_covered(const world::Box& cell, const std::vector<world::Box>& boxes) {
     std::sort(cuts[a].begin(), cuts[a].end());
     cuts[a].erase(std::unique(cuts[a].begin(), cuts[a].end()), cuts[a].end());
   }
+  // Bounded work: the sub-boxes times the boxes each is tested against (double: no wrap).
+  const double tests = static_cast<double>(cuts[0].size() - 1) * static_cast<double>(cuts[1].size() - 1) *
+                       static_cast<double>(cuts[2].size() - 1) * static_cast<double>(boxes.size());
+  if (tests > static_cast<double>(kMaxCoverTests)) return false;
   for (std::size_t i = 0; i + 1 < cuts[0].size(); ++i)
     for (std::size_t j = 0; j + 1 < cuts[1].size(); ++j)
       for (std::size_t k = 0; k + 1 < cuts[2].size(); ++k) {
@@ -155,13 +160,45 @@ std::uint64_t subcells_in_grown_voxels(const world::VoxelObstacles& voxels, doub
   return blocked;
 }
 
+/// The cells a grown box meets (lo..hi) and those it holds whole (inner_lo..inner_hi), per axis.
+struct BoxCells {
+  Eigen::Vector3i lo, hi, inner_lo, inner_hi;
+  bool has_inner() const { return (inner_lo.array() <= inner_hi.array()).all(); }
+};
+
+/// The kPassabilitySubcells^3 sub-cell centres of a cell, per axis, and which of them a closed
+/// box holds (bit x + 4 y + 16 z), by plain comparisons: a centre outside every box is a point
+/// of the cell outside their union, so box_covered() need not run.
+struct SubcellCentres {
+  std::array<std::array<double, kPassabilitySubcells>, 3> at{};
+  explicit SubcellCentres(const world::Box& cell) {
+    for (std::size_t a = 0; a < 3; ++a)
+      for (std::size_t s = 0; s < kPassabilitySubcells; ++s)
+        at[a][s] = cell.min[static_cast<int>(a)] +
+                   (static_cast<double>(s) + 0.5) * cell.extent()[static_cast<int>(a)] / kPassabilitySubcells;
+  }
+  std::uint64_t inside(const world::Box& g) const {
+    std::array<unsigned, 3> in{};  // per axis, bit s: centre s within [g.min, g.max]
+    for (std::size_t a = 0; a < 3; ++a)
+      for (std::size_t s = 0; s < kPassabilitySubcells; ++s)
+        if (at[a][s] >= g.min[static_cast<int>(a)] && at[a][s] <= g.max[static_cast<int>(a)]) in[a] |= 1U << s;
+    std::uint64_t mask = 0;
+    for (unsigned z = 0; z < kPassabilitySubcells; ++z)
+      for (unsigned y = 0; y < kPassabilitySubcells; ++y)
+        if ((in[2] >> z & 1U) && (in[1] >> y & 1U))
+          mask |= static_cast<std::uint64_t>(in[0]) << (kPassabilitySubcells * (y + kPassabilitySubcells * z));
+    return mask;
+  }
+};
+
 /// encode()'s working arrays, kept by each thread between calls (issue 16: made afresh, the
 /// ~300 kB of them were mapped and page-faulted on every query, which cost more than the
 /// encoding itself on the sim maps). Their contents never carry from one call to the next.
 struct EncodeScratch {
   std::vector<world::Box> grown, local;
-  std::vector<std::pair<Eigen::Vector3i, Eigen::Vector3i>> range;
+  std::vector<BoxCells> range;
   std::vector<std::uint32_t> offset, touching;
+  std::vector<std::int32_t> cover;
   std::vector<std::pair<std::uint32_t, std::uint64_t>> box_blocked;
 
   /// Gives back arrays grown past kKeptBytes (a huge map's), so that one such query does not
@@ -176,6 +213,7 @@ struct EncodeScratch {
     trim_one(range);
     trim_one(offset);
     trim_one(touching);
+    trim_one(cover);
     trim_one(box_blocked);
   }
 };
@@ -193,29 +231,108 @@ std::vector<std::uint8_t> encode(const world::Map& map, const Eigen::Vector3i& d
   const auto cells = static_cast<std::size_t>(dims.prod());
   std::vector<std::uint8_t> e(cells, kFree);
   // The grown obstacles and the cell range each one meets: cell i's closed box
-  // [b + i c, b + (i+1) c] meets [g.min, g.max] iff (g.min - b)/c - 1 <= i <= (g.max - b)/c.
+  // [b + i c, b + (i+1) c] meets [g.min, g.max] iff (g.min - b)/c - 1 <= i <= (g.max - b)/c;
+  // and the range of cells inside it (inner, empty when lo > hi), from the cells' own edges
+  // (cell_box's numbers, so the test is exactly cell_box(i) within g).
   std::vector<world::Box>& grown = scratch.grown;
-  std::vector<std::pair<Eigen::Vector3i, Eigen::Vector3i>>& range = scratch.range;
+  std::vector<BoxCells>& range = scratch.range;
   grown.clear();
   range.clear();
+  std::array<std::vector<double>, 3> edge_lo, edge_hi;
+  for (int a = 0; a < 3; ++a)
+    for (int i = 0; i < dims[a]; ++i) {
+      const world::Box cb = cell_box(b, dims, Eigen::Vector3i::Constant(i));
+      edge_lo[static_cast<std::size_t>(a)].push_back(cb.min[a]);
+      edge_hi[static_cast<std::size_t>(a)].push_back(cb.max[a]);
+    }
+  std::uint64_t shell_cells = 0;  // cells met but not held whole, summed over the boxes
   for (const world::Box& o : map.obstacles()) {
     grown.push_back(o.inflated(radius));
     const world::Box& g = grown.back();
-    Eigen::Vector3i lo, hi;
+    BoxCells r;
     for (int a = 0; a < 3; ++a) {
-      lo[a] = std::max(0, static_cast<int>(std::ceil((g.min[a] - b.min[a]) / c[a] - 1.0)));
-      hi[a] = std::min(dims[a] - 1, static_cast<int>(std::floor((g.max[a] - b.min[a]) / c[a])));
+      r.lo[a] = std::max(0, static_cast<int>(std::ceil((g.min[a] - b.min[a]) / c[a] - 1.0)));
+      r.hi[a] = std::min(dims[a] - 1, static_cast<int>(std::floor((g.max[a] - b.min[a]) / c[a])));
+      const auto& lo_edges = edge_lo[static_cast<std::size_t>(a)];
+      const auto& hi_edges = edge_hi[static_cast<std::size_t>(a)];
+      // Both edges grow with i: the first cell starting at or above g.min, the last ending at or
+      // below g.max.
+      r.inner_lo[a] = static_cast<int>(std::lower_bound(lo_edges.begin(), lo_edges.end(), g.min[a]) - lo_edges.begin());
+      r.inner_hi[a] = static_cast<int>(std::upper_bound(hi_edges.begin(), hi_edges.end(), g.max[a]) - hi_edges.begin()) - 1;
+      r.inner_lo[a] = std::max(r.inner_lo[a], r.lo[a]);
+      r.inner_hi[a] = std::min(r.inner_hi[a], r.hi[a]);
     }
-    range.emplace_back(lo, hi);
+    if ((r.lo.array() <= r.hi.array()).all()) {
+      const std::uint64_t met = static_cast<std::uint64_t>(r.hi.x() - r.lo.x() + 1) *
+                                static_cast<std::uint64_t>(r.hi.y() - r.lo.y() + 1) *
+                                static_cast<std::uint64_t>(r.hi.z() - r.lo.z() + 1);
+      shell_cells += met - (r.has_inner() ? static_cast<std::uint64_t>(r.inner_hi.x() - r.inner_lo.x() + 1) *
+                                                static_cast<std::uint64_t>(r.inner_hi.y() - r.inner_lo.y() + 1) *
+                                                static_cast<std::uint64_t>(r.inner_hi.z() - r.inner_lo.z() + 1)
+                                          : 0);
+    }
+    range.push_back(r);
   }
-  // Obstacles meeting each cell, as one flat list (offsets per cell): count, then fill.
+  // Work is bounded by the cells the boxes meet without holding them (issue 20: 20 000 boxes
+  // each spanning the map cost 29 s and 80 000 ran out of time): refused past the bound.
+  if (shell_cells > kMaxEncodeShellCells)
+    throw Error("map: its " + std::to_string(grown.size()) + " obstacles, grown by the robot radius, meet " +
+                std::to_string(shell_cells) + " cells of the " + std::to_string(dims.x()) + " x " +
+                std::to_string(dims.y()) + " x " + std::to_string(dims.z()) +
+                " heuristic grid without covering them, more than the bound " + std::to_string(kMaxEncodeShellCells) +
+                " (merge overlapping boxes, or give the map as voxels)");
+
+  // Cells inside a grown box are solid: a 3-D difference array over the inner ranges, summed
+  // (O(boxes + cells), never per box per cell).
+  const std::size_t px = static_cast<std::size_t>(dims.x()) + 1, py = static_cast<std::size_t>(dims.y()) + 1;
+  std::vector<std::int32_t>& cover = scratch.cover;
+  cover.assign(px * py * (static_cast<std::size_t>(dims.z()) + 1), 0);
+  const auto at = [&](int i, int j, int k) -> std::int32_t& {
+    return cover[(static_cast<std::size_t>(k) * py + static_cast<std::size_t>(j)) * px + static_cast<std::size_t>(i)];
+  };
+  for (const BoxCells& r : range) {
+    if (!r.has_inner()) continue;
+    const int x[2] = {r.inner_lo.x(), r.inner_hi.x() + 1}, y[2] = {r.inner_lo.y(), r.inner_hi.y() + 1},
+              z[2] = {r.inner_lo.z(), r.inner_hi.z() + 1};
+    for (int q = 0; q < 8; ++q) at(x[q & 1], y[(q >> 1) & 1], z[q >> 2]) += (__builtin_popcount(q) & 1) ? -1 : 1;
+  }
+  // Prefix sums along x (each row), then y (row += the row before), then z (plane += the plane
+  // before): contiguous loops.
+  const std::size_t pz = static_cast<std::size_t>(dims.z()) + 1, plane = px * py;
+  std::int32_t* d = cover.data();
+  for (std::size_t row = 0; row < py * pz; ++row)
+    for (std::size_t i = 1; i < px; ++i) d[row * px + i] += d[row * px + i - 1];
+  for (std::size_t k = 0; k < pz; ++k)
+    for (std::size_t q = k * plane + px; q < (k + 1) * plane; ++q) d[q] += d[q - px];
+  for (std::size_t q = plane; q < plane * pz; ++q) d[q] += d[q - plane];
+  for (int k = 0; k < dims.z(); ++k)
+    for (int j = 0; j < dims.y(); ++j)
+      for (int i = 0; i < dims.x(); ++i)
+        if (at(i, j, k) > 0) e[cell_index(dims, i, j, k)] = kSolid;
+
+  // Obstacles meeting each other cell (met, not held whole, and not solid already), as one flat
+  // list (offsets per cell): count, then fill. Only each box's shell is walked.
   std::vector<std::uint32_t>& offset = scratch.offset;
   offset.assign(cells + 1, 0);
   const auto for_each_cell = [&](std::size_t o, auto&& f) {
-    const auto& [lo, hi] = range[o];
-    for (int k = lo.z(); k <= hi.z(); ++k)
-      for (int j = lo.y(); j <= hi.y(); ++j)
-        for (int i = lo.x(); i <= hi.x(); ++i) f(cell_index(dims, i, j, k));
+    const BoxCells& r = range[o];
+    for (int k = r.lo.z(); k <= r.hi.z(); ++k)
+      for (int j = r.lo.y(); j <= r.hi.y(); ++j) {
+        const bool inner_row = r.has_inner() && k >= r.inner_lo.z() && k <= r.inner_hi.z() && j >= r.inner_lo.y() &&
+                               j <= r.inner_hi.y();
+        const auto visit = [&](int i0, int i1) {
+          for (int i = i0; i <= i1; ++i) {
+            const std::size_t idx = cell_index(dims, i, j, k);
+            if (e[idx] != kSolid) f(idx);
+          }
+        };
+        if (inner_row) {
+          visit(r.lo.x(), r.inner_lo.x() - 1);
+          visit(r.inner_hi.x() + 1, r.hi.x());
+        } else {
+          visit(r.lo.x(), r.hi.x());
+        }
+      }
   };
   for (std::size_t o = 0; o < grown.size(); ++o) for_each_cell(o, [&](std::size_t idx) { ++offset[idx + 1]; });
   for (std::size_t idx = 0; idx < cells; ++idx) offset[idx + 1] += offset[idx];
@@ -235,32 +352,39 @@ std::vector<std::uint8_t> encode(const world::Map& map, const Eigen::Vector3i& d
   std::vector<std::pair<std::uint32_t, std::uint64_t>>& box_blocked = scratch.box_blocked;
   box_blocked.clear();
   std::vector<world::Box>& local = scratch.local;
+  constexpr std::uint64_t kAllCentres = ~std::uint64_t{0};
   for (std::size_t idx = 0; idx < cells; ++idx) {
     if (offset[idx] == offset[idx + 1]) continue;
-    e[idx] = kPartial;
+    e[idx] = kPartial;  // met by a box that does not hold it, and inside none
     const world::Box cell = cell_box(b, dims, cell_coords(dims, idx));
     local.clear();
-    bool inside_one = false;
     double clipped_volume = 0.0;  // sum over the boxes of |box and cell|: the union is no larger
+    std::uint64_t blocked = 0;
     for (std::uint32_t t = offset[idx]; t < offset[idx + 1]; ++t) {
       const world::Box& g = grown[touching[t]];
-      inside_one = inside_one || ((cell.min.array() >= g.min.array()).all() && (cell.max.array() <= g.max.array()).all());
-      clipped_volume += (g.max.cwiseMin(cell.max) - g.min.cwiseMax(cell.min)).cwiseMax(0.0).prod();
-      local.push_back(g);
+      const world::Box clipped{g.min.cwiseMax(cell.min), g.max.cwiseMin(cell.max)};
+      // A run of boxes equal within the cell adds nothing (issue 20: 20 000 copies of a box).
+      if (!local.empty() && local.back().min == clipped.min && local.back().max == clipped.max) continue;
+      clipped_volume += (clipped.max - clipped.min).cwiseMax(0.0).prod();
+      if (passability) blocked |= subcells_inside(cell, g);
+      local.push_back(clipped);
     }
-    // One box holding the whole cell covers it; a single box that does not, does not. Only
-    // cells met by several boxes, none holding them, need the exact cut (box_covered), and
-    // only when their volumes together could fill the cell: the union's volume is at most the
-    // sum, so a smaller sum proves a gap (issue 16: 226k small boxes spent ~50 ms cutting
-    // cells they could never fill). The margin keeps rounding of the sum on the safe side.
+    // A single box that does not hold the cell does not cover it. Several boxes need the exact
+    // cut (box_covered) only when no sub-cell centre is left out (a centre in no box is a point
+    // of the cell outside the union) and their volumes together could fill the cell (the
+    // union's volume is at most the sum; issue 16: 226k small boxes spent ~50 ms cutting cells
+    // they could never fill). The margin keeps rounding of the sum on the safe side.
     constexpr double kVolumeRounding = 1e-9;
-    const bool could_fill = clipped_volume >= cell.extent().prod() * (1.0 - kVolumeRounding);
-    if (inside_one || (local.size() > 1 && could_fill && box_covered(cell, local))) e[idx] = kSolid;
-    if (passability && e[idx] == kPartial) {
-      std::uint64_t blocked = 0;
-      for (const world::Box& g : local) blocked |= subcells_inside(cell, g);
-      box_blocked.emplace_back(static_cast<std::uint32_t>(idx), blocked);
-    }
+    const auto centres_covered = [&] {
+      const SubcellCentres centres(cell);
+      std::uint64_t covered = 0;
+      for (const world::Box& g : local) covered |= centres.inside(g);  // the centres lie in the cell
+      return covered == kAllCentres;
+    };
+    if (local.size() > 1 && clipped_volume >= cell.extent().prod() * (1.0 - kVolumeRounding) && centres_covered() &&
+        box_covered(cell, local))
+      e[idx] = kSolid;
+    if (passability && e[idx] == kPartial) box_blocked.emplace_back(static_cast<std::uint32_t>(idx), blocked);
   }
   if (map.voxels()) encode_voxels(map, dims, radius, e);
   if (passability) {

@@ -45,8 +45,14 @@ Eigen::Vector3d cell_size(const world::Box& bounds, const Eigen::Vector3i& dims)
 Eigen::Vector3i cell_of(const world::Box& bounds, const Eigen::Vector3i& dims, const Eigen::Vector3d& p);
 world::Box cell_box(const world::Box& bounds, const Eigen::Vector3i& dims, const Eigen::Vector3i& c);
 
+/// The most sub-box-in-box tests box_covered() makes (issue 20: n boxes with distinct faces
+/// inside one cell cut it into up to (2n + 1)^3 sub-boxes, each tested against n boxes).
+inline constexpr std::uint64_t kMaxCoverTests = std::uint64_t{1} << 24;
+
 /// Whether the closed box `cell` lies inside the union of `boxes` (exact: the boxes'
-/// faces cut the cell into sub-boxes, each of which is inside one box or outside all).
+/// faces cut the cell into sub-boxes, each of which is inside one box or outside all). Past
+/// kMaxCoverTests tests (sub-boxes x boxes) it answers false unproven: the encoding then keeps
+/// such a cell partial, never solid.
 bool box_covered(const world::Box& cell, const std::vector<world::Box>& boxes);
 
 /// Channel E: kFree / kPartial / kSolid per cell for obstacles grown by `radius`. Boxes are cut
@@ -57,6 +63,12 @@ std::vector<std::uint8_t> encode_environment(const world::Map& map, const Eigen:
 
 /// Channel P bits (issue 16: a door and a wall are both kPartial in E; P tells them apart).
 enum PassabilityBit : std::uint8_t { kPassX = 1, kPassY = 2, kPassZ = 4, kPassAll = 7 };
+/// The most cells, summed over a map's grown boxes, that a box meets without holding them
+/// whole (its shell on the grid), past which the encoding refuses the map (issue 20: the work
+/// grows with it; a box's interior is summed in O(1) per box). 2^27: ~500 MB of lists at most;
+/// the 226k-box map of docs/heuristic.md needs ~10^6.
+inline constexpr std::uint64_t kMaxEncodeShellCells = std::uint64_t{1} << 27;
+
 /// Sub-cells per axis on which P is decided (4^3 = 64: one bit mask of a 64-bit word per cell).
 inline constexpr int kPassabilitySubcells = 4;
 

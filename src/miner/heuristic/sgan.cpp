@@ -257,7 +257,7 @@ struct Sgan::Impl {
   // (oneDNN) reads with padding 0.
   bool own_kernels = false;
   std::vector<float> noise_padded, a1_padded;
-  std::vector<float> noise;  // a query's N, voxel order (predict)
+  std::vector<float> noise_grid;  // a query's N, voxel order (predict)
   std::vector<std::vector<float>> condition_padded;  // one planar padded grid per condition
   std::vector<const float*> condition_pointers;
   std::vector<kernels::SparseInput> sparse;
@@ -786,10 +786,10 @@ std::vector<float> Sgan::predict(const std::vector<std::uint8_t>& environment, c
   if (g.arch.scale_channels != 0) g.set_scale(scale_input(bounds, g.arch.dims, robot_radius, g.arch.scale_divisor));
   const auto scale = static_cast<float>(g.arch.environment_scale);
   // N(0, 1) in voxel order (x fastest), one bulk draw of the query's stream.
-  g.noise.resize(n);
-  rng.fill_normal_ziggurat(g.noise.data(), n);
+  g.noise_grid.resize(n);
+  rng.fill_normal_ziggurat(g.noise_grid.data(), n);
   if (g.own_kernels) {
-    g.set_input_encoded(environment.data(), state.data(), passability.data(), scale, g.noise.data());
+    g.set_input_encoded(environment.data(), state.data(), passability.data(), scale, g.noise_grid.data());
     return checked_probabilities(g.path, g.run());
   }
   g.begin_input();
@@ -798,7 +798,7 @@ std::vector<float> Sgan::predict(const std::vector<std::uint8_t>& environment, c
     // The network reads the blocked bits 1 - P_a (train.py's to_inputs): 0 on free cells.
     for (int a = 0; a < pc; ++a) p[a] = 1.0F - static_cast<float>((passability[v] >> a) & 1U);
     g.set_input(x, y, z, v, scale * static_cast<float>(environment[v]), static_cast<float>(state[v]),
-                g.noise[v], p);
+                g.noise_grid[v], p);
   });
   return checked_probabilities(g.path, g.run());
 }

@@ -105,6 +105,53 @@ TEST_CASE("A cell covered only by the union of two boxes is covered: a gap of an
         heuristic::kSolid);
 }
 
+TEST_CASE("Boxes encode in work bounded by the cells they meet without holding, the same E", "[REQ-HEUR-012]") {
+  using miner::world::Box;
+  namespace h = miner::heuristic;
+  const Eigen::Vector3i dims(32, 32, 32);
+  // 5 000 boxes spanning the map but its top metre (issue 20: 20 000 such boxes took 29 s, each
+  // cell of the grid listed against every box): E is the one box's E, cell for cell; so are
+  // boxes that differ by less than a cell, whose tops cut the top layer apart.
+  const Box bounds{{0, 0, 0}, {400, 400, 100}};
+  const miner::world::Map one(bounds, 1.0, {Box{{0, 0, 0}, {400, 400, 99}}});
+  const std::vector<std::uint8_t> e_one = h::encode_environment(one, dims, 0.3);
+  std::vector<Box> copies(5000, Box{{0, 0, 0}, {400, 400, 99}}), staggered;
+  for (int i = 0; i < 5000; ++i) staggered.push_back(Box{{0, 0, 0}, {400, 400, 98.0 + 1e-4 * i}});
+  const miner::world::Map many(bounds, 1.0, copies), stair(bounds, 1.0, staggered);
+  CHECK(h::encode_environment(many, dims, 0.3) == e_one);
+  CHECK(h::encode_environment_passability(many, dims, 0.3).passability ==
+        h::encode_environment_passability(one, dims, 0.3).passability);
+  const miner::world::Map top(bounds, 1.0, {Box{{0, 0, 0}, {400, 400, 98.0 + 1e-4 * 4999}}});
+  CHECK(h::encode_environment(stair, dims, 0.3) == h::encode_environment(top, dims, 0.3));
+  // The layers: solid below the top layer's cells, which the boxes' tops cut (partial).
+  CHECK(e_one[h::cell_index(dims, 5, 5, 0)] == h::kSolid);
+  CHECK(e_one[h::cell_index(dims, 5, 5, 30)] == h::kSolid);
+  CHECK(e_one[h::cell_index(dims, 5, 5, 31)] == h::kPartial);
+
+  // Past kMaxEncodeShellCells cells met without being held, the map is refused before the work:
+  // 400 boxes each meeting every cell of a 256^3 grid and holding all but its outer layer
+  // (~390 000 cells each).
+  const miner::world::Map fine(Box{{0, 0, 0}, {10, 10, 10}}, 0.5,
+                               std::vector<Box>(400, Box{{0.01, 0.01, 0.01}, {9.99, 9.99, 9.99}}));
+  CHECK_THROWS_WITH(h::encode_environment(fine, Eigen::Vector3i(256, 256, 256), 0.0),
+                    Catch::Contains("400 obstacles") && Catch::Contains("more than the bound 134217728"));
+}
+
+TEST_CASE("The exact cover test is bounded: past kMaxCoverTests it answers unproven (partial)", "[REQ-HEUR-012]") {
+  using miner::world::Box;
+  const Box cell{{0, 0, 0}, {1, 1, 1}};
+  // One box holds the cell; n small boxes with their own faces inside it cut it into
+  // (2n + 1)^3 sub-boxes, each tested against the n + 1 boxes.
+  const auto boxes = [](int n) {
+    std::vector<Box> b{Box{{-1, -1, -1}, {2, 2, 2}}};
+    for (int i = 0; i < n; ++i)  // faces all distinct: lows in [0.1, 0.3), highs in [0.6, 0.8)
+      b.push_back(Box{Eigen::Vector3d::Constant(0.1 + 0.005 * i), Eigen::Vector3d::Constant(0.6 + 0.005 * i)});
+    return b;
+  };
+  CHECK(miner::heuristic::box_covered(cell, boxes(10)));        // 21^3 x 11: proven
+  CHECK_FALSE(miner::heuristic::box_covered(cell, boxes(39)));  // 79^3 x 40 > 2^24: unproven
+}
+
 TEST_CASE("Regions connect through faces, edges and corners only", "[REQ-HEUR-004]") {
   const Eigen::Vector3i d(4, 4, 4);
   std::vector<std::uint8_t> m(64, 0);

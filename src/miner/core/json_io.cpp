@@ -26,12 +26,16 @@ void require_path_without_nul(const std::string& path, const std::string& what) 
                 " (a path ends at its first NUL)");
 }
 
-std::string read_file_bytes(const std::string& path, const std::string& what) {
+std::string read_file_bytes(const std::string& path, const std::string& what, std::uintmax_t max_bytes) {
   require_path_without_nul(path, what);
   // A device or a pipe (/dev/zero, a FIFO) would be read without end: only regular files.
   std::error_code ec;
   if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
     throw Error(path + ": cannot open " + what + ": not a regular file");
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (!ec && size > max_bytes)
+    throw Error(path + ": the " + what + " holds " + std::to_string(size) + " bytes, larger than the " +
+                std::to_string(max_bytes) + " a " + what + " may have");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path + ": cannot open " + what);
   std::ostringstream ss;
@@ -39,7 +43,9 @@ std::string read_file_bytes(const std::string& path, const std::string& what) {
   return ss.str();
 }
 
-Json read_json_file(const std::string& path) { return parse_json(read_file_bytes(path), path); }
+Json read_json_file(const std::string& path) {
+  return parse_json(read_file_bytes(path, "JSON file", kMaxJsonFileBytes), path);
+}
 
 std::string json_error_text(const std::exception& e) {
   std::string text = e.what();

@@ -4,6 +4,7 @@
 /// writing files atomically so a good file is never half-overwritten (REQ-CORE-003,
 /// REQ-CORE-004).
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <utility>
@@ -16,15 +17,21 @@ namespace miner {
 
 using Json = nlohmann::json;
 
-/// Parses `path` as JSON. Throws Error naming the file on a missing file or a
-/// syntax error (with the byte offset nlohmann reports).
+/// The largest JSON file read (issue 20: a 2 GB file was read whole, then ran out of memory
+/// naming nothing). MINER's largest documents, maps of ~10^5 boxes, are ~25 MB.
+inline constexpr std::uintmax_t kMaxJsonFileBytes = std::uintmax_t{256} << 20;
+
+/// Parses `path` as JSON. Throws Error naming the file on a missing file, a file larger than
+/// kMaxJsonFileBytes (before reading it) or a syntax error (with the byte offset nlohmann
+/// reports).
 Json read_json_file(const std::string& path);
-/// The whole file as bytes; throws miner::Error "<path>: cannot open <what>" when it cannot
-/// be opened.
 /// The message of a JSON library exception without the library's "[json.exception.kind.N] "
 /// prefix (what users see names their file and field, not the library's internals).
 std::string json_error_text(const std::exception& e);
-std::string read_file_bytes(const std::string& path, const std::string& what = "file");
+/// The whole file as bytes; throws miner::Error "<path>: cannot open <what>" when it cannot
+/// be opened, and "<path>: ... larger than" when it holds more than max_bytes.
+std::string read_file_bytes(const std::string& path, const std::string& what = "file",
+                            std::uintmax_t max_bytes = UINTMAX_MAX);
 /// Throws miner::Error naming the path and the offset when it holds a NUL byte (the system
 /// would open the path cut there); read_file_bytes and the atomic writers call it.
 void require_path_without_nul(const std::string& path, const std::string& what);

@@ -346,7 +346,7 @@ Map Map::from_json(const Json& doc, const std::string& origin) {
 
 Map Map::load(const std::string& path) {
   if (ends_with(path, ".bt") || ends_with(path, ".ot")) return load_octomap(path);
-  const std::string bytes = read_file_bytes(path);
+  const std::string bytes = read_file_bytes(path, "map file", kMaxJsonFileBytes);
   // Formats MINER reads elsewhere, recognised by their first bytes, are named as such instead
   // of as malformed JSON (issue 20, fourth campaign: an OctoMap named .BT got the JSON
   // library's "invalid literal; last read: '#'").

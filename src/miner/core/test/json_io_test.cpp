@@ -49,6 +49,21 @@ TEST_CASE("Malformed JSON names the file and the byte offset", "[REQ-CORE-003]")
                     Contains("/nonexistent/file.json: cannot open file"));
 }
 
+TEST_CASE("A JSON file larger than kMaxJsonFileBytes is refused by its size before it is read", "[REQ-CORE-003]") {
+  // A sparse file: its size is past the bound, its blocks are never written (nor read).
+  const std::string path = (std::filesystem::temp_directory_path() / "miner_json_too_large.json").string();
+  {
+    std::ofstream(path) << "{}";
+  }
+  std::filesystem::resize_file(path, miner::kMaxJsonFileBytes + 1);
+  CHECK_THROWS_WITH(miner::read_json_file(path),
+                    Catch::Contains(path) && Catch::Contains("268435457 bytes") && Catch::Contains("larger than"));
+  // At the bound it is read (and parsed: "{}" then NUL bytes, refused as such, not by size).
+  std::filesystem::resize_file(path, 64);
+  CHECK_THROWS_WITH(miner::read_json_file(path), !Catch::Contains("larger than"));
+  std::filesystem::remove(path);
+}
+
 TEST_CASE("A key named twice in one object is refused, naming it", "[REQ-CORE-003]") {
   CHECK_THROWS_WITH(miner::parse_json(R"({"resolution": 0.25, "bounds": {}, "resolution": 0.5})", "m.json"),
                     Contains("m.json: resolution: the key appears twice"));

@@ -134,6 +134,17 @@ TEST_CASE("map gen --preset scan writes the run's voxels beside the map, and pla
   args.back() = b;
   REQUIRE(miner_cli(args).code == 0);
   CHECK(read(dir() + "/scan-a.bt") == read(dir() + "/scan-b.bt"));  // same seed, same bytes
+  // The .bt beside the JSON is an output: an earlier save's pair is replaced, another file never
+  // is (issue 20, sixth campaign: an unrelated c.bt was overwritten), refused before the work.
+  REQUIRE(miner_cli(args).code == 0);  // b again: its own earlier output
+  const std::string c = dir() + "/scan-c.json", c_bt = dir() + "/scan-c.bt";
+  std::ofstream(c_bt) << "someone else's OctoMap";
+  args.back() = c;
+  const Run kept = miner_cli(args);
+  CHECK(kept.code == 1);
+  CHECK_THAT(kept.err, Contains(c_bt) && Contains("is not the voxel file of a map at") && !Contains("unknown voxels"));
+  CHECK(read(c_bt) == "someone else's OctoMap");
+  CHECK_FALSE(std::filesystem::exists(c));
   const Run info = miner_cli({"map", "info", "--map", a, "--json"});
   REQUIRE(info.code == 0);
   CHECK(miner::parse_json(info.out, "stdout")["voxels"]["counts"]["unknown"]["voxels"].get<double>() > 0);

@@ -26,16 +26,12 @@ void require_path_without_nul(const std::string& path, const std::string& what) 
                 " (a path ends at its first NUL)");
 }
 
-std::string read_file_bytes(const std::string& path, const std::string& what, std::uintmax_t max_bytes) {
+std::string read_file_bytes(const std::string& path, const std::string& what) {
   require_path_without_nul(path, what);
   // A device or a pipe (/dev/zero, a FIFO) would be read without end: only regular files.
   std::error_code ec;
   if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
     throw Error(path + ": cannot open " + what + ": not a regular file");
-  const std::uintmax_t size = std::filesystem::file_size(path, ec);
-  if (!ec && size > max_bytes)
-    throw Error(path + ": the " + what + " holds " + std::to_string(size) + " bytes, larger than the " +
-                std::to_string(max_bytes) + " a " + what + " may have");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path + ": cannot open " + what);
   std::ostringstream ss;
@@ -43,8 +39,18 @@ std::string read_file_bytes(const std::string& path, const std::string& what, st
   return ss.str();
 }
 
+void require_json_file_size(const std::string& path) {
+  std::error_code ec;
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (!ec && size > kMaxJsonFileBytes)
+    throw Error(path + ": holds " + std::to_string(size) + " bytes, larger than the " + std::to_string(kMaxJsonFileBytes) +
+                " a JSON document may have (it is not read)");
+}
+
 Json read_json_file(const std::string& path) {
-  return parse_json(read_file_bytes(path, "JSON file", kMaxJsonFileBytes), path);
+  require_path_without_nul(path, "file");
+  require_json_file_size(path);
+  return parse_json(read_file_bytes(path), path);
 }
 
 std::string json_error_text(const std::exception& e) {

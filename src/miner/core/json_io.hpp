@@ -29,9 +29,11 @@ Json read_json_file(const std::string& path);
 /// prefix (what users see names their file and field, not the library's internals).
 std::string json_error_text(const std::exception& e);
 /// The whole file as bytes; throws miner::Error "<path>: cannot open <what>" when it cannot
-/// be opened, and "<path>: ... larger than" when it holds more than max_bytes.
-std::string read_file_bytes(const std::string& path, const std::string& what = "file",
-                            std::uintmax_t max_bytes = UINTMAX_MAX);
+/// be opened.
+std::string read_file_bytes(const std::string& path, const std::string& what = "file");
+/// Throws miner::Error naming the path and both sizes when the file at `path` holds more than
+/// kMaxJsonFileBytes (nothing when it cannot be sized: the read then names the fault).
+void require_json_file_size(const std::string& path);
 /// Throws miner::Error naming the path and the offset when it holds a NUL byte (the system
 /// would open the path cut there); read_file_bytes and the atomic writers call it.
 void require_path_without_nul(const std::string& path, const std::string& what);

@@ -346,7 +346,9 @@ Map Map::from_json(const Json& doc, const std::string& origin) {
 
 Map Map::load(const std::string& path) {
   if (ends_with(path, ".bt") || ends_with(path, ".ot")) return load_octomap(path);
-  const std::string bytes = read_file_bytes(path, "map file", kMaxJsonFileBytes);
+  require_path_without_nul(path, "file");
+  require_json_file_size(path);
+  const std::string bytes = read_file_bytes(path);
   // Formats MINER reads elsewhere, recognised by their first bytes, are named as such instead
   // of as malformed JSON (issue 20, fourth campaign: an OctoMap named .BT got the JSON
   // library's "invalid literal; last read: '#'").
@@ -434,6 +436,28 @@ void Map::save_octomap(const std::string& path) const {
   write_octree_bt(to_voxel_layer(), path);
 }
 
+void Map::check_voxel_side_file(const std::string& path) {
+  namespace fs = std::filesystem;
+  const fs::path bt = fs::path(path).replace_extension(".bt");
+  std::error_code ec;
+  if (!fs::exists(bt, ec)) return;
+  // An earlier save to this path: the JSON there names this file as its voxels.
+  bool earlier_output = false;
+  try {
+    const Json doc = read_json_file(path);
+    earlier_output = doc.is_object() && doc.contains("voxels") && doc["voxels"].is_object() &&
+                     doc["voxels"].contains("file") && doc["voxels"]["file"].is_string() &&
+                     voxel_file_path(path, doc["voxels"]["file"].get<std::string>()) ==
+                         fs::absolute(bt).lexically_normal().string();
+  } catch (const Error&) {
+    earlier_output = false;  // no map there (or not one): the .bt is someone else's file
+  }
+  if (!earlier_output)
+    throw Error(bt.string() + ": exists and is not the voxel file of a map at " + path +
+                ": a voxel map's JSON is written with its voxels beside it as " + bt.filename().string() +
+                ", which would replace that file (remove it, or choose another output name)");
+}
+
 void Map::save(const std::string& path) const {
   // issue 20: a ".ot" path got JSON that load() then read as an OctoMap and refused.
   if (path.size() >= 3 && path.compare(path.size() - 3, 3, ".ot") == 0)
@@ -443,6 +467,7 @@ void Map::save(const std::string& path) const {
   } else if (source_ && source_->file.empty()) {
     // The voxels first, then the document that names them: a reader never sees a reference to a
     // file that is not there yet.
+    check_voxel_side_file(path);
     const std::filesystem::path bt = std::filesystem::path(path).replace_extension(".bt");
     const std::string bytes = octree_bt_bytes(*source_->layer);
     write_file_atomic(bt.string(), bytes);

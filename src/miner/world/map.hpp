@@ -107,6 +107,11 @@ class Map {
   /// The document; a voxel map references its file by absolute path and SHA-256. A voxel map
   /// made in memory (a generated scan) has no file yet: throws miner::Error (save() writes one).
   Json to_json() const;
+  /// The voxel file save() writes beside a JSON `path` (the path with .bt). Throws Error naming
+  /// it when it exists and is not the voxel file of the map now at `path` (an earlier output of
+  /// the same save): another file is never replaced (issue 20, sixth campaign: `map gen --preset
+  /// scan --out x.json` overwrote an unrelated x.bt).
+  static void check_voxel_side_file(const std::string& path);
   /// Writes the map as JSON (atomic), or as an OctoMap `.bt` if `path` ends in .bt. A voxel
   /// map made in memory saved as JSON writes its voxels first to the `.bt` of the same stem
   /// beside it, referenced by file name and SHA-256 (REQ-WORLD-019).

@@ -170,6 +170,7 @@ ScanResult scan_map(const Map& map, const std::vector<Eigen::Vector3d>& path, co
   // The volume the vehicle swept along the path is free: it was there (mapping pipelines clear
   // it too). Set, not voted: a noisy return inside it cannot outweigh the vehicle's presence.
   if (o.body_radius > 0.0) {
+    constexpr double kVoxelCircumradius = 0.8660254037844387;  // sqrt(3) / 2: a unit cube's half diagonal
     const int n = static_cast<int>(std::ceil(o.body_radius / res)) + 1;
     octomap::KeySet swept;
     for (const Eigen::Vector3d& p : resample_path(path, 0.5 * res)) {
@@ -184,7 +185,12 @@ ScanResult scan_map(const Map& map, const std::vector<Eigen::Vector3d>& path, co
             if (swept.count(key)) continue;
             const octomap::point3d c = tree.keyToCoord(key);
             const Eigen::Vector3d cd(c.x(), c.y(), c.z());
-            if ((cd - p).norm() <= o.body_radius + res && map.is_free(cd)) swept.insert(key);
+            // Only voxels that meet no obstacle (the sphere around the cube clear): a voxel an
+            // obstacle surface meets keeps what the rays saw, so a body wider than the path's
+            // clearance never erases a return (issue 20, sixth campaign: --body-radius 1 on a
+            // path planned for 0.2 m freed 884 occupied voxels).
+            if ((cd - p).norm() <= o.body_radius + res && map.is_free(cd, kVoxelCircumradius * res))
+              swept.insert(key);
           }
     }
     for (const auto& key : swept) tree.setNodeValue(key, tree.getClampingThresMinLog(), true);

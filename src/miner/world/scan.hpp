@@ -13,7 +13,8 @@
 /// range, or leaves the map's bounds first, marks free space up to there and nothing at its end.
 /// At the first and last pose the sensor turns a full circle (spin_at_ends, at the same angular
 /// spacing). The volume the vehicle swept along the path (body_radius plus one voxel) is set
-/// free afterwards, unless an obstacle holds a voxel's centre: the vehicle was there.
+/// free afterwards, except voxels an obstacle meets (within the half diagonal of the voxel's
+/// centre): the vehicle was there, and a return on a surface stays occupied.
 /// Each pose's rays are integrated as one scan (a voxel both crossed and hit counts as hit,
 /// OctoMap's insertPointCloud rule), with OctoMap's default sensor model (hit 0.7, miss 0.4).
 /// Randomness comes from Rng(seed, pose index) only: the same inputs give the same bytes.

@@ -63,6 +63,35 @@ TEST_CASE("A scan marks free space along rays, surfaces as occupied, the rest un
   CHECK(octree_bt_bytes(*parse_octree(scan.bt, "scan")) == scan.bt);
 }
 
+TEST_CASE("The swept volume is free but never erases a return: any body radius keeps every occupied voxel",
+          "[REQ-WORLD-016]") {
+  // The path passes 0.6 m from the block's face; a 1.5 m body would reach into it (issue 20,
+  // sixth campaign: occupied voxels fell from 6461 to 5577 with --body-radius 1).
+  const Map map = scene();
+  ScanOptions o;
+  o.noise = 0.0;
+  o.dropout = 0.0;
+  o.range = 6.0;
+  const std::vector<V> path{V(1, 2.4, 1.5), V(9, 2.4, 1.5)};
+  const auto occupied = [&](double body) {
+    o.body_radius = body;
+    const ScanResult scan = scan_map(map, path, o);
+    std::vector<std::size_t> out;
+    for (std::size_t i = 0; i < scan.layer->size(); ++i)
+      if (scan.layer->state(i) == VoxelState::kOccupied) out.push_back(i);
+    return std::make_pair(out, scan.layer);
+  };
+  const auto [none, layer0] = occupied(0.0);
+  const auto [wide, layer1] = occupied(1.5);
+  REQUIRE(none.size() > 100);
+  CHECK(wide == none);
+  // The body still frees space the rays never saw: voxels near the path behind the start.
+  std::size_t freed = 0;
+  for (std::size_t i = 0; i < layer0->size(); ++i)
+    freed += layer0->state(i) != VoxelState::kFree && layer1->state(i) == VoxelState::kFree;
+  CHECK(freed > 0);
+}
+
 TEST_CASE("Scan noise and dropouts come from the seed and change the map", "[REQ-WORLD-016]") {
   const Map map = scene();
   ScanOptions o;

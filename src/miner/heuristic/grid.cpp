@@ -117,8 +117,8 @@ void encode_voxels(const world::Map& map, const Eigen::Vector3i& dims, double ra
   }
 }
 
-/// The sub-cells (bit x + 4 y + 16 z of kPassabilitySubcells^3) whose centres lie in the closed
-/// box g, for the cell `cell`.
+}  // namespace
+
 std::uint64_t subcells_inside(const world::Box& cell, const world::Box& g) {
   constexpr int n = kPassabilitySubcells;
   int lo[3], hi[3];
@@ -134,6 +134,8 @@ std::uint64_t subcells_inside(const world::Box& cell, const world::Box& g) {
   for (int z = lo[2]; z <= hi[2]; ++z) volume |= plane << (n * n * z);
   return volume;
 }
+
+namespace {
 
 /// The sub-cells of `cell` whose centres lie in a grown-blocked voxel (the voxel holding the
 /// centre; centres off the layer are not blocked by it).

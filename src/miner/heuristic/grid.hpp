@@ -89,6 +89,11 @@ Encoding encode_environment_passability(const world::Map& map, const Eigen::Vect
 /// The kPassabilitySubcells^3 free-sub-cell mask (bit x + 4 y + 16 z) -> its P bits.
 std::uint8_t passability_of(std::uint64_t free_subcells);
 
+/// The sub-cells of `cell` (bit x + 4 y + 16 z of kPassabilitySubcells^3) whose centres lie in
+/// the closed box g: the sub-cells a grown box blocks in encode_environment_passability. A
+/// centre on g's boundary is inside; g may reach past the cell (what lies outside is ignored).
+std::uint64_t subcells_inside(const world::Box& cell, const world::Box& g);
+
 /// Channel S: the (2 dilation + 1)^3 cubes around the cells of start and goal.
 std::vector<std::uint8_t> encode_state(const world::Box& bounds, const Eigen::Vector3i& dims,
                                        const Eigen::Vector3d& start, const Eigen::Vector3d& goal, int dilation);

@@ -191,6 +191,19 @@ std::pair<double, double> feasible_objective(const MincoProblem& problem, const 
   return {e.F, e.k};
 }
 
+std::pair<double, std::vector<double>> log_time_objective(const MincoProblem& problem, const std::vector<double>& tau,
+                                                          const AllocationOptions& options) {
+  validate(options);
+  std::vector<double> start(tau.size());
+  for (std::size_t i = 0; i < tau.size(); ++i) start[i] = std::exp(tau[i]);
+  const AllocationObjective objective(problem, options, start);
+  double F = 0.0;
+  std::vector<double> gradient(tau.size());
+  if (!objective.Evaluate(tau.data(), &F, gradient.data()))
+    throw Error("allocation: the objective is not finite for these durations");
+  return {F, gradient};
+}
+
 AllocationResult optimise_allocation(const MincoProblem& problem, const AllocationOptions& o) {
   validate(o);
   const auto segments = problem.points.rows() - 1;

@@ -78,4 +78,12 @@ AllocationResult optimise_allocation(const MincoProblem& problem, const Allocati
 std::pair<double, double> feasible_objective(const MincoProblem& problem, const std::vector<double>& durations,
                                              const AllocationOptions& options);
 
+/// F and its gradient in the variables Ceres sees, tau_i = log T_i, exactly as
+/// optimise_allocation()'s objective hands them to Ceres (exposed for tests): F at exp(tau)
+/// made feasible, and dF/dtau_i = (dJ*/dT_i + rho) T_i where no limit is active (forward
+/// differences where one is). Throws miner::Error for bad options or where the objective
+/// tells Ceres the point cannot be evaluated.
+std::pair<double, std::vector<double>> log_time_objective(const MincoProblem& problem, const std::vector<double>& tau,
+                                                          const AllocationOptions& options);
+
 }  // namespace miner::traj

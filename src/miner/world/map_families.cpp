@@ -326,7 +326,6 @@ FamilyDraw mixed(const GeneratorPreset& p, Rng& rng, const Box& bounds) {
   const Eigen::Vector3d e = bounds.extent();
   const double size = std::cbrt(e.prod());
   const double margin = 2.0 * p.robot_radius;
-  const double passage = 2.0 * p.robot_radius + 0.3;  // the narrowest opening a slab is sure to have, m
   FamilyDraw d;
   d.query.robot_radius = p.robot_radius;
   // The query's axis: the longest one half the time, any other with room for slabs otherwise.
@@ -359,20 +358,7 @@ FamilyDraw mixed(const GeneratorPreset& p, Rng& rng, const Box& bounds) {
       const double len = q(rng.uniform(0.3, 1.0) * e[ua]);
       if (rng.uniform01() < 0.5) u1 = u0 + len; else u0 = u1 - len;
     }
-    std::vector<Box> openings;
-    const int n_open = 1 + static_cast<int>(rng.uniform_index(3));  // 1-3
-    for (int o = 0; o < n_open; ++o) {
-      // The first opening lets the robot through; the others may be narrower than it.
-      const double lo_side = o == 0 ? passage : 0.2;
-      Eigen::Vector3d side, c;
-      side[axis] = 2.0 * t;
-      c[axis] = w;
-      for (int k : {ua, va}) {
-        side[k] = std::min(e[k], rng.uniform(lo_side, std::max(lo_side, 0.35 * e[k])));
-        c[k] = bounds.min[k] + rng.uniform(0.5 * side[k], e[k] - 0.5 * side[k]);
-      }
-      openings.push_back(make_box(c - 0.5 * side, c + 0.5 * side));
-    }
+    const std::vector<Box> openings = slab_openings(p, rng, bounds, axis, w, t);
     std::vector<Box> pieces;
     slab_with_openings(pieces, axis, w - 0.5 * t, w + 0.5 * t, u0, u1, v0, v1, openings);
     for (Box& piece : pieces) add_clear(d.obstacles, piece, bounds, d.query, keep_free);
@@ -405,6 +391,29 @@ FamilyDraw mixed(const GeneratorPreset& p, Rng& rng, const Box& bounds) {
 }
 
 }  // namespace
+
+/// The 1-3 openings of one "mixed" slab across `axis` at w, t thick (REQ-WORLD-020): the
+/// first at least 2 r + 0.3 m on each side before rounding, the others at least 0.2 m.
+std::vector<Box> slab_openings(const GeneratorPreset& p, Rng& rng, const Box& bounds, int axis, double w, double t) {
+  const Eigen::Vector3d e = bounds.extent();
+  const int ua = (axis + 1) % 3, va = (axis + 2) % 3;
+  const double passage = 2.0 * p.robot_radius + 0.3;  // the narrowest opening a slab is sure to have, m
+  std::vector<Box> openings;
+  const int n_open = 1 + static_cast<int>(rng.uniform_index(3));  // 1-3
+  for (int o = 0; o < n_open; ++o) {
+    // The first opening lets the robot through; the others may be narrower than it.
+    const double lo_side = o == 0 ? passage : 0.2;
+    Eigen::Vector3d side, c;
+    side[axis] = 2.0 * t;
+    c[axis] = w;
+    for (int k : {ua, va}) {
+      side[k] = std::min(e[k], rng.uniform(lo_side, std::max(lo_side, 0.35 * e[k])));
+      c[k] = bounds.min[k] + rng.uniform(0.5 * side[k], e[k] - 0.5 * side[k]);
+    }
+    openings.push_back(make_box(c - 0.5 * side, c + 0.5 * side));
+  }
+  return openings;
+}
 
 /// Boxes covering the rectangle [u0, u1] x [v0, v1] of the plane across `axis` (thickness
 /// [w0, w1] along it) less the given openings (rectangles in the same plane): the plane is cut

@@ -108,6 +108,12 @@ FamilyDraw draw_family(const GeneratorPreset& preset, Rng& rng, const Box& bound
 /// in u and v cuts the plane; their extent along `axis` is ignored): "mixed"'s slabs.
 void slab_with_openings(std::vector<Box>& out, int axis, double w0, double w1, double u0, double u1, double v0,
                         double v1, const std::vector<Box>& openings);
+/// The 1-3 openings of one "mixed" slab across `axis` centred at w, t thick, drawn from `rng`
+/// within `bounds` (boxes 2 t long along `axis`, corners rounded to the 0.05 m quantum): the
+/// first at least 2 r + 0.3 m on each of the plane's axes before rounding (r the preset's
+/// robot radius), the others at least 0.2 m (REQ-WORLD-020).
+std::vector<Box> slab_openings(const GeneratorPreset& preset, Rng& rng, const Box& bounds, int axis, double w,
+                               double t);
 
 }  // namespace detail
 

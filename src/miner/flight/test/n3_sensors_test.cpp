@@ -208,6 +208,39 @@ TEST_CASE("IMU samples at rest have the stated bias, noise density and gravity",
   }
 }
 
+TEST_CASE("The gyro bias random walk has variance sigma^2 T over a horizon T at any sample rate", "[REQ-FLIGHT-004]") {
+  // H0 (the stated density): over a horizon T = N dt the gyro bias moves by
+  // b(T) - b(0) ~ N(0, sigma_g^2 T) on each axis, independently across axes and IMUs, so
+  // X = sum of (b(T) - b(0))^2 / (sigma_g^2 T) over m IMUs and 3 axes ~ chi2(3m) exactly.
+  // The test is two-sided with 2.5e-7 in each tail per rate, so with the two rates the false
+  // fail is <= 1e-6. H1: the variance is c sigma_g^2 T with c <= 1/2 or c >= 2 (a step scaled
+  // by dt instead of sqrt(dt) gives c = dt: 1/400 and 1/50 here); m is sized so that H1's
+  // miss is <= 1e-3 (checked below with the exact chi-square cdf). The horizon is 1 s at the
+  // N3 rate (400 Hz) and at 50 Hz: the variance must not depend on the sample rate.
+  const flight::ImuParams p;  // the stated densities
+  const double T = 1.0;
+  const int m = 150;
+  const double k = 3.0 * m;
+  const double lo = miner::chi_square_quantile(2.5e-7, k), hi = miner::chi_square_quantile(1 - 2.5e-7, k);
+  CHECK(miner::chi_square_cdf(hi / 2.0, k) <= 1e-3);          // c = 2 misses (X / 2 ~ chi2 below hi / 2)
+  CHECK(1.0 - miner::chi_square_cdf(2.0 * lo, k) <= 1e-3);    // c = 1/2 misses
+  miner::Rng rng(26);
+  for (const double rate : {400.0, 50.0}) {
+    const double dt = 1.0 / rate;
+    const int N = static_cast<int>(std::lround(T / dt));
+    double X = 0.0;
+    for (int j = 0; j < m; ++j) {
+      flight::ImuModel imu(p, dt, rng);
+      const Eigen::Vector3d b0 = imu.gyro_bias();
+      for (int n = 0; n < N; ++n) imu.sample(Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
+      X += (imu.gyro_bias() - b0).squaredNorm() / (p.gyro_bias_random_walk * p.gyro_bias_random_walk * T);
+    }
+    INFO("rate " << rate << " Hz: X = " << X << ", chi2(" << k << ") band [" << lo << ", " << hi << "]");
+    CHECK(X >= lo);
+    CHECK(X <= hi);
+  }
+}
+
 TEST_CASE("Pose measurements carry their stamp, noise and outliers at the stated rate", "[REQ-FLIGHT-004]") {
   flight::PoseParams p;
   p.outlier_probability = 0.1;

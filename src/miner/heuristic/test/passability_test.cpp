@@ -1,5 +1,7 @@
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -142,4 +144,111 @@ TEST_CASE("P of solid cells is 0 and of a voxel wall with a gap is read from its
   CHECK(at(enc.passability, 5, 4, 0) == kPassAll);
   CHECK(at(enc.passability, 5, 5, 3) == (kPassY | kPassZ));  // above it
   CHECK(at(enc.passability, 8, 8, 0) == kPassAll);
+}
+
+namespace {
+
+/// The sub-cells of `cell` whose centres lie in the closed box g, by testing each centre.
+std::uint64_t centres_in_box(const world::Box& cell, const world::Box& g) {
+  std::uint64_t mask = 0;
+  const Eigen::Vector3d h = cell.extent() / kN;
+  for (int z = 0; z < kN; ++z)
+    for (int y = 0; y < kN; ++y)
+      for (int x = 0; x < kN; ++x) {
+        const Eigen::Vector3d c = cell.min + Eigen::Vector3d(x + 0.5, y + 0.5, z + 0.5).cwiseProduct(h);
+        if ((c.array() >= g.min.array()).all() && (c.array() <= g.max.array()).all())
+          mask |= std::uint64_t{1} << (x + kN * (y + kN * z));
+      }
+  return mask;
+}
+
+}  // namespace
+
+TEST_CASE("A grown box blocks exactly the sub-cells whose centres lie in it: the closed box", "[REQ-HEUR-015]") {
+  // subcells_inside against a direct test of every 4^3 centre. (1) Dyadic cells and boxes
+  // whose faces fall on centres (a centre on a face is inside: closed box), half-way between
+  // centres, on cell faces and past the cell, exactly representable so both sides are exact.
+  Rng rng(26, 0);
+  const world::Box unit{{0, 0, 0}, {1, 1, 1}};
+  int on_face = 0;
+  for (int trial = 0; trial < 4000; ++trial) {
+    const Eigen::Vector3d scale(std::ldexp(1.0, static_cast<int>(rng.uniform_index(4)) - 1),
+                                std::ldexp(1.0, static_cast<int>(rng.uniform_index(4)) - 1),
+                                std::ldexp(1.0, static_cast<int>(rng.uniform_index(4)) - 1));
+    const Eigen::Vector3d origin(static_cast<double>(rng.uniform_index(9)) - 4.0,
+                                 static_cast<double>(rng.uniform_index(9)) - 4.0,
+                                 static_cast<double>(rng.uniform_index(9)) - 4.0);
+    const world::Box cell{origin, origin + scale};
+    world::Box g;
+    for (int a = 0; a < 3; ++a) {
+      // Eighths of the cell from -2/8 to 10/8: centres are the odd eighths 1, 3, 5, 7.
+      int lo = static_cast<int>(rng.uniform_index(13)) - 2, hi = static_cast<int>(rng.uniform_index(13)) - 2;
+      if (lo > hi) std::swap(lo, hi);
+      g.min[a] = origin[a] + scale[a] * lo / 8.0;
+      g.max[a] = origin[a] + scale[a] * hi / 8.0;
+      on_face += (hi % 2 != 0) && hi >= 1 && hi <= 7;
+    }
+    const std::uint64_t want = centres_in_box(cell, g);
+    INFO("trial " << trial << ": cell " << cell.min.transpose() << " .. " << cell.max.transpose() << ", box "
+                  << g.min.transpose() << " .. " << g.max.transpose());
+    REQUIRE(heuristic::subcells_inside(cell, g) == want);
+  }
+  CHECK(on_face > 1000);  // many boxes end exactly on a centre
+  CHECK(heuristic::subcells_inside(unit, unit) == ~std::uint64_t{0});
+  CHECK(heuristic::subcells_inside(unit, world::Box{{0.375, 0.375, 0.375}, {0.625, 0.625, 0.625}}) ==
+        centres_in_box(unit, world::Box{{0.375, 0.375, 0.375}, {0.625, 0.625, 0.625}}));
+  CHECK(heuristic::subcells_inside(unit, world::Box{{0, 0, 0}, {0.124, 1, 1}}) == 0);  // short of the first centre
+  // (2) Random cells and boxes of any size (no face on a centre but by chance, skipped).
+  for (int trial = 0; trial < 4000; ++trial) {
+    const Eigen::Vector3d lo(rng.uniform(-5, 5), rng.uniform(-5, 5), rng.uniform(-5, 5));
+    const Eigen::Vector3d ext(rng.uniform(0.1, 3), rng.uniform(0.1, 3), rng.uniform(0.1, 3));
+    const world::Box cell{lo, lo + ext};
+    world::Box g;
+    bool near_centre = false;
+    for (int a = 0; a < 3; ++a) {
+      double u = rng.uniform(-0.3, 1.3), v = rng.uniform(-0.3, 1.3);
+      if (u > v) std::swap(u, v);
+      g.min[a] = lo[a] + u * ext[a];
+      g.max[a] = lo[a] + v * ext[a];
+      for (int s = 0; s < kN; ++s)
+        for (double f : {u, v}) near_centre = near_centre || std::abs(f - (s + 0.5) / kN) < 1e-9;
+    }
+    if (near_centre) continue;
+    INFO("random trial " << trial);
+    REQUIRE(heuristic::subcells_inside(cell, g) == centres_in_box(cell, g));
+  }
+}
+
+TEST_CASE("P of a partial cell is the flood of the sub-cells whose centres lie outside every grown box", "[REQ-HEUR-015]") {
+  // Through the public encoding: one box on a 4 x 4 x 4 map of 1 m cells, grown by 0.125 m, its
+  // faces on eighths of a cell (so the grown faces fall on sub-cell centres or half-way): each
+  // partial cell's P is passability_of of the centres outside the grown box.
+  Rng rng(2619, 0);
+  const Eigen::Vector3i dims(4, 4, 4);
+  const double radius = 0.125;
+  int partial = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    world::Box box;
+    for (int a = 0; a < 3; ++a) {
+      int lo = static_cast<int>(rng.uniform_index(31)) + 1, hi = static_cast<int>(rng.uniform_index(31)) + 1;
+      if (lo > hi) std::swap(lo, hi);
+      if (lo == hi) ++hi;
+      box.min[a] = lo / 8.0;
+      box.max[a] = hi / 8.0;
+    }
+    const world::Map map(world::Box{{0, 0, 0}, {4, 4, 4}}, 0.125, {box});
+    const heuristic::Encoding enc = encode(map, dims, radius);
+    const world::Box grown = box.inflated(radius);
+    for (int k = 0; k < 4; ++k)
+      for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < 4; ++i) {
+          const std::size_t idx = heuristic::cell_index(dims, i, j, k);
+          if (enc.environment[idx] != heuristic::kPartial) continue;
+          ++partial;
+          const world::Box cell{Eigen::Vector3d(i, j, k), Eigen::Vector3d(i + 1, j + 1, k + 1)};
+          INFO("trial " << trial << ", cell " << i << " " << j << " " << k);
+          REQUIRE(enc.passability[idx] == heuristic::passability_of(~centres_in_box(cell, grown)));
+        }
+  }
+  CHECK(partial > 1000);
 }

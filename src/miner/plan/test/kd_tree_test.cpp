@@ -1,5 +1,7 @@
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+
 #include "miner/core/error.hpp"
 #include "miner/core/rng.hpp"
 #include "miner/plan/kd_tree.hpp"
@@ -46,4 +48,65 @@ TEST_CASE("An empty k-d tree refuses nearest and returns no neighbours", "[REQ-P
   tree.within(V::Zero(), -1.0, out);  // a negative radius holds nothing
   CHECK(out.empty());
   CHECK(tree.nearest(V(5, 5, 5)) == 0);
+}
+
+TEST_CASE("A radius query returns the closed ball: points exactly at distance r are included", "[REQ-PLAN-006]") {
+  // Integer coordinates and radii: every squared distance and r^2 is exact, so the points on
+  // the sphere |p - q| = r (axis offsets, the 3-4-5 and 1-2-2 triangles, 2-3-6 of 7) are on
+  // it exactly and must be returned, as a linear scan with <= returns them.
+  miner::Rng rng(26);
+  KdTree tree;
+  std::vector<V> points;
+  for (int x = -7; x <= 7; ++x)
+    for (int y = -7; y <= 7; ++y)
+      for (int z = -7; z <= 7; ++z) {
+        const V p(x, y, z);
+        tree.insert(p);
+        points.push_back(p);
+      }
+  // The tree built in random order too (its splits then fall elsewhere).
+  std::vector<std::size_t> order(points.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  for (std::size_t i = order.size(); i > 1; --i) std::swap(order[i - 1], order[rng.uniform_index(i)]);
+  KdTree shuffled;
+  for (std::size_t i : order) shuffled.insert(points[i]);
+
+  std::vector<std::size_t> got, expected;
+  for (double r : {0.0, 1.0, 2.0, 3.0, 5.0, 7.0}) {
+    for (int trial = 0; trial < 20; ++trial) {
+      const V q(static_cast<double>(rng.uniform_index(9)) - 4.0, static_cast<double>(rng.uniform_index(9)) - 4.0,
+                static_cast<double>(rng.uniform_index(9)) - 4.0);
+      expected.clear();
+      std::size_t on_sphere = 0;
+      for (std::size_t i = 0; i < points.size(); ++i) {
+        const double d2 = (points[i] - q).squaredNorm();
+        if (d2 <= r * r) expected.push_back(i);
+        if (d2 == r * r) ++on_sphere;
+      }
+      INFO("r = " << r << ", q = " << q.transpose());
+      REQUIRE(on_sphere > 0);  // the query has points exactly at distance r
+      tree.within(q, r, got);
+      CHECK(got == expected);
+      shuffled.within(q, r, got);
+      std::vector<std::size_t> mapped;
+      for (std::size_t j : got) mapped.push_back(order[j]);
+      std::sort(mapped.begin(), mapped.end());
+      CHECK(mapped == expected);
+    }
+  }
+  // The named offsets themselves.
+  tree.within(V::Zero(), 5.0, got);
+  const auto has = [&](const V& p) {
+    for (std::size_t i : got)
+      if (points[i] == p) return true;
+    return false;
+  };
+  CHECK(has(V(3, 4, 0)));
+  CHECK(has(V(0, -4, 3)));
+  CHECK(has(V(5, 0, 0)));
+  CHECK(has(V(0, 0, -5)));
+  CHECK_FALSE(has(V(3, 4, 1)));
+  tree.within(V::Zero(), 3.0, got);
+  CHECK(has(V(1, 2, 2)));
+  CHECK(has(V(-2, 1, -2)));
 }

@@ -83,6 +83,28 @@ TEST_CASE("Evaluation: position and derivatives at segment ends and in between",
   CHECK(t.evaluate(0.5, 6).norm() == 0.0);  // degree 5: the 6th derivative vanishes
 }
 
+TEST_CASE("Evaluation before t = 0 is clamped to the start state in every derivative", "[REQ-TRAJ-004]") {
+  // A moving start (velocity, acceleration and, for snap, jerk nonzero), so that segment 0's
+  // polynomial continued before t = 0 differs from the start state in every derivative.
+  for (int s : {3, 4}) {
+    Eigen::MatrixX3d pts(3, 3);
+    pts << 0, 0, 0, 1, 2, 0, 3, 1, 1;
+    MincoProblem p = rest_to_rest(s, pts, {1.0, 1.5});
+    p.head.row(1) << 0.8, -0.5, 0.3;
+    p.head.row(2) << -0.4, 0.6, 0.2;
+    if (s == 4) p.head.row(3) << 0.3, 0.1, -0.7;
+    const auto t = solve_minco(p);
+    for (int k = 0; k <= 2 * s; ++k) {
+      const Eigen::Vector3d start = t.evaluate_segment(0, 0.0, k);
+      if (k < s) CHECK((start - p.head.row(k).transpose()).norm() < 1e-12);  // the documented start state
+      for (double before : {-1e-9, -0.25, -1.0, -100.0}) {
+        INFO("s = " << s << ", k = " << k << ", t = " << before);
+        CHECK(t.evaluate(before, k) == start);
+      }
+    }
+  }
+}
+
 TEST_CASE("Cost from the coefficients equals the solver's Hermite-form cost", "[REQ-TRAJ-005]") {
   Eigen::MatrixX3d pts(4, 3);
   pts << 0, 0, 0, 1, 2, 3, -1, 2, 0, 2, 2, 2;

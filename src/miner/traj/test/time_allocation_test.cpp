@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "miner/core/error.hpp"
+#include "miner/core/rng.hpp"
 #include "miner/traj/problem_io.hpp"
 #include "miner/traj/time_allocation.hpp"
 
@@ -86,6 +87,43 @@ TEST_CASE("Where no limit is active the answer is a stationary point: (dJ/dT_i +
   solver.cost_and_gradients(q, &g);
   for (std::size_t i = 0; i < r.durations.size(); ++i)
     CHECK(std::abs((g.durations[static_cast<Eigen::Index>(i)] + o.rho) * r.durations[i]) <= 1e-5 * r.objective);
+}
+
+TEST_CASE("The gradient handed to Ceres is dF/dlog T: central differences in log T agree on every component", "[REQ-TRAJ-011]") {
+  // Ceres optimises over tau = log T; where no limit is active (k = 1) the gradient it gets
+  // must be the chain rule's (dJ*/dT_i + rho) T_i, not dF/dT_i. Random rest-to-rest problems
+  // and random durations (0.4..2.5 s, so that dF/dT and dF/dtau differ by the factor T_i),
+  // limits far away, every component against a central difference of F in tau.
+  miner::Rng rng(19);
+  AllocationOptions o;
+  o.limits = Limits{1e3, 1e3};
+  for (int trial = 0; trial < 24; ++trial) {
+    const int s = 3 + trial % 2;
+    const int M = 1 + static_cast<int>(rng.uniform_index(5));
+    Eigen::MatrixX3d pts(M + 1, 3);
+    for (int r = 0; r <= M; ++r)
+      for (int c = 0; c < 3; ++c) pts(r, c) = rng.uniform(-3.0, 3.0);
+    const auto p = rest_to_rest(s, pts, {});
+    o.rho = rng.uniform(0.1, 10.0);
+    std::vector<double> tau(static_cast<std::size_t>(M));
+    for (double& x : tau) x = std::log(rng.uniform(0.4, 2.5));
+    const auto [F, gradient] = log_time_objective(p, tau, o);
+    std::vector<double> T(tau.size());
+    for (std::size_t i = 0; i < tau.size(); ++i) T[i] = std::exp(tau[i]);
+    const auto [F_direct, k] = feasible_objective(p, T, o);
+    REQUIRE(k == 1.0);  // no limit active: the analytic branch
+    CHECK(F == Approx(F_direct).epsilon(1e-12));
+    REQUIRE(gradient.size() == tau.size());
+    for (std::size_t i = 0; i < tau.size(); ++i) {
+      const double h = 1e-5;
+      auto plus = tau, minus = tau;
+      plus[i] += h;
+      minus[i] -= h;
+      const double fd = (log_time_objective(p, plus, o).first - log_time_objective(p, minus, o).first) / (2 * h);
+      INFO("trial " << trial << ", s = " << s << ", M = " << M << ", component " << i << ", T = " << T[i]);
+      CHECK(gradient[i] == Approx(fd).epsilon(1e-6).margin(1e-8 * F));
+    }
+  }
 }
 
 TEST_CASE("Optimised allocation refuses moving ends, naming why", "[REQ-TRAJ-011]") {

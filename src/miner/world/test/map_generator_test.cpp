@@ -201,6 +201,44 @@ TEST_CASE("Mixed slabs: the pieces cover the plane less its openings, each point
   }
 }
 
+TEST_CASE("Each mixed slab's first opening is at least 2 r + 0.3 m wide on both axes of its plane", "[REQ-WORLD-020]") {
+  // REQ-WORLD-020: the first opening is drawn 2 r + 0.3 m or more on each side before its
+  // corners are rounded to the 0.05 m quantum, so after rounding it is at least that less
+  // 0.05 m (each corner moves by at most half the quantum) on both axes of the plane; the
+  // others at least 0.2 m less 0.05. Random bounds of the family's sizes (thin ones included,
+  // where the draw's range is narrowest), every axis, many slabs.
+  const GeneratorPreset p = generator_preset("mixed");
+  const double passage = 2.0 * p.robot_radius + 0.3;
+  miner::Rng rng(26);
+  int narrow_others = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    const Eigen::Vector3d lo(std::round(rng.uniform(-20, 20)), std::round(rng.uniform(-20, 20)), 0.0);
+    const Eigen::Vector3d extent(rng.uniform(8, 100), rng.uniform(8, 100), rng.uniform(3, 40));
+    const Box bounds{lo, lo + extent};
+    const int axis = trial % 3, ua = (axis + 1) % 3, va = (axis + 2) % 3;
+    const double t = rng.uniform(0.1, 0.6);
+    const double w = bounds.min[axis] + rng.uniform(0.2, 0.8) * extent[axis];
+    const auto openings = detail::slab_openings(p, rng, bounds, axis, w, t);
+    INFO("trial " << trial << ": bounds " << bounds.min.transpose() << " .. " << bounds.max.transpose() << ", axis " << axis);
+    REQUIRE(openings.size() >= 1);
+    REQUIRE(openings.size() <= 3);
+    for (std::size_t o = 0; o < openings.size(); ++o) {
+      const Eigen::Vector3d side = openings[o].extent();
+      const double least = (o == 0 ? passage : 0.2) - 0.05 - 1e-9;
+      INFO("opening " << o << ": sides " << side[ua] << " x " << side[va]);
+      CHECK(side[ua] >= least);
+      CHECK(side[va] >= least);
+      // Inside the plane's bounds (up to rounding) and across the slab.
+      CHECK(openings[o].min[ua] >= bounds.min[ua] - 0.025 - 1e-9);
+      CHECK(openings[o].max[ua] <= bounds.max[ua] + 0.025 + 1e-9);
+      CHECK(openings[o].min[axis] < w - 0.5 * t);
+      CHECK(openings[o].max[axis] > w + 0.5 * t);
+      if (o > 0) narrow_others += std::min(side[ua], side[va]) < passage - 0.05;
+    }
+  }
+  CHECK(narrow_others >= 1);  // the other openings may be narrower than the robot's passage
+}
+
 TEST_CASE("Mixed maps: slabs across every axis with passable openings, rods, a free solvable query, the same bytes", "[REQ-WORLD-020]") {
   const GeneratorPreset p = generator_preset("mixed");
   REQUIRE(is_family(p));

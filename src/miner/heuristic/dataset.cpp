@@ -184,6 +184,28 @@ std::string read_shard(const std::string& dir, const ShardRecord& r, std::size_t
                 " samples of " + std::to_string(kDatasetChannels) + " x " + std::to_string(cells) + "), found " + std::to_string(bytes.size()));
   if (sha256_hex(bytes) != r.sha256)
     throw Error(path + ": its SHA-256 differs from the one dataset.json records (the file was changed)");
+  // The bytes are grids of levels, not trusted for matching their hash (issue 20, sixth campaign:
+  // a shard of zeros, with its SHA-256 recomputed, gave a truth connectivity of 0 without a
+  // word): each channel within its levels, and S and T each marking some cell.
+  struct Channel {
+    const char* name;
+    std::uint8_t max;
+    bool marks_cells;
+  };
+  constexpr Channel kChannels[kDatasetChannels] = {
+      {"environment", 2, false}, {"state", 1, true}, {"target", 1, true}, {"passability", kPassAll, false}};
+  for (std::size_t k = 0; k < r.count; ++k)
+    for (std::size_t c = 0; c < kDatasetChannels; ++c) {
+      const auto* grid = reinterpret_cast<const std::uint8_t*>(bytes.data()) + (k * kDatasetChannels + c) * cells;
+      const std::uint8_t* high = std::find_if(grid, grid + cells, [&](std::uint8_t v) { return v > kChannels[c].max; });
+      if (high != grid + cells)
+        throw Error(path + ": sample " + std::to_string(k) + " of the shard, channel " + kChannels[c].name + ", cell " +
+                    std::to_string(high - grid) + ": holds " + std::to_string(*high) + ", outside its levels 0.." +
+                    std::to_string(kChannels[c].max));
+      if (kChannels[c].marks_cells && std::find(grid, grid + cells, std::uint8_t{1}) == grid + cells)
+        throw Error(path + ": sample " + std::to_string(k) + " of the shard, channel " + kChannels[c].name +
+                    ": marks no cell (a sample's " + kChannels[c].name + " holds its start and goal cells)");
+    }
   return bytes;
 }
 

@@ -173,7 +173,8 @@ Scenario scenario_from_json(const Json& doc, const std::string& origin, const st
   }
   if (root.has("seed")) {
     const JsonField f = root.at("seed");
-    if (!f.value().is_number_unsigned()) f.fail("must be a non-negative integer");
+    // 2^64 and beyond parse as a double: the range, not the sign, is what is wrong with them.
+    if (!f.value().is_number_unsigned()) f.fail("must be an integer in [0, 2^64 - 1], got " + f.value().dump());
     s.seed = f.value().get<std::uint64_t>();
   }
   if (root.has("hover_after_s")) {
@@ -239,6 +240,16 @@ Scenario scenario_from_json(const Json& doc, const std::string& origin, const st
     root.fail("controller.max_tilt_deg exceeds the N3's max_tilt_deg");
   ticks_per(root.has("controller") ? root.at("controller") : root, s.n3.rate_hz, s.controller.rate_hz, "controller rate");
   ticks_per(root.has("pose") ? root.at("pose") : root, s.n3.rate_hz, s.pose.rate_hz, "pose rate");
+  // The N3 drops API control when no command arrived for timeout_s: a timeout shorter than the
+  // controller's period, or no longer than the command latency (the first command arrives after
+  // it), times out every command and the vehicle never moves (issue 20, sixth campaign: such
+  // scenarios were flown and ended in "did not reach the goal").
+  if (s.n3.timeout_s < 1.0 / s.controller.rate_hz)
+    root.fail("n3.timeout_s " + std::to_string(s.n3.timeout_s) + " s is shorter than the controller's period (" +
+              std::to_string(1.0 / s.controller.rate_hz) + " s at controller.rate_hz): every command would time out");
+  if (s.n3.latency_s >= s.n3.timeout_s)
+    root.fail("n3.latency_s " + std::to_string(s.n3.latency_s) + " s is not below n3.timeout_s " +
+              std::to_string(s.n3.timeout_s) + " s: the first command would arrive after the N3 dropped API control");
   if (root.has("command_dropout_s")) {
     const JsonField d = root.at("command_dropout_s");
     if (d.array_size() != 2) d.fail("expected [t0, t1]");

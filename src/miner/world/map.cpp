@@ -62,10 +62,13 @@ Eigen::Vector3i grid_dims(const Box& bounds, double resolution) {
   // Snaps in the cell count: a face within this many cells of a whole number is on it.
   constexpr double kGridSnapTolerance = 1e-9;
   const Eigen::Vector3d extent = bounds.extent();
-  if (resolution > extent.minCoeff()) {
+  // Compared in cells, with the snap: an extent of one cell that rounding left a hair short
+  // (1.2 - 1.1 < 0.1 in doubles) is one cell (issue 20, sixth campaign: "0.1 m is coarser than
+  // the smallest extent (0.1 m)").
+  if (extent.minCoeff() / resolution < 1.0 - kGridSnapTolerance) {
     std::ostringstream os;
-    os << "resolution: " << resolution << " m is coarser than the smallest extent of the bounds ("
-       << extent.minCoeff() << " m): the grid would have no cell along that axis";
+    os << "resolution: " << resolution << " m is coarser than the smallest extent of the bounds (" << extent.minCoeff()
+       << " m): the grid would have no cell along that axis";
     throw Error(os.str());
   }
   Eigen::Vector3d cells;

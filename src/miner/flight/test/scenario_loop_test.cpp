@@ -112,6 +112,18 @@ TEST_CASE("Bad scenarios are refused before flight with the fault named", "[REQ-
   }
   // Bounded work: a hover of a day, or limits so low the reference would last hours, are
   // refused before any sampling or simulation.
+  // The N3's timeout against the controller's period and the command latency, and a seed past
+  // 2^64 - 1 (issue 20, sixth campaign).
+  doc = default_doc();
+  doc["n3"]["timeout_s"] = 0.005;
+  expect_scenario_error(doc, "n3.timeout_s 0.005000 s is shorter than the controller's period");
+  doc = default_doc();
+  doc["n3"]["latency_s"] = 0.5;
+  doc["n3"]["timeout_s"] = 0.1;
+  expect_scenario_error(doc, "n3.latency_s 0.500000 s is not below n3.timeout_s 0.100000 s");
+  doc = default_doc();
+  doc["seed"] = 18446744073709551616.0;
+  expect_scenario_error(doc, "seed: must be an integer in [0, 2^64 - 1], got 1.8446744073709552e+19");
   doc = default_doc();
   doc["hover_after_s"] = 86400;
   expect_scenario_error(doc, "hover_after_s: must be at most 1000 s");

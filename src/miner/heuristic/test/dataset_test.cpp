@@ -1,10 +1,10 @@
 #include <catch2/catch.hpp>
 
-#include <functional>
-
 #include <deque>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <iterator>
 #include <set>
 #include <sstream>
 
@@ -13,6 +13,7 @@
 #include "miner/core/error.hpp"
 #include "miner/core/json_io.hpp"
 #include "miner/core/progress.hpp"
+#include "miner/core/sha256.hpp"
 #include "miner/heuristic/dataset.hpp"
 #include "miner/heuristic/grid.hpp"
 #include "miner/plan/heuristic_region.hpp"
@@ -405,6 +406,33 @@ TEST_CASE("A dataset folder that contradicts itself is refused naming the file a
         edit_json(q0 + "/train-index.json", [](miner::Json& d) { d[0]["start"][0] = 1e6; });
       },
       "start: lies outside the sample's bounds");
+  // Shard bytes outside their levels, or a sample with no start and goal cells, with the SHA-256
+  // in dataset.json recomputed to match (issue 20, sixth campaign: they were read silently).
+  const auto edit_shard = [&](const std::string& q0, const std::function<void(std::string&)>& change) {
+    const std::string shard = q0 + "/train-00000.bin";
+    std::string bytes;
+    {
+      std::ifstream in(shard, std::ios::binary);
+      bytes.assign(std::istreambuf_iterator<char>(in), {});
+    }
+    change(bytes);
+    miner::write_file_atomic(shard, bytes);
+    edit_json(q0 + "/dataset.json",
+              [&](miner::Json& d) { d["splits"]["train"]["shards"][0]["sha256"] = miner::sha256_hex(bytes); });
+  };
+  const std::size_t cells = 8 * 8 * 4;
+  refused([&](const std::string& q0, const std::string&) { edit_shard(q0, [](std::string& b) { b[5] = 9; }); },
+          "train-00000.bin: sample 0 of the shard, channel environment, cell 5: holds 9, outside its levels 0..2");
+  refused(
+      [&](const std::string& q0, const std::string&) {
+        edit_shard(q0, [&](std::string& b) { b[4 * cells + 3 * cells + 7] = static_cast<char>(8); });
+      },
+      "sample 1 of the shard, channel passability, cell 7: holds 8, outside its levels 0..7");
+  refused(
+      [&](const std::string& q0, const std::string&) {
+        edit_shard(q0, [&](std::string& b) { std::fill(b.begin() + cells, b.begin() + 2 * cells, '\0'); });
+      },
+      "sample 0 of the shard, channel state: marks no cell");
 }
 
 TEST_CASE("Bad dataset options are refused naming the option", "[REQ-HEUR-003]") {

@@ -64,6 +64,11 @@ TEST_CASE("A resolution that would need too many cells is refused by name", "[RE
   CHECK_THROWS_WITH(Map(Box{{0, 0, 0}, {1000, 1000, 1000}}, 0.01, {}), Contains("resolution: 0.01 m gives a grid of"));
   // The grid is the map's: 10 m at 0.1 m is 100 cells (snapped), not 101.
   CHECK(miner::world::grid_dims(Box{{0, 0, 0}, {10, 10, 10}}, 0.1) == I(100, 100, 100));
+  // One cell thick, though 1.2 - 1.1 < 0.1 in doubles (issue 20, sixth campaign: refused as
+  // "0.1 m is coarser than the smallest extent (0.1 m)"); a truly thinner extent is refused.
+  CHECK(miner::world::grid_dims(Box{{0, 0, 1.1}, {1, 1, 1.2}}, 0.1) == I(10, 10, 1));
+  CHECK_THROWS_WITH(miner::world::grid_dims(Box{{0, 0, 1.1}, {1, 1, 1.19}}, 0.1),
+                    Catch::Contains("coarser than the smallest extent"));
   CHECK(VoxelGrid(Map(Box{{0, 0, 0}, {10, 10, 10}}, 0.1, {}), 0.0).dims() == I(100, 100, 100));
 }
 

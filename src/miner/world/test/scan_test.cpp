@@ -16,14 +16,20 @@ Map scene() {
   return Map(Box{{0, 0, 0}, {12, 8, 4}}, 0.2, {Box{{5, 3, 0}, {7, 5, 3}}, Box{{10, 0, 0}, {10.4, 8, 1}}});
 }
 
-}  // namespace
-
-TEST_CASE("A scan marks free space along rays, surfaces as occupied, the rest unknown", "[REQ-WORLD-016]") {
-  const Map map = scene();
+/// No noise, no dropouts, a 6 m range: every return on a surface.
+ScanOptions noiseless() {
   ScanOptions o;
   o.noise = 0.0;
   o.dropout = 0.0;
   o.range = 6.0;
+  return o;
+}
+
+}  // namespace
+
+TEST_CASE("A scan marks free space along rays, surfaces as occupied, the rest unknown", "[REQ-WORLD-016]") {
+  const Map map = scene();
+  const ScanOptions o = noiseless();
   const std::vector<V> path{V(1, 4, 1.5), V(3, 4, 1.5)};
   const ScanResult scan = scan_map(map, path, o);
   const VoxelLayer& layer = *scan.layer;
@@ -68,10 +74,7 @@ TEST_CASE("The swept volume is free but never erases a return: any body radius k
   // The path passes 0.6 m from the block's face; a 1.5 m body would reach into it (issue 20,
   // sixth campaign: occupied voxels fell from 6461 to 5577 with --body-radius 1).
   const Map map = scene();
-  ScanOptions o;
-  o.noise = 0.0;
-  o.dropout = 0.0;
-  o.range = 6.0;
+  ScanOptions o = noiseless();
   const std::vector<V> path{V(1, 2.4, 1.5), V(9, 2.4, 1.5)};
   const auto occupied = [&](double body) {
     o.body_radius = body;

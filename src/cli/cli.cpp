@@ -303,8 +303,10 @@ ResolvedQuery resolve_query(const QueryOptions& q) {
   // ... lies inside obstacle 0" named neither).
   const std::string start_name = q.start.empty() ? q.map + ": query.start" : "--start";
   const std::string goal_name = q.goal.empty() ? q.map + ": query.goal" : "--goal";
-  if (q.start.empty()) map.require_free(start, radius, start_name);
-  if (q.goal.empty()) map.require_free(goal, radius, goal_name);
+  // Both ends, given or stored, named as given (issue 20, sixth campaign: `plan --start` inside
+  // an obstacle named neither the option nor the map).
+  map.require_free(start, radius, start_name);
+  map.require_free(goal, radius, goal_name);
   return {std::move(map), start, goal, radius, start_name, goal_name};
 }
 

@@ -293,6 +293,12 @@ TEST_CASE("Options a run would not read, clamped values and mismatched suffixes 
       {{"map", "scan", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5", "--range", "2", "--noise", "1.5",
         "--out", dir() + "/s4.bt"},
        2, "--noise: must be at most half of --range"},
+      // An end given on the command line inside an obstacle names the option (issue 20, sixth
+      // campaign: plan and heuristic named neither it nor the map).
+      {{"plan", "--map", map, "--start", "5", "5", "5", "--goal", "9", "5", "5", "--planner", "rrtstar"}, 1,
+       "--start (5, 5, 5) lies inside obstacle 0"},
+      {{"heuristic", "--map", map, "--start", "1", "5", "5", "--goal", "5", "5", "5", "--out", dir() + "/h5.json"}, 1,
+       "--goal (5, 5, 5) lies inside obstacle 0"},
       {{"heuristic", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5", "--raw", "--strict-bridge", "--out",
         dir() + "/h4.json"},
        2, "--strict-bridge: is a filter step"},

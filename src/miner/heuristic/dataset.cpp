@@ -174,7 +174,8 @@ DatasetLayout read_layout(const Json& doc, const std::string& origin) {
   return L;
 }
 
-/// A shard's bytes, checked against its record: 3 grids per sample and the recorded SHA-256.
+/// A shard's bytes, checked against its record (kDatasetChannels grids per sample, the recorded
+/// SHA-256) and against the channels' levels.
 std::string read_shard(const std::string& dir, const ShardRecord& r, std::size_t cells) {
   const std::string path = dir + "/" + r.file;
   std::string bytes = read_file_bytes(path, "dataset shard");

@@ -37,7 +37,7 @@ world::Box cell_box(const world::Box& b, const Eigen::Vector3i& dims, const Eige
   return {lo, lo + s};
 }
 
-bool box_covered(const world::Box& cell, const std::vector<world::Box>& boxes) {
+bool box_covered(const world::Box& cell, const std::vector<world::Box>& boxes, std::uint64_t* budget) {
   // Breakpoints of every box face strictly inside the cell, per axis: between two
   // consecutive ones no face is crossed, so each sub-box's centre decides for all of it.
   std::vector<double> cuts[3];
@@ -53,6 +53,10 @@ bool box_covered(const world::Box& cell, const std::vector<world::Box>& boxes) {
   const double tests = static_cast<double>(cuts[0].size() - 1) * static_cast<double>(cuts[1].size() - 1) *
                        static_cast<double>(cuts[2].size() - 1) * static_cast<double>(boxes.size());
   if (tests > static_cast<double>(kMaxCoverTests)) return false;
+  if (budget != nullptr) {
+    if (tests > static_cast<double>(*budget)) return false;
+    *budget -= static_cast<std::uint64_t>(tests);
+  }
   for (std::size_t i = 0; i + 1 < cuts[0].size(); ++i)
     for (std::size_t j = 0; j + 1 < cuts[1].size(); ++j)
       for (std::size_t k = 0; k + 1 < cuts[2].size(); ++k) {
@@ -355,6 +359,7 @@ std::vector<std::uint8_t> encode(const world::Map& map, const Eigen::Vector3i& d
   box_blocked.clear();
   std::vector<world::Box>& local = scratch.local;
   constexpr std::uint64_t kAllCentres = ~std::uint64_t{0};
+  std::uint64_t cover_budget = kMaxEncodeCoverTests;  // exact cover tests left for this encoding
   for (std::size_t idx = 0; idx < cells; ++idx) {
     if (offset[idx] == offset[idx + 1]) continue;
     e[idx] = kPartial;  // met by a box that does not hold it, and inside none
@@ -365,7 +370,7 @@ std::vector<std::uint8_t> encode(const world::Map& map, const Eigen::Vector3i& d
     for (std::uint32_t t = offset[idx]; t < offset[idx + 1]; ++t) {
       const world::Box& g = grown[touching[t]];
       const world::Box clipped{g.min.cwiseMax(cell.min), g.max.cwiseMin(cell.max)};
-      // A run of boxes equal within the cell adds nothing (issue 20: 20 000 copies of a box).
+      // A run of consecutive boxes equal within the cell adds nothing (issue 20: 20 000 copies of a box).
       if (!local.empty() && local.back().min == clipped.min && local.back().max == clipped.max) continue;
       clipped_volume += (clipped.max - clipped.min).cwiseMax(0.0).prod();
       if (passability) blocked |= subcells_inside(cell, g);
@@ -384,7 +389,7 @@ std::vector<std::uint8_t> encode(const world::Map& map, const Eigen::Vector3i& d
       return covered == kAllCentres;
     };
     if (local.size() > 1 && clipped_volume >= cell.extent().prod() * (1.0 - kVolumeRounding) && centres_covered() &&
-        box_covered(cell, local))
+        box_covered(cell, local, &cover_budget))
       e[idx] = kSolid;
     if (passability && e[idx] == kPartial) box_blocked.emplace_back(static_cast<std::uint32_t>(idx), blocked);
   }

@@ -49,11 +49,16 @@ world::Box cell_box(const world::Box& bounds, const Eigen::Vector3i& dims, const
 /// inside one cell cut it into up to (2n + 1)^3 sub-boxes, each tested against n boxes).
 inline constexpr std::uint64_t kMaxCoverTests = std::uint64_t{1} << 24;
 
+/// The most sub-box-in-box tests one encoding spends on exact cover tests over all its cells
+/// (a per-cell bound alone let 4096 cells at ~2^24 tests each run for minutes).
+inline constexpr std::uint64_t kMaxEncodeCoverTests = std::uint64_t{1} << 26;
+
 /// Whether the closed box `cell` lies inside the union of `boxes` (exact: the boxes'
 /// faces cut the cell into sub-boxes, each of which is inside one box or outside all). Past
-/// kMaxCoverTests tests (sub-boxes x boxes) it answers false unproven: the encoding then keeps
-/// such a cell partial, never solid.
-bool box_covered(const world::Box& cell, const std::vector<world::Box>& boxes);
+/// kMaxCoverTests tests (sub-boxes x boxes), or past what is left of `*budget` when given (the
+/// tests are then taken from it), it answers false unproven: the encoding then keeps such a
+/// cell partial, never solid.
+bool box_covered(const world::Box& cell, const std::vector<world::Box>& boxes, std::uint64_t* budget = nullptr);
 
 /// Channel E: kFree / kPartial / kSolid per cell for obstacles grown by `radius`. Boxes are cut
 /// exactly; a voxel layer (REQ-WORLD-012) is read from its occupancy in one pass over the voxels

@@ -330,8 +330,8 @@ struct Sgan::Impl {
             planes[c][p] = in.condition[c];
             cv[c] = in.condition[c];
           }
-          // scale > 0 (checked at load), so E/2 is nonzero exactly where E is.
-          if ((environment[v] | state[v] | blocked) != 0) sparse.push_back(in);
+          // As set_input: the voxels where a condition, as the float the kernels read, is nonzero.
+          if (in.condition[0] != 0.0F || (state[v] | blocked) != 0) sparse.push_back(in);
         }
       }
   }

@@ -244,11 +244,16 @@ Scenario scenario_from_json(const Json& doc, const std::string& origin, const st
   // controller's period, or no longer than the command latency (the first command arrives after
   // it), times out every command and the vehicle never moves (issue 20, sixth campaign: such
   // scenarios were flown and ended in "did not reach the goal").
-  if (s.n3.timeout_s < 1.0 / s.controller.rate_hz)
-    root.fail("n3.timeout_s " + std::to_string(s.n3.timeout_s) + " s is shorter than the controller's period (" +
-              std::to_string(1.0 / s.controller.rate_hz) + " s at controller.rate_hz): every command would time out");
-  if (s.n3.latency_s >= s.n3.timeout_s)
-    root.fail("n3.latency_s " + std::to_string(s.n3.latency_s) + " s is not below n3.timeout_s " +
+  // The N3 checks at its own ticks: the longest silence it sees between commands is the
+  // controller's period less one N3 tick.
+  const double longest_silence = 1.0 / s.controller.rate_hz - 1.0 / s.n3.rate_hz;
+  if (s.n3.timeout_s < longest_silence)
+    root.fail("n3.timeout_s " + std::to_string(s.n3.timeout_s) + " s is shorter than the " +
+              std::to_string(longest_silence) +
+              " s the N3 sees between commands (controller.rate_hz's period less one n3 tick): every command would "
+              "time out");
+  if (s.n3.latency_s > s.n3.timeout_s)
+    root.fail("n3.latency_s " + std::to_string(s.n3.latency_s) + " s is above n3.timeout_s " +
               std::to_string(s.n3.timeout_s) + " s: the first command would arrive after the N3 dropped API control");
   if (root.has("command_dropout_s")) {
     const JsonField d = root.at("command_dropout_s");

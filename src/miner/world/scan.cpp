@@ -171,6 +171,8 @@ ScanResult scan_map(const Map& map, const std::vector<Eigen::Vector3d>& path, co
   // it too). Set, not voted: a noisy return inside it cannot outweigh the vehicle's presence.
   if (o.body_radius > 0.0) {
     constexpr double kVoxelCircumradius = 0.8660254037844387;  // sqrt(3) / 2: a unit cube's half diagonal
+    // OctoMap's float voxel centres (~4e-6 m off at 100 m): a margin in voxels over the rounding.
+    constexpr double kCentreRounding = 1e-4;
     const int n = static_cast<int>(std::ceil(o.body_radius / res)) + 1;
     octomap::KeySet swept;
     for (const Eigen::Vector3d& p : resample_path(path, 0.5 * res)) {
@@ -189,7 +191,7 @@ ScanResult scan_map(const Map& map, const std::vector<Eigen::Vector3d>& path, co
             // obstacle surface meets keeps what the rays saw, so a body wider than the path's
             // clearance never erases a return (issue 20, sixth campaign: --body-radius 1 on a
             // path planned for 0.2 m freed 884 occupied voxels).
-            if ((cd - p).norm() <= o.body_radius + res && map.is_free(cd, kVoxelCircumradius * res))
+            if ((cd - p).norm() <= o.body_radius + res && map.is_free(cd, (kVoxelCircumradius + kCentreRounding) * res))
               swept.insert(key);
           }
     }

@@ -116,11 +116,11 @@ TEST_CASE("Bad scenarios are refused before flight with the fault named", "[REQ-
   // 2^64 - 1 (issue 20, sixth campaign).
   doc = default_doc();
   doc["n3"]["timeout_s"] = 0.005;
-  expect_scenario_error(doc, "n3.timeout_s 0.005000 s is shorter than the controller's period");
+  expect_scenario_error(doc, "n3.timeout_s 0.005000 s is shorter than the 0.007500 s the N3 sees between commands");
   doc = default_doc();
   doc["n3"]["latency_s"] = 0.5;
   doc["n3"]["timeout_s"] = 0.1;
-  expect_scenario_error(doc, "n3.latency_s 0.500000 s is not below n3.timeout_s 0.100000 s");
+  expect_scenario_error(doc, "n3.latency_s 0.500000 s is above n3.timeout_s 0.100000 s");
   doc = default_doc();
   doc["seed"] = 18446744073709551616.0;
   expect_scenario_error(doc, "seed: must be an integer in [0, 2^64 - 1], got 1.8446744073709552e+19");

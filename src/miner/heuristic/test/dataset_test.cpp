@@ -138,7 +138,8 @@ TEST_CASE("Boxes encode in work bounded by the cells they meet without holding, 
                     Catch::Contains("400 obstacles") && Catch::Contains("more than the bound 134217728"));
 }
 
-TEST_CASE("The exact cover test is bounded: past kMaxCoverTests it answers unproven (partial)", "[REQ-HEUR-012]") {
+TEST_CASE("The exact cover test is bounded per cell and per encoding: past its budget it answers unproven (partial)",
+          "[REQ-HEUR-012]") {
   using miner::world::Box;
   const Box cell{{0, 0, 0}, {1, 1, 1}};
   // One box holds the cell; n small boxes with their own faces inside it cut it into
@@ -151,6 +152,14 @@ TEST_CASE("The exact cover test is bounded: past kMaxCoverTests it answers unpro
   };
   CHECK(miner::heuristic::box_covered(cell, boxes(10)));        // 21^3 x 11: proven
   CHECK_FALSE(miner::heuristic::box_covered(cell, boxes(39)));  // 79^3 x 40 > 2^24: unproven
+  // An encoding's budget over all its cells: the tests are taken from it while it lasts
+  // (21^3 x 11 = 101 871 per call here), then cells stay unproven.
+  std::uint64_t budget = 250000;
+  CHECK(miner::heuristic::box_covered(cell, boxes(10), &budget));
+  CHECK(budget == 250000 - 101871);
+  CHECK(miner::heuristic::box_covered(cell, boxes(10), &budget));
+  CHECK_FALSE(miner::heuristic::box_covered(cell, boxes(10), &budget));
+  CHECK(budget == 250000 - 2 * 101871);
 }
 
 TEST_CASE("Regions connect through faces, edges and corners only", "[REQ-HEUR-004]") {

@@ -13,6 +13,7 @@
 
 #include "miner/core/error.hpp"
 #include "miner/core/rng.hpp"
+#include "miner/core/text.hpp"
 #include "miner/traj/baselines.hpp"
 #include "miner/traj/minco.hpp"
 #include "miner/traj/trapezoidal_allocation.hpp"
@@ -185,11 +186,10 @@ void print_table(const std::vector<BackendRecord>& records, std::ostream& out) {
     rows[{r.order, r.segments}][r.method] = &r;
   }
   out << "microseconds per solve (median), ratio to MINCO in brackets\n";
-  out << std::left << std::setw(6) << "s" << std::setw(7) << "M";
-  for (const auto& m : methods) out << std::setw(24) << m;
-  out << "\n";
+  std::vector<std::vector<std::string>> table{{"s", "M"}};
+  for (const auto& m : methods) table.front().push_back(m);
   for (const auto& [key, by_method] : rows) {
-    out << std::left << std::setw(6) << key.first << std::setw(7) << key.second;
+    std::vector<std::string> line{std::to_string(key.first), std::to_string(key.second)};
     for (const auto& m : methods) {
       std::ostringstream cell;
       const auto it = by_method.find(m);
@@ -200,10 +200,11 @@ void print_table(const std::vector<BackendRecord>& records, std::ostream& out) {
         if (m != "minco" && !std::isnan(it->second->ratio_to_minco))
           cell << " (" << std::setprecision(1) << it->second->ratio_to_minco << "x)";
       }
-      out << std::setw(24) << cell.str();
+      line.push_back(cell.str());
     }
-    out << "\n";
+    table.push_back(std::move(line));
   }
+  out << aligned_columns(table);
 }
 
 }  // namespace miner::bench

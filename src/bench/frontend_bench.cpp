@@ -361,6 +361,9 @@ void check_run_record(const JsonField& r, double lower_bound) {
   check_count(r.at("iterations"));
   if (!r.at("solved").value().is_boolean()) r.at("solved").fail("expected true or false");
   const bool solved = r.at("solved").value().get<bool>();
+  // A solved run's cost is a number, named as the field when it is not (issue 20, sixth
+  // campaign U13: "malformed run record: type must be number, but is string").
+  if (solved) (void)r.at("cost").number();
   if (!solved)
     for (const char* k : {"cost", "first", "target"})
       if (!r.at(k).value().is_null()) r.at(k).fail("an unsolved run has no " + std::string(k));
@@ -517,18 +520,9 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
   std::vector<nlohmann::json> tags;
   for (std::size_t p = 0; p < parts.size(); ++p) {
     const nlohmann::json mine = settings(parts[p]);
-    if (mine != common) {
-      // Name the first setting that differs, with both values.
-      std::string key;
-      for (const auto& [k, v] : common.items())
-        if (!mine.contains(k) || mine.at(k) != v) { key = k; break; }
-      if (key.empty())
-        for (const auto& [k, v] : mine.items())
-          if (!common.contains(k)) { key = k; break; }
-      throw Error("merge: " + names[p] + " and " + names.front() + " are different campaigns: \"" + key + "\" is " +
-                  (mine.contains(key) ? mine.at(key).dump() : std::string("absent")) + " in the one and " +
-                  (common.contains(key) ? common.at(key).dump() : std::string("absent")) + " in the other");
-    }
+    // Name the first setting that differs, with both values.
+    if (const std::string d = first_difference(mine, common); !d.empty())
+      throw Error("merge: " + names[p] + " and " + names.front() + " are different campaigns: " + d);
     // The planner list is per-shard JSON (its summaries), so its names are compared on their own:
     // a part of other --planners is another campaign, not an incomplete one (fifth campaign).
     const auto planner_names = [](const nlohmann::json& part) {

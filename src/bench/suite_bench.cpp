@@ -13,8 +13,10 @@
 #include "bench/ompl_planners.hpp"
 #include "miner/core/error.hpp"
 #include "miner/core/json_io.hpp"
+#include "miner/core/sha256.hpp"
 #include "miner/report/svg_plot.hpp"
 #include "miner/world/map.hpp"
+#include "miner/world/voxel_layer.hpp"
 
 namespace miner::bench {
 
@@ -271,6 +273,24 @@ bool in_paper_band(const SuiteCell& cell, const SuiteDefinition& suite) {
          s->first_iterations <= suite.band_hi;
 }
 
+/// What a generated map is, for telling two entries' maps apart: its JSON, with voxels made in
+/// memory (the `scan` preset, which has no file to reference) standing as their grid and the
+/// SHA-256 of their cell states (issue 20, sixth campaign U15: to_json() refused them mid-run with
+/// an internal message).
+namespace {
+Json map_fingerprint(const world::Map& map) {
+  const auto& source = map.voxel_source();
+  if (!source || !source->file.empty()) return map.to_json();
+  Json doc = world::Map(map.bounds(), map.resolution(), map.obstacles(), map.query()).to_json();
+  const world::VoxelLayer& layer = *source->layer;
+  doc["voxels"] = {{"origin_cells", {layer.origin_cells().x(), layer.origin_cells().y(), layer.origin_cells().z()}},
+                   {"dims", {layer.dims().x(), layer.dims().y(), layer.dims().z()}},
+                   {"states_sha256", sha256_hex(std::string(layer.states().begin(), layer.states().end()))},
+                   {"unknown", world::to_string(source->unknown)}};
+  return doc;
+}
+}  // namespace
+
 SuiteBenchResult run_suite_bench(const SuiteBenchOptions& o, const std::string& command, std::ostream* progress) {
   if (o.suite.maps.empty() || o.suite.step_fractions.empty()) throw Error("bench suite: the suite has no map or no step");
   if (o.runs < 1) throw Error("bench suite: --runs must be >= 1");
@@ -295,7 +315,7 @@ SuiteBenchResult run_suite_bench(const SuiteBenchOptions& o, const std::string& 
     } catch (const Error& e) {
       throw Error(entry(i) + ": " + e.what(), e.code());  // "no solvable map" stays exit 3, as in map gen
     }
-    generated.push_back(maps.back().to_json());
+    generated.push_back(map_fingerprint(maps.back()));
   }
   // Two entries that generate one map (names aside) would run its campaign twice and count
   // it twice in every summary.

@@ -333,13 +333,26 @@ namespace {
 /// would free the option structs they own while CLI11 still writes into them.)
 struct ParsedOnly {};
 
-/// Every integer option of `app` and its subcommands reads decimal digits only (kDecimalInteger).
-void decimal_integers(CLI::App* app) {
+/// A real option written as a negative zero ("-0", "-0.0e3") reads as 0: "robot radius -0 m" and
+/// a JSON -0.0 are no one's intent (issue 20, sixth campaign U6). Other text passes unchanged to
+/// the option's own checks.
+const CLI::Validator kUnsignedZero(
+    [](std::string& text) -> std::string {
+      double v = 0.0;
+      if (!text.empty() && text[0] == '-' && read_finite_decimal(text, v) && v == 0.0) text.erase(0, 1);
+      return {};
+    },
+    "");
+
+/// Every integer option of `app` and its subcommands reads decimal digits only (kDecimalInteger);
+/// every real option reads a negative zero as 0 (kUnsignedZero).
+void decimal_numbers(CLI::App* app) {
   for (CLI::Option* o : app->get_options()) {
     const std::string type = o->get_type_name();
     if (type.rfind("INT", 0) == 0 || type.rfind("UINT", 0) == 0) o->transform(kDecimalInteger);  // first, may edit
+    if (type.rfind("FLOAT", 0) == 0) o->transform(kUnsignedZero);
   }
-  for (CLI::App* sub : app->get_subcommands([](CLI::App*) { return true; })) decimal_integers(sub);
+  for (CLI::App* sub : app->get_subcommands([](CLI::App*) { return true; })) decimal_numbers(sub);
 }
 
 /// The voxel file a map file (JSON) references (Map::voxel_file_path, as the map reads it); empty
@@ -526,7 +539,7 @@ void add_commands(CLI::App& app, std::ostream& out) {
       ->group("")
       ->callback([&out] { out << cli_reference_markdown(); });
   quiet_everywhere(&app);
-  decimal_integers(&app);
+  decimal_numbers(&app);
 }
 
 /// The command a line addresses and its path of command names from `app` ("miner plan").
@@ -634,7 +647,8 @@ std::vector<std::string> numeric_options_without_checks() {
       const bool integer = type.rfind("INT", 0) == 0 || type.rfind("UINT", 0) == 0;
       const bool real = type.rfind("FLOAT", 0) == 0;
       if (!integer && !real) continue;
-      // Integer options carry kDecimalInteger (added by decimal_integers): a range is a second check.
+      // Integer options carry kDecimalInteger and real ones kUnsignedZero (added by
+      // decimal_numbers): a range is a second check.
       int checks = 0;
       for (int k = 0;; ++k) {
         try {
@@ -644,7 +658,7 @@ std::vector<std::string> numeric_options_without_checks() {
           break;
         }
       }
-      if (checks < (integer ? 2 : 1)) unchecked.push_back(command_path(cmd) + " " + o->get_name());
+      if (checks < 2) unchecked.push_back(command_path(cmd) + " " + o->get_name());
     }
   }
   return unchecked;
@@ -763,7 +777,16 @@ int parse_line(CLI::App& app, const std::vector<std::string>& args, std::ostream
     out << e.what() << "\n";
     return 0;
   } catch (const CLI::ParseError& e) {
-    err << "miner: usage error: " << plain_usage_text(e.what()) << "\n";
+    // An option left without its value took the next option as it (`dataset --merge --out d`),
+    // and a requirement CLI11 checks before the parse completes then blamed the option taken:
+    // "--out is required" (issue 20, sixth campaign U11). The option without a value is the fault.
+    std::string text = e.what();
+    try {
+      check_no_option_as_value(&app);
+    } catch (const CLI::ParseError& first) {
+      text = first.what();
+    }
+    err << "miner: usage error: " << plain_usage_text(text) << "\n";
     err << "run 'miner --help' (or 'miner <command> --help') for usage\n";
     return static_cast<int>(ExitCode::kUsage);
   } catch (const Error& e) {

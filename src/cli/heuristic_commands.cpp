@@ -142,13 +142,31 @@ void add_heuristic_commands(CLI::App& app, std::ostream& out) {
     options.dims = Eigen::Vector3i(o->dims[0], o->dims[1], o->dims[2]);
     const Json doc = heuristic::write_dataset(options, o->out, progress_stream());
     const Json& s = doc["splits"];
+    // A part holds only its shards' samples: the summary counts those, beside the dataset's
+    // (issue 20, sixth campaign U12: a part that held none said "4 train, 0 val, 2 test").
+    const auto here = [&](const char* split) {
+      long long n = 0;
+      for (const Json& shard : s[split]["shards"]) n += shard["count"].get<long long>();
+      return n;
+    };
     if (o->json) {
-      out << dump_json({{"out", o->out}, {"train", s["train"]["count"]}, {"val", s["val"]["count"]},
-                        {"test", s["test"]["count"]}, {"dims", o->dims}});
+      Json summary = {{"out", o->out}, {"train", s["train"]["count"]}, {"val", s["val"]["count"]},
+                      {"test", s["test"]["count"]}, {"dims", o->dims}};
+      if (doc.contains("part"))
+        summary["part"] = {{"index", doc["part"]["index"]}, {"count", doc["part"]["count"]},
+                           {"train", here("train")}, {"val", here("val")}, {"test", here("test")}};
+      out << dump_json(summary);
       return;
     }
-    out << "wrote " << o->out << ": " << s["train"]["count"] << " train, " << s["val"]["count"] << " val, "
-        << s["test"]["count"] << " test samples of " << heuristic::kDatasetChannels << " x " << o->dims[0] << "x" << o->dims[1] << "x" << o->dims[2]
+    out << "wrote " << o->out;
+    if (doc.contains("part"))
+      out << ": part " << doc["part"]["index"] << " of " << doc["part"]["count"] << ", holding " << here("train")
+          << " train, " << here("val") << " val, " << here("test") << " test samples (of the dataset's "
+          << s["train"]["count"] << ", " << s["val"]["count"] << ", " << s["test"]["count"] << ")";
+    else
+      out << ": " << s["train"]["count"] << " train, " << s["val"]["count"] << " val, " << s["test"]["count"]
+          << " test samples";
+    out << " of " << heuristic::kDatasetChannels << " x " << o->dims[0] << "x" << o->dims[1] << "x" << o->dims[2]
         << " (dataset.json describes the layout)\n";
   });
 

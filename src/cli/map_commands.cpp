@@ -94,13 +94,18 @@ void run_gen(const GenOptions& o, std::ostream& out) {
   const Map map = world::generate_map(preset, o.seed, overrides);
   map.save(o.out);
   const Eigen::Vector3d e = map.bounds().extent();
+  // An OctoMap holds voxels only: the generated query is not in a .bt, and the summary says so
+  // (issue 20, sixth campaign U16: a query lost without a word).
+  const bool query_kept = !ends_with(o.out, ".bt");
   if (o.json) {
     out << dump_json({{"out", o.out}, {"preset", o.preset}, {"seed", o.seed}, {"extent_m", vec3_json(e)},
-                      {"resolution_m", map.resolution()}, {"obstacles", map.obstacles().size()}});
+                      {"resolution_m", map.resolution()}, {"obstacles", map.obstacles().size()},
+                      {"query_kept", query_kept}});
     return;
   }
   out << "wrote " << o.out << ": preset " << o.preset << ", seed " << o.seed << ", " << e.x() << " x " << e.y()
-      << " x " << e.z() << " m at " << map.resolution() << " m, " << map.obstacles().size() << " obstacles\n";
+      << " x " << e.z() << " m at " << map.resolution() << " m, " << map.obstacles().size() << " obstacles"
+      << (query_kept ? "" : "; no query (an OctoMap holds voxels only: write .json to keep it)") << "\n";
 }
 
 struct InfoOptions {
@@ -182,16 +187,29 @@ void run_info(const InfoOptions& o, std::ostream& out) {
 struct ConvertOptions {
   std::string in, out;
   bool json = false;
+  bool drop_query = false;
 };
 
 void run_convert(const ConvertOptions& o, std::ostream& out) {
   const Map map = Map::load(o.in);
-  map.save(o.out);
+  // An OctoMap holds voxels only: a query would be lost without a word (issue 20, sixth campaign
+  // U16: `astar` on the .bt then said "has no query"). Said and refused unless asked for.
+  const bool to_octomap = ends_with(o.out, ".bt");
+  if (to_octomap && map.query() && !o.drop_query)
+    throw Error(o.in + ": query: " + o.out + " is an OctoMap, which holds voxels only, so the map's query (start, " +
+                    "goal, robot radius) would be lost; pass --drop-query to convert without it, or write .json",
+                ExitCode::kUsage);
+  try {
+    map.save(o.out);
+  } catch (const Error& e) {
+    throw Error(o.in + ": " + e.what(), e.code());  // the map's fault, named by its file
+  }
   std::ostringstream human;
   human << "wrote " << o.out << " (" << map.obstacles().size() << " obstacles";
   if (map.voxels()) human << ", " << map.voxels()->layer().count(world::VoxelState::kOccupied) << " occupied voxels";
-  human << " from " << o.in << ")\n";
-  Json doc{{"in", o.in}, {"out", o.out}, {"obstacles", map.obstacles().size()}};
+  human << " from " << o.in << (to_octomap && map.query() ? "; its query was dropped, as asked" : "") << ")\n";
+  Json doc{{"in", o.in}, {"out", o.out}, {"obstacles", map.obstacles().size()},
+           {"query_dropped", to_octomap && map.query().has_value()}};
   if (map.voxels()) doc["occupied_voxels"] = map.voxels()->layer().count(world::VoxelState::kOccupied);
   report(o.json, doc, human.str(), out);
 }
@@ -383,6 +401,8 @@ void add_map_commands(CLI::App& app, std::ostream& out) {
   c->add_option("--in", conv->in, "input map (.json, .bt or .ot)")->required();
   c->add_option("--out", conv->out, "output map (.json or .bt)")->required()->check(kOutputFile & kMapOutput);
   c->add_flag("--json", conv->json, "print the summary as JSON");
+  c->add_flag("--drop-query", conv->drop_query,
+              "writing .bt: convert a map that has a query (an OctoMap cannot hold it) without it");
   c->callback([conv, &out] { run_convert(*conv, out); });
 
   auto scan = std::make_shared<ScanCliOptions>();

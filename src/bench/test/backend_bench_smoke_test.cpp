@@ -52,3 +52,21 @@ TEST_CASE("bench backend prints a Table II style table and refuses bad options",
   bad.budget_s = 0;
   CHECK_THROWS_WITH(miner::bench::run_backend_bench(bad), Contains("must be positive"));
 }
+
+TEST_CASE("The backend table keeps every column apart however wide its values", "[REQ-TRAJ-009]") {
+  // Issue 20, sixth campaign U14: M = 1000000 and 209888 us read "1000000209888" at a fixed width.
+  miner::bench::BackendRecord big;
+  big.method = "minco";
+  big.order = 4;
+  big.segments = 1000000;
+  big.us_per_solve = 209888.0;
+  miner::bench::BackendRecord dense = big;
+  dense.method = "dense-lu-with-a-long-name";
+  dense.us_per_solve = 123456789.0;
+  dense.ratio_to_minco = 588.2;
+  std::ostringstream out;
+  miner::bench::print_table({big, dense}, out);
+  INFO(out.str());
+  CHECK_THAT(out.str(), Contains("4  1000000  209888  123456789 (588.2x)"));
+  CHECK_THAT(out.str(), Contains("s  M        minco   dense-lu-with-a-long-name"));
+}

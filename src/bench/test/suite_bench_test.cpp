@@ -175,6 +175,26 @@ TEST_CASE("A suite map that cannot be generated is refused before any campaign",
   CHECK_THROWS_WITH(run_suite_bench(o, "test", nullptr), Contains("maps[0] (\"bad\"): size:"));
 }
 
+TEST_CASE("A suite map of voxels made in memory (the scan preset) is benchmarked like any other", "[REQ-REPORT-008]") {
+  // Issue 20, sixth campaign U15: a `scan` entry failed mid-run with "map: its voxels were made
+  // in memory and have no file to reference" (telling entries apart wrote the map's JSON).
+  using namespace miner::bench;
+  auto suite = load_suite(write_suite("scan.json", R"({"format": "miner-bench-suite-v1", "steps": [0.1],
+    "band": [1, 1000000], "maps": [{"name": "a", "preset": "scan", "seed": 13, "size": [10, 8, 3], "resolution": 0.25},
+                                   {"name": "b", "preset": "scan", "seed": 14, "size": [10, 8, 3], "resolution": 0.25}]})"));
+  auto o = tiny_options(suite);
+  o.planners = {"rrtstar"};
+  o.runs = 1;
+  const auto r = run_suite_bench(o, "test", nullptr);
+  REQUIRE(r.cells.size() == 2);
+  CHECK(r.cells[0].preset == "scan");
+  // The same recipe twice is still one map benchmarked twice: refused.
+  suite.maps[1] = suite.maps[0];
+  suite.maps[1].name = "again";
+  o.suite = suite;
+  CHECK_THROWS_WITH(run_suite_bench(o, "test", nullptr), Contains("maps[1] (\"again\") generates the same map as"));
+}
+
 TEST_CASE("The Mann-Whitney test of the headlines matches the textbook values", "[REQ-REPORT-008]") {
   using miner::bench::mann_whitney_p;
   const double inf = std::numeric_limits<double>::infinity();

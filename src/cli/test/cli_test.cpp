@@ -1,6 +1,7 @@
 #include <catch2/catch.hpp>
 #include <CLI/CLI.hpp>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <functional>
@@ -207,6 +208,37 @@ TEST_CASE("map convert goes to OctoMap and back", "[REQ-CLI-001][REQ-WORLD-003]"
   CHECK_THAT(ot.err, Contains("writes OctoMaps as .bt only"));
   CHECK_FALSE(std::filesystem::exists(dir() + "/pillar.ot"));
   CHECK(miner_cli({"map", "gen", "--preset", "indoor", "--out", dir() + "/gen.ot"}).code == 2);
+}
+
+TEST_CASE("map convert to .bt neither loses a query silently nor blames its output for the map", "[REQ-CLI-001][REQ-WORLD-003]") {
+  // Issue 20, sixth campaign U16: the query was dropped without a word; U17: off-lattice bounds
+  // were reported against the output path.
+  const std::string with_query = write("conv-query.json", R"({"format": "miner-map-v1",
+    "bounds": {"min": [0,0,0], "max": [10,10,10]}, "resolution": 1.0,
+    "obstacles": [{"type": "box", "min": [4,4,0], "max": [6,6,10]}],
+    "query": {"start": [1,5,5], "goal": [9,5,5], "robot_radius": 0.2}})");
+  const std::string bt = dir() + "/conv-query.bt";
+  std::filesystem::remove(bt);
+  const Run lost = miner_cli({"map", "convert", "--in", with_query, "--out", bt});
+  CHECK(lost.code == 2);
+  CHECK_THAT(lost.err, Contains(with_query + ": query: " + bt + " is an OctoMap") && Contains("--drop-query"));
+  CHECK_FALSE(std::filesystem::exists(bt));
+  const Run dropped = miner_cli({"map", "convert", "--in", with_query, "--out", bt, "--drop-query", "--json"});
+  REQUIRE(dropped.code == 0);
+  CHECK(miner::parse_json(dropped.out, "stdout")["query_dropped"] == true);
+  // To JSON the query is kept, and no flag is needed.
+  REQUIRE(miner_cli({"map", "convert", "--in", with_query, "--out", dir() + "/conv-query-copy.json"}).code == 0);
+  CHECK(miner::read_json_file(dir() + "/conv-query-copy.json").contains("query"));
+  // A generated map written as .bt says that its query is not in it.
+  const Run gen = miner_cli({"map", "gen", "--preset", "indoor", "--out", dir() + "/gen-q.bt", "--quiet"});
+  REQUIRE(gen.code == 0);
+  CHECK_THAT(gen.out, Contains("no query (an OctoMap holds voxels only"));
+  // Bounds off the resolution's lattice are the input map's fault.
+  const std::string offgrid = write("conv-offgrid.json", R"({"format": "miner-map-v1",
+    "bounds": {"min": [0,0,0], "max": [4,4,3]}, "resolution": 0.3, "obstacles": []})");
+  const Run off = miner_cli({"map", "convert", "--in", offgrid, "--out", dir() + "/conv-offgrid.bt"});
+  CHECK(off.code == 1);
+  CHECK_THAT(off.err, Contains("error: " + offgrid + ": bounds: (0, 0, 0) - (4, 4, 3) are not whole multiples"));
 }
 
 TEST_CASE("Bad input: each case names what is wrong and exits non-zero", "[REQ-CLI-002][REQ-WORLD-002][REQ-WORLD-010]") {
@@ -420,6 +452,16 @@ TEST_CASE("Fifth campaign: empty shards, coinciding ends, far clouds and shard p
   const Run measured = miner_cli({"bench", "heuristic", "--data", part, "--split", "test", "--no-planners"});
   CHECK(measured.code == 1);
   CHECK_THAT(measured.err, Contains("is a part of a sharded dataset") && Contains("dataset --merge"));
+  // bench paper says the same (sixth campaign U19: "split 'test' has only 0 samples").
+  const Run paper = miner_cli({"bench", "paper", "--heuristic-data", part, "--heuristic-samples", "1", "--out",
+                               dir() + "/part-paper.md"});
+  CHECK(paper.code == 1);
+  CHECK_THAT(paper.err, Contains(part + ": is a part of a sharded dataset") && Contains("dataset --merge"));
+  // And `dataset` itself says which samples a part holds (U12).
+  const Run part_summary = miner_cli({"dataset", "--preset", "indoor", "--count", "4", "--test-count", "2", "--shard-size",
+                                      "1", "--shard", "1/2", "--out", dir() + "/part-5th-b"});
+  REQUIRE(part_summary.code == 0);
+  CHECK_THAT(part_summary.out, Contains(": part 1 of 2, holding 2 train, 0 val, 1 test samples (of the dataset's 4, 0, 2)"));
 }
 
 TEST_CASE("A report's Generated-by line is the command line that reproduces it", "[REQ-CLI-003]") {
@@ -795,12 +837,40 @@ TEST_CASE("Integer options are decimal: no octal, hex, sign or exponent", "[REQ-
   INFO(ten.err);
   REQUIRE(ten.code == 0);
   CHECK(miner::read_json_file(out)["dims"][0] == 10);
-  for (const char* bad : {"0x8", "+8", "8e0", " 8", "8 ", "", "-", "0b11"}) {
+  for (const char* bad : {"0x8", "+8", "8e0", " 8", "8 ", "-", "0b11"}) {
     const Run r = region(bad);
     INFO(bad);
     CHECK(r.code == 2);
     CHECK_THAT(r.err, Contains("--dims: must be a decimal integer, got"));
   }
+  const Run empty = region("");
+  CHECK(empty.code == 2);
+  CHECK_THAT(empty.err, Contains("--dims: needs a value, got an empty one"));
+}
+
+TEST_CASE("An option left without its value is named, not the option it swallowed", "[REQ-CLI-002]") {
+  // Issue 20, sixth campaign U11: `dataset --merge --out d` said "--out is required".
+  const Run r = miner_cli({"dataset", "--merge", "--out", dir() + "/merge-no-parts"});
+  CHECK(r.code == 2);
+  CHECK_THAT(r.err, Contains("--merge: needs a value, got the option --out") && !Contains("is required"));
+}
+
+TEST_CASE("A real option written as negative zero reads as 0", "[REQ-CLI-002]") {
+  // Issue 20, sixth campaign U6: --radius -0 printed "robot radius -0 m" and "robot_radius": -0.0.
+  const std::string map = write("pillar-zero.json", kPillarMap);
+  for (const char* zero : {"-0", "-0.0", "-0e5"}) {
+    const Run r = miner_cli({"astar", "--map", map, "--start", zero, "5", "5", "--goal", "9", "5", "5", "--radius", zero,
+                             "--json"});
+    INFO(zero << ": " << r.err);
+    REQUIRE(r.code == 0);
+    const auto doc = miner::parse_json(r.out, "stdout");
+    CHECK_FALSE(std::signbit(doc["robot_radius"].get<double>()));
+    CHECK_FALSE(std::signbit(doc["start"][0].get<double>()));
+  }
+  // Other negative numbers keep their sign, and their checks.
+  const Run neg = miner_cli({"astar", "--map", map, "--radius", "-0.1"});
+  CHECK(neg.code == 2);
+  CHECK_THAT(neg.err, Contains("--radius") && Contains("-0.1"));
 }
 
 TEST_CASE("The argument layer alone: refusals as run_cli gives them, and no command run", "[REQ-CLI-002][REQ-HARNESS-006]") {
@@ -1233,6 +1303,9 @@ TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[RE
     doctor([&](miner::Json& d) { solved(d)["cost"] = 0.5 * d["lower_bound"].get<double>(); }, "below the campaign's lower bound");
     doctor([&](miner::Json& d) { auto& r = solved(d); r["cost"] = 2.0 * r["first"]["cost"].get<double>(); }, "costs only fall");
     doctor([&](miner::Json& d) { solved(d)["iterations"] = 1e9; }, "more than the campaign's budget");
+    // Sixth campaign U13: a solved run's cost of another type named no field.
+    doctor([&](miner::Json& d) { solved(d)["cost"] = "NaN"; }, ".cost: expected a number");
+    doctor([&](miner::Json& d) { solved(d)["cost"] = nullptr; }, ".cost: expected a number");
     // Third campaign: counts that wrap or are not whole, times below zero or absurd, a stage after
     // the run's end, an unsolved run with a cost, unknown keys in the summaries and throughput.
     doctor([&](miner::Json& d) { solved(d)["first"]["nodes"] = -3; }, "first.nodes: expected null or an integer >= 0");
@@ -1249,7 +1322,7 @@ TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[RE
     doctor([](miner::Json& d) { d["planners"][0]["foo"] = 1; }, "planners[0]");
     doctor([](miner::Json& d) { d["foo"] = 1; }, "foo: unknown key");
     doctor([](miner::Json& d) { d["sed"] = d["seed"]; d.erase("seed"); }, "did you mean \"seed\"");
-    doctor([](miner::Json& d) { d["steer_step"] = 123.0; }, "\"steer_step\" is 123.0 in the one");
+    doctor([](miner::Json& d) { d["steer_step"] = 123.0; }, "different campaigns: steer_step is 123.0 in the one");
     // Fourth campaign: the campaign's own costs contradicting each other.
     doctor([](miner::Json& d) { d["target_cost"] = 0.5 * d["lower_bound"].get<double>(); },
            "is not target_factor x reference_cost");

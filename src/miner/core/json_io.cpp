@@ -70,6 +70,10 @@ Json parse_json(const std::string& text, const std::string& origin) {
   constexpr int kMaxJsonDepth = 256;
   int depth = 0;
   bool in_string = false;
+  // The first number the JSON library would misread, kept until the parser has said whether the
+  // text is JSON at all: "hello 0-1" is not JSON at byte 0, whatever "0-1" is (sixth campaign).
+  std::string bad_number;
+  std::size_t bad_number_byte = 0;
   for (std::size_t i = 0; i < text.size(); ++i) {
     const char c = text[i];
     // JSON text holds no NUL byte (inside a string it is written \u0000): the JSON library
@@ -102,11 +106,17 @@ Json parse_json(const std::string& text, const std::string& origin) {
         ++end;
       }
       const std::string token = text.substr(i, end - i);
-      const double v = std::strtod(token.c_str(), nullptr);
-      if ((nonzero && std::fabs(v) < std::numeric_limits<double>::min()) || std::isinf(v))
-        throw Error(origin + ": the number " + token + " at byte " + std::to_string(i) + " is " +
-                    (std::isinf(v) ? "beyond the largest double" : "below the smallest normal double (2.2e-308)") +
-                    ": it would not be read as written");
+      char* parsed_end = nullptr;
+      const double v = std::strtod(token.c_str(), &parsed_end);
+      // Only a whole token that reads as a number is judged here; "0-1" is left to the parser.
+      const bool whole = parsed_end == token.c_str() + token.size();
+      if (whole && bad_number.empty() &&
+          ((nonzero && std::fabs(v) < std::numeric_limits<double>::min()) || std::isinf(v))) {
+        bad_number = "the number " + token + " at byte " + std::to_string(i) + " is " +
+                     (std::isinf(v) ? "beyond the largest double" : "below the smallest normal double (2.2e-308)") +
+                     ": it would not be read as written";
+        bad_number_byte = i;
+      }
       i = end - 1;
     }
   }
@@ -151,13 +161,20 @@ Json parse_json(const std::string& text, const std::string& origin) {
     }
     return true;
   };
+  Json doc;
   try {
-    return Json::parse(text, no_duplicates);
+    doc = Json::parse(text, no_duplicates);
   } catch (const Json::parse_error& e) {
+    // The library counts bytes from 1 at the byte it stopped on; a misread number before it is
+    // the first fault.
+    if (!bad_number.empty() && bad_number_byte + 1 < e.byte) throw Error(origin + ": " + bad_number);
     throw Error(origin + ": malformed JSON at byte " + std::to_string(e.byte) + ": " + json_error_text(e));
   } catch (const Json::exception& e) {  // e.g. out_of_range.406: a number like 1e999
+    if (!bad_number.empty()) throw Error(origin + ": " + bad_number);
     throw Error(origin + ": invalid JSON: " + json_error_text(e));
   }
+  if (!bad_number.empty()) throw Error(origin + ": " + bad_number);
+  return doc;
 }
 
 namespace {
@@ -180,6 +197,28 @@ JsonField JsonField::at(const std::string& key) const {
   if (it == value_->end()) throw Error(origin_ + ": " + child + ": missing required field");
   return JsonField(*it, child, origin_);
 }
+
+namespace {
+std::string difference_at(const Json& one, const Json& other, const std::string& path) {
+  if (one == other) return {};
+  const auto child = [&](const std::string& key) { return path.empty() ? key : path + "." + key; };
+  if (one.is_object() && other.is_object()) {
+    for (const auto& [key, value] : one.items()) {
+      if (!other.contains(key)) return child(key) + " is " + value.dump() + " in the one and absent in the other";
+      if (std::string d = difference_at(value, other.at(key), child(key)); !d.empty()) return d;
+    }
+    for (const auto& [key, value] : other.items())
+      if (!one.contains(key)) return child(key) + " is absent in the one and " + value.dump() + " in the other";
+  }
+  if (one.is_array() && other.is_array() && one.size() == other.size())
+    for (std::size_t i = 0; i < one.size(); ++i)
+      if (std::string d = difference_at(one[i], other[i], path + "[" + std::to_string(i) + "]"); !d.empty()) return d;
+  return (path.empty() ? std::string("the document") : path) + " is " + one.dump() + " in the one and " + other.dump() +
+         " in the other";
+}
+}  // namespace
+
+std::string first_difference(const Json& one, const Json& other) { return difference_at(one, other, ""); }
 
 std::size_t edit_distance(const std::string& a, const std::string& b) {
   std::vector<std::size_t> row(b.size() + 1);

@@ -99,6 +99,12 @@ std::size_t edit_distance(const std::string& a, const std::string& b);
 /// mean" of unknown keys, commands and options.
 std::string nearest_name(const std::string& word, const std::vector<std::string>& candidates);
 
+/// Where two documents first differ, as "field is A in the one and B in the other" with the
+/// dotted path of the first differing value (objects compared key by key in order, arrays
+/// element by element, "absent" for a missing key); empty when they are equal. How a merge
+/// names the setting two parts disagree on.
+std::string first_difference(const Json& one, const Json& other);
+
 /// [x, y, z] as a JSON array: what JsonField::vec3 reads back.
 Json vec3_json(const Eigen::Vector3d& v);
 

@@ -1,6 +1,7 @@
 #include "miner/flight/dynamics.hpp"
 
 #include <cmath>
+#include <sstream>
 #include <string>
 
 #include <cvode/cvode.h>
@@ -157,6 +158,10 @@ Integrator::Integrator(const VehicleParams& vehicle, IntegratorOptions options)
   m.check(CVodeSVtolerances(m.cvode, options.relative_tolerance, m.abstol), "CVodeSVtolerances");
   m.check(CVodeSetUserData(m.cvode, &m), "CVodeSetUserData");
   m.check(CVodeSetMaxNumSteps(m.cvode, options.max_steps_per_tick), "CVodeSetMaxNumSteps");
+  // CVODE's own report goes to stderr in its words ("[CVODE ERROR] CVode ... mxstep"); a failure
+  // is thrown below with the time and the cause in this program's words instead.
+  m.check(CVodeSetErrHandlerFn(m.cvode, [](int, const char*, const char*, char*, void*) {}, nullptr),
+          "CVodeSetErrHandlerFn");
   m.nls = SUNNonlinSol_FixedPoint(m.y, 0, m.context);
   m.check(CVodeSetNonlinearSolver(m.cvode, m.nls), "CVodeSetNonlinearSolver");
 }
@@ -177,7 +182,16 @@ void Integrator::advance(QuadState& state, double t0, double t1, const Eigen::Ve
   m.check(CVodeReInit(m.cvode, t0, m.y), "CVodeReInit");
   m.check(CVodeSetStopTime(m.cvode, t1), "CVodeSetStopTime");
   realtype t_reached = t0;
-  m.check(CVode(m.cvode, t1, m.y, &t_reached, CV_NORMAL), "CVode");
+  const int flag = CVode(m.cvode, t1, m.y, &t_reached, CV_NORMAL);
+  if (flag == CV_TOO_MUCH_WORK || flag == CV_CONV_FAILURE || flag == CV_ERR_FAILURE) {
+    std::ostringstream os;
+    os << "the vehicle's dynamics could not be integrated over the N3 tick [" << t0 << ", " << t1 << "] s (CVODE "
+       << CVodeGetReturnFlagName(flag) << " at t = " << t_reached << " s): the plant is too stiff or diverging; check "
+       << "the vehicle's time constants (motor_time_constant_up_s/down_s >= " << kMinPlantTimeConstant
+       << " s) and the scenario's disturbances";
+    throw Error(os.str());
+  }
+  m.check(flag, "CVode");
   StateVector x = Eigen::Map<StateVector>(N_VGetArrayPointer(m.y));
   if (!x.allFinite()) throw Error("integrator: the state became non-finite at t = " + std::to_string(t1));
   state = unpack(x);

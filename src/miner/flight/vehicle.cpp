@@ -44,8 +44,16 @@ void validate(const VehicleParams& v, const std::string& origin) {
   positive(v.thrust_coefficient, "thrust_coefficient_N_per_rad_s2", 1.0);
   positive(v.torque_to_thrust_ratio, "torque_to_thrust_ratio_m", 1.0);
   positive(v.rotor_speed_max, "rotor_speed_max_rad_s", 1e5);
-  positive(v.motor_time_constant_up, "motor_time_constant_up_s", 1.0);
-  positive(v.motor_time_constant_down, "motor_time_constant_down_s", 1.0);
+  for (const auto& [tau, field] : {std::pair{v.motor_time_constant_up, "motor_time_constant_up_s"},
+                                   std::pair{v.motor_time_constant_down, "motor_time_constant_down_s"}})
+    if (!std::isfinite(tau) || !(tau >= kMinPlantTimeConstant) || tau > 1.0) {
+      char text[200];
+      std::snprintf(text, sizeof text,
+                    "must be a finite number in [%g, 1] s (real motors respond in 10-100 ms; shorter ones are "
+                    "too stiff for the integrator), got %g",
+                    kMinPlantTimeConstant, tau);
+      bad(origin, field, text);
+    }
   positive(v.radius, "radius_m", kMaxRobotRadius);
   for (int i = 0; i < 3; ++i) {
     if (!std::isfinite(v.linear_drag[i]) || v.linear_drag[i] < 0.0 || v.linear_drag[i] > 100.0)
@@ -61,6 +69,17 @@ void validate(const VehicleParams& v, const std::string& origin) {
     bad(origin, "rotor_drag_N_s_per_m_rad", "must be finite and in [0, 0.01]");
   if (!std::isfinite(v.quadratic_drag) || v.quadratic_drag < 0.0 || v.quadratic_drag > 100.0)
     bad(origin, "quadratic_drag_N_s2_per_m2", "must be finite and in [0, 100]");
+  // The drag's lag, mass over the linear coefficients at full rotor speed, is a plant time
+  // constant too: a 1 g vehicle with 100 N s/m of drag is as stiff as a 10 us motor.
+  const double linear_coefficient = v.linear_drag.maxCoeff() + 4.0 * v.rotor_drag * v.rotor_speed_max;
+  if (linear_coefficient > 0.0 && v.mass / linear_coefficient < kMinPlantTimeConstant) {
+    char text[240];
+    std::snprintf(text, sizeof text,
+                  "mass %g kg over the linear drag %g N s/m (at full rotor speed) is a lag of %g s, shorter than the "
+                  "%g s the integrator takes: a vehicle this light cannot carry this much drag",
+                  v.mass, linear_coefficient, v.mass / linear_coefficient, kMinPlantTimeConstant);
+    bad(origin, "linear_drag_N_s_per_m", text);
+  }
   if (!std::isfinite(v.rotor_speed_min) || v.rotor_speed_min < 0.0 ||
       v.rotor_speed_min >= v.rotor_speed_max)
     bad(origin, "rotor_speed_min_rad_s", "must satisfy 0 <= min < rotor_speed_max_rad_s");

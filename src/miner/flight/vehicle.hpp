@@ -22,6 +22,13 @@
 namespace miner::flight {
 
 inline constexpr const char* kVehicleFormat = "miner-vehicle-v1";
+
+/// The shortest time constant of the plant's lags a vehicle file may give, s: the motors' and
+/// the drag's (mass / drag coefficient). Real multirotor motors respond in 10-100 ms and drag
+/// acts over seconds; the non-stiff (Adams) integrator of REQ-FLIGHT-002 steps at most ~tau at a
+/// time, so a motor constant of 1e-9 s needed millions of steps per N3 tick and failed there
+/// (issue 20, sixth campaign U9). 1 ms keeps even a 0.5x model mismatch to a few steps per tick.
+inline constexpr double kMinPlantTimeConstant = 1e-3;
 /// Standard gravity used by the dynamics, the N3 and the estimator alike (m/s^2).
 using miner::kGravity;
 

@@ -93,7 +93,7 @@ Json write_dataset(const DatasetOptions& o, const std::string& dir, std::ostream
 Json merge_dataset_parts(const std::vector<std::string>& parts, const std::string& dir);
 
 /// The samples the folder holds of split `split`, from dataset.json alone (checked as read_split
-/// checks it; a part of a sharded dataset holds only its own shards' samples).
+/// checks it: a part of a sharded dataset is refused, naming `dataset --merge`).
 std::size_t split_samples_held(const std::string& dir, const std::string& split);
 
 /// Reads split `split` back: one Sample per record (metadata from the index).

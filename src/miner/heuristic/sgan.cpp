@@ -807,17 +807,32 @@ std::vector<double> reference_errors(const Sgan& sgan, const std::string& refere
   const TensorFile ref = read_tensor_file(reference_path, "sgan-reference");
   const Eigen::Vector3i d = sgan.architecture().dims;
   const std::vector<int> shape = {d.z(), d.y(), d.x()};
-  const JsonField samples = JsonField(ref.meta, "meta", reference_path).at("samples");
+  const JsonField meta(ref.meta, "meta", reference_path);
+  // The keys train.py and reference.py write; a misspelt one is refused, as in the weights' meta
+  // (issue 20, sixth campaign U7: "sampels" was ignored).
+  meta.only_keys({"samples", "weights"});
+  if (meta.has("weights")) (void)meta.at("weights").string();
+  const JsonField samples = meta.at("samples");
   if (samples.integer() < 1) samples.fail("must be >= 1");
+  // An input the network is given must be finite: a NaN there was reported as the weights and
+  // the reference not belonging together (sixth campaign U8). Named by tensor and element.
+  const auto finite_input = [&](const std::string& name, const std::vector<int>& tensor_shape) -> const std::vector<float>& {
+    const std::vector<float>& values = ref.at(name, tensor_shape).values;
+    for (std::size_t i = 0; i < values.size(); ++i)
+      if (!std::isfinite(values[i]))
+        throw Error(reference_path + ": " + name + "[" + std::to_string(i) + "]: is " + std::to_string(values[i]) +
+                    ": a reference's inputs are finite (the network was run on them)");
+    return values;
+  };
   std::vector<double> errors;
   for (int k = 0; k < samples.integer(); ++k) {
     const std::string p = std::to_string(k) + ".";
     const int sc = sgan.architecture().scale_channels;
     const int pc = sgan.architecture().passability_channels;
-    const auto out = sgan.forward(ref.at(p + "environment", shape).values, ref.at(p + "state", shape).values,
-                                  ref.at(p + "noise", shape).values,
-                                  sc ? ref.at(p + "scale", {sc}).values : std::vector<float>{},
-                                  pc ? ref.at(p + "passability", {pc, d.z(), d.y(), d.x()}).values : std::vector<float>{});
+    const auto out = sgan.forward(finite_input(p + "environment", shape), finite_input(p + "state", shape),
+                                  finite_input(p + "noise", shape),
+                                  sc ? finite_input(p + "scale", {sc}) : std::vector<float>{},
+                                  pc ? finite_input(p + "passability", {pc, d.z(), d.y(), d.x()}) : std::vector<float>{});
     const auto& want = ref.at(p + "output", shape).values;
     double worst = 0.0;
     for (std::size_t i = 0; i < out.size(); ++i) {

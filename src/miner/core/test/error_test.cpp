@@ -28,4 +28,17 @@ TEST_CASE("An error's message keeps the user's control bytes visible and whole",
   CHECK(std::string(e.what()) == "m.json: unknown obstacle type \"bo\\x00x\\x1b[2J\"");
   CHECK(miner::printable_text("line one\n\tline two\x7f") == "line one\n\tline two\\x7f");
   CHECK(miner::printable_text("caf\xc3\xa9") == "caf\xc3\xa9");  // UTF-8 stays as it is
+  CHECK(miner::printable_text("\xe2\x82\xac \xf0\x9f\x9a\x81") == "\xe2\x82\xac \xf0\x9f\x9a\x81");  // 3- and 4-byte forms
+}
+
+TEST_CASE("An error's message shows bytes that are not UTF-8 as hex escapes", "[REQ-CORE-002]") {
+  // Sixth campaign, U5: a .bt header line's raw 0xC0 0x95 went to the terminal.
+  CHECK(miner::printable_text("a\xc0\x95z") == "a\\xc0\\x95z");           // overlong lead byte
+  CHECK(miner::printable_text("\xff") == "\\xff");                          // never in UTF-8
+  CHECK(miner::printable_text("x\xc3") == "x\\xc3");                        // cut short at the end
+  CHECK(miner::printable_text("\xc3(") == "\\xc3(");                        // lead without continuation
+  CHECK(miner::printable_text("\xed\xa0\x80") == "\\xed\\xa0\\x80");      // a surrogate
+  CHECK(miner::printable_text("\xe0\x80\xaf") == "\\xe0\\x80\\xaf");      // overlong 3-byte
+  CHECK(miner::printable_text("\xf4\x90\x80\x80") == "\\xf4\\x90\\x80\\x80");  // above U+10FFFF
+  CHECK(miner::printable_text("\x80") == "\\x80");                          // a lone continuation byte
 }

@@ -91,6 +91,37 @@ TEST_CASE("A number the JSON library would not read as written is refused, namin
   CHECK(ok["k1e-400"] == "1e-400");  // inside strings nothing is a number
 }
 
+TEST_CASE("Text that is not JSON is called malformed where it stops being JSON", "[REQ-CORE-003]") {
+  // Sixth campaign, U3: "hello world 0-1" was blamed on "the number 0-1 ... below the smallest
+  // normal double"; the fault is at the first byte, and "0-1" is no number at all.
+  CHECK_THROWS_WITH(miner::parse_json("hello world 0-1\n", "t.json"), Contains("t.json: malformed JSON at byte 1"));
+  CHECK_THROWS_WITH(miner::parse_json("{\"a\": 0-1}", "t.json"), Contains("t.json: malformed JSON at byte"));
+  // A misread number before the first syntax fault is still the fault named.
+  CHECK_THROWS_WITH(miner::parse_json("[1e-400, x]", "t.json"), Contains("t.json: the number 1e-400 at byte 1"));
+  CHECK_THROWS_WITH(miner::parse_json("[1, x, 1e-400]", "t.json"), Contains("t.json: malformed JSON at byte 5"));
+}
+
+TEST_CASE("first_difference names the first differing value by its dotted path, with both values", "[REQ-CORE-003]") {
+  const Json a = Json::parse(R"({"seed": 1, "dims": [8, 8, 4], "o": {"k": "x", "m": true}})");
+  CHECK(miner::first_difference(a, a).empty());
+  Json b = a;
+  b["dims"][2] = 8;
+  CHECK(miner::first_difference(b, a) == "dims[2] is 8 in the one and 4 in the other");
+  b = a;
+  b["o"]["m"] = false;
+  CHECK(miner::first_difference(b, a) == "o.m is false in the one and true in the other");
+  b = a;
+  b["o"].erase("k");
+  CHECK(miner::first_difference(b, a) == "o.k is absent in the one and \"x\" in the other");
+  b = a;
+  b["new"] = 2;
+  CHECK(miner::first_difference(b, a) == "new is 2 in the one and absent in the other");
+  b = a;
+  b["dims"] = {8, 8};  // arrays of other lengths are named whole
+  CHECK(miner::first_difference(b, a) == "dims is [8,8] in the one and [8,8,4] in the other");
+  CHECK(miner::first_difference(Json(1), Json("1")) == "the document is 1 in the one and \"1\" in the other");
+}
+
 TEST_CASE("Field access names the dotted path and the type found", "[REQ-CORE-003]") {
   const Json doc = miner::parse_json(
       R"({"bounds": {"min": [0, "a", 2], "max": [1, 2]}, "r": -1, "n": 2.5, "s": 3})",

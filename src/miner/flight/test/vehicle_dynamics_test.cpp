@@ -62,6 +62,35 @@ TEST_CASE("Missing or non-physical vehicle parameters are refused naming the par
   expect_vehicle_error(doc, "unknown format tag");
 }
 
+TEST_CASE("Plant time constants shorter than the integrator can take are refused naming the field", "[REQ-FLIGHT-001]") {
+  // Issue 20, sixth campaign U9: a motor constant of 1e-9 s was accepted and failed in CVODE
+  // mid-flight ("mxstep steps taken"), naming neither the vehicle nor the field.
+  for (const char* field : {"motor_time_constant_up_s", "motor_time_constant_down_s"})
+    for (const double tau : {1e-9, 5e-4}) {
+      miner::Json doc = vehicle_doc();
+      doc[field] = tau;
+      expect_vehicle_error(doc, std::string("v.json: ") + field + ": must be a finite number in [0.001, 1] s");
+    }
+  miner::Json doc = vehicle_doc();
+  doc["motor_time_constant_up_s"] = flight::kMinPlantTimeConstant;  // the bound itself is accepted
+  CHECK_NOTHROW(flight::vehicle_from_json(doc, "v.json"));
+  // A light vehicle under heavy drag lags faster than 1 ms (mass 0.05 kg / 100 N s/m = 0.5 ms).
+  doc = vehicle_doc();
+  doc["mass_kg"] = 0.05;
+  doc["linear_drag_N_s_per_m"] = {100.0, 0.1, 0.1};
+  expect_vehicle_error(doc, "v.json: linear_drag_N_s_per_m: mass 0.05 kg over the linear drag 100 N s/m");
+}
+
+TEST_CASE("An integrator that runs out of steps says so in the program's words", "[REQ-FLIGHT-002]") {
+  const flight::VehicleParams v;
+  flight::Integrator integrator(v, flight::IntegratorOptions{1e-6, 2});  // two internal steps per tick
+  flight::QuadState s = flight::hover_state(v, {0, 0, 1}, 0.0);
+  const Eigen::Vector4d u = Eigen::Vector4d::Constant(v.rotor_speed_max);
+  CHECK_THROWS_WITH(integrator.advance(s, 0.0, 0.5, u),
+                    Contains("the vehicle's dynamics could not be integrated over the N3 tick [0, 0.5] s") &&
+                        Contains("CV_TOO_MUCH_WORK") && Contains("motor_time_constant_up_s"));
+}
+
 TEST_CASE("Hover is an equilibrium of the dynamics", "[REQ-FLIGHT-002]") {
   const flight::VehicleParams v;
   flight::Integrator integrator(v);

@@ -290,6 +290,22 @@ TEST_CASE("The dataset has its splits, unseen test seeds and the same bytes for 
   CHECK_THROWS_WITH(heuristic::read_split(a, "test"), Contains("test-00000.bin") && Contains("expected"));
 }
 
+TEST_CASE("A part that would hold no shard file is refused before any sample is drawn", "[REQ-REPORT-006]") {
+  // Issue 20, sixth campaign U12: --shard 5/6 of a dataset with 2 shard files per split wrote an
+  // empty part and said "4 train, 0 val, 2 test samples".
+  auto o = small_options();
+  o.dims = Eigen::Vector3i(8, 8, 4);
+  o.shard_count = 3;  // the training split has 2 files of 2 samples: part 2 gets none
+  o.shard_index = 2;
+  const std::string out = temp_dir() + "/empty-part";
+  std::filesystem::remove_all(out);
+  CHECK_THROWS_WITH(heuristic::write_dataset(o, out, nullptr),
+                    Contains("--shard 2/3: the largest split has 2 shard file(s)") && Contains("no sample"));
+  CHECK_FALSE(std::filesystem::exists(out));
+  o.shard_index = 1;  // the last part that holds a file is written
+  CHECK_NOTHROW(heuristic::write_dataset(o, out, nullptr));
+}
+
 TEST_CASE("A dataset folder that contradicts itself is refused naming the file and field",
           "[REQ-HEUR-001][REQ-REPORT-006]") {
   namespace fs = std::filesystem;
@@ -323,6 +339,12 @@ TEST_CASE("A dataset folder that contradicts itself is refused naming the file a
     CHECK_FALSE(fs::exists(out));
     return q0;
   };
+  // A part of other options is named by the option and both values (sixth campaign U21: "a part
+  // of a different dataset (options differ)").
+  refused([&](const std::string&, const std::string& q1) { edit_json(q1 + "/dataset.json", [](miner::Json& d) { d["dilation"] = 3; }); },
+          "a part of a different dataset than ");
+  refused([&](const std::string&, const std::string& q1) { edit_json(q1 + "/dataset.json", [](miner::Json& d) { d["dims"][2] = 8; }); },
+          ": dims[2] is 8 in the one and 4 in the other");
   // A shard name that leaves the folder: neither read nor written outside it.
   fs::copy_file(p0 + "/train-00000.bin", root + "/escape.bin");
   refused(

@@ -159,6 +159,37 @@ TEST_CASE("A reference whose outputs are not finite is refused, never agreed wit
                     Contains("0.output[17]") && Contains("not a finite comparison"));
 }
 
+TEST_CASE("A reference whose inputs are not finite is refused naming the tensor", "[REQ-HEUR-005]") {
+  // Issue 20, sixth campaign U8: a NaN input was blamed on the weights and the reference not
+  // belonging together, or on the outputs.
+  const std::string shipped = miner::read_file_bytes(kFixtures + "reference.bin");
+  const std::string path = (std::filesystem::temp_directory_path() / "miner_sgan_test_nan_input.bin").string();
+  for (const char* tensor : {"0.environment", "0.noise", "0.state"}) {
+    const std::string blob = with_tensor_edited(shipped, tensor, [](std::string& data, std::size_t offset, std::size_t) {
+      const float inf = std::numeric_limits<float>::infinity();
+      std::memcpy(&data[offset + 4 * 5], &inf, 4);  // element 5
+    });
+    miner::write_file_atomic(path, blob);
+    CHECK_THROWS_WITH(heuristic::reference_errors(heuristic::Sgan::builtin(), path),
+                      Contains(path + ": " + tensor + "[5]: is inf") && !Contains("belong"));
+  }
+}
+
+TEST_CASE("A reference's meta refuses an unknown key, suggesting the known one", "[REQ-HEUR-005]") {
+  // Issue 20, sixth campaign U7: "sampels" was ignored (the weights' meta refused such keys).
+  const std::string shipped = miner::read_file_bytes(kFixtures + "reference.bin");
+  const std::string path = (std::filesystem::temp_directory_path() / "miner_sgan_test_meta_key.bin").string();
+  miner::Json h = header_of(shipped);
+  h["meta"]["sampels"] = 2;
+  miner::write_file_atomic(path, with_header(shipped, h));
+  CHECK_THROWS_WITH(heuristic::reference_errors(heuristic::Sgan::builtin(), path),
+                    Contains("meta.sampels") && Contains("samples"));
+  h = header_of(shipped);
+  h["meta"]["weights"] = 7;
+  miner::write_file_atomic(path, with_header(shipped, h));
+  CHECK_THROWS_WITH(heuristic::reference_errors(heuristic::Sgan::builtin(), path), Contains("meta.weights"));
+}
+
 TEST_CASE("Weights that overflow a layer give an error naming the file, never a silently empty region",
           "[REQ-HEUR-006]") {
   // The shipped weights with enc1's kernel set to 3e38 (finite, so the reader accepts them) and

@@ -173,12 +173,23 @@ TEST_CASE("A tiny .bt whose two leaves lie far apart is refused by its grid size
   CHECK_THROWS_WITH(Map::load(path), Contains("far-leaves.bt: the known leaves span 640 x 640 x 640 voxels, more than the 6.71089e+07"));
 }
 
+TEST_CASE("A .bt whose voxels lie far from the origin is refused naming the file", "[REQ-WORLD-014][REQ-WORLD-002]") {
+  // Issue 20, sixth campaign U2: "bounds.min: ... lies farther than 1e+06 m" named no file.
+  octomap::OcTree tree(50.0);
+  tree.updateNode(octomap::point3d(-1500000.0f, 25.0f, 25.0f), true);
+  const std::string path = miner::world::test::temp_path("far-origin.bt");
+  tree.writeBinary(path);
+  CHECK_THROWS_WITH(Map::load(path), Contains("far-origin.bt: the map its voxels span: bounds.min: (") &&
+                                         Contains("lies farther than 1e+06 m from the origin"));
+}
+
 TEST_CASE("A map whose bounds are off its resolution's lattice is not written as a larger .bt", "[REQ-WORLD-003]") {
   // 4 m at 0.3 m is 13.33 cells: the .bt would cover 4.2 m (issue 20, fourth campaign).
   const std::string path = miner::world::test::temp_path("offlattice.bt");
   std::filesystem::remove(path);
   CHECK_THROWS_WITH(Map(Box{{0, 0, 0}, {4, 4, 3}}, 0.3, {}).save(path),
-                    Contains("offlattice.bt: the map's bounds") && Contains("not whole multiples of its resolution 0.3 m along x"));
+                    Contains("bounds: (0, 0, 0) - (4, 4, 3) are not whole multiples of the resolution 0.3 m along x") &&
+                        Contains("so " + path + " would cover more than the map"));
   CHECK_FALSE(std::filesystem::exists(path));
   CHECK_THROWS_WITH(Map(Box{{0.1, 0, 0}, {4.1, 4, 3}}, 0.5, {}).save(path), Contains("along x (0.1 m is 0.2 cells)"));
   CHECK_NOTHROW(Map(Box{{-0.6, 0, 0}, {3, 4.2, 3}}, 0.3, {}).save(path));  // on the lattice: -2, 10, 14 cells

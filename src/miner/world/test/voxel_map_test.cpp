@@ -88,7 +88,15 @@ TEST_CASE("A map file references its voxels by path and SHA-256", "[REQ-WORLD-01
   CHECK_THROWS_WITH(Map::load(write("key.json", R"({"format": "miner-map-v1", "voxels": {"files": "small.bt"}})")),
                     Contains("files") && Contains("did you mean"));
   CHECK_THROWS_WITH(Map::load(write("gone.json", R"({"format": "miner-map-v1", "voxels": {"file": "gone.bt"}})")),
-                    Contains("gone.bt: cannot open"));
+                    Contains("gone.json: voxels.file: ") && Contains("gone.bt: cannot open"));
+  // A voxel file that is a device or a folder is named through the map and its field (issue 20,
+  // sixth campaign U4: "/dev/zero: cannot open voxel file" named neither).
+  CHECK_THROWS_WITH(Map::load(write("dev.json", R"({"format": "miner-map-v1", "voxels": {"file": "/dev/zero"}})")),
+                    Contains("dev.json: voxels.file: /dev/zero:"));
+  CHECK_THROWS_WITH(Map::load(write("dir.json", R"({"format": "miner-map-v1", "voxels": {"file": "."}})")),
+                    Contains("dir.json: voxels.file: "));
+  CHECK_THROWS_WITH(Map::load(write("text-ref.json", R"({"format": "miner-map-v1", "voxels": {"file": "text-ref.json"}})")),
+                    Contains("text-ref.json: voxels.file: ") && Contains("OctoMap"));
   CHECK_THROWS_WITH(
       Map::load(write("lattice.json", R"({"format": "miner-map-v1", "bounds": {"min": [0.5, 0, 0], "max": [4, 4, 4]},
                                           "resolution": 1, "obstacles": [], "voxels": {"file": "small.bt"}})")),

@@ -322,10 +322,11 @@ std::vector<std::uint8_t> encode(const world::Map& map, const Eigen::Vector3i& d
   offset.assign(cells + 1, 0);
   const auto for_each_cell = [&](std::size_t o, auto&& f) {
     const BoxCells& r = range[o];
+    const bool has_inner = r.has_inner();
     for (int k = r.lo.z(); k <= r.hi.z(); ++k)
       for (int j = r.lo.y(); j <= r.hi.y(); ++j) {
-        const bool inner_row = r.has_inner() && k >= r.inner_lo.z() && k <= r.inner_hi.z() && j >= r.inner_lo.y() &&
-                               j <= r.inner_hi.y();
+        const bool inner_row =
+            has_inner && k >= r.inner_lo.z() && k <= r.inner_hi.z() && j >= r.inner_lo.y() && j <= r.inner_hi.y();
         const auto visit = [&](int i0, int i1) {
           for (int i = i0; i <= i1; ++i) {
             const std::size_t idx = cell_index(dims, i, j, k);

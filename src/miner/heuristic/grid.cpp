@@ -123,21 +123,35 @@ void encode_voxels(const world::Map& map, const Eigen::Vector3i& dims, double ra
 
 }  // namespace
 
-std::uint64_t subcells_inside(const world::Box& cell, const world::Box& g) {
-  constexpr int n = kPassabilitySubcells;
-  int lo[3], hi[3];
-  for (int a = 0; a < 3; ++a) {
-    const double h = cell.extent()[a] / n;
-    lo[a] = std::max(0, static_cast<int>(std::ceil((g.min[a] - cell.min[a]) / h - 0.5)));
-    hi[a] = std::min(n - 1, static_cast<int>(std::floor((g.max[a] - cell.min[a]) / h - 0.5)));
-    if (lo[a] > hi[a]) return 0;
+namespace {
+/// The kPassabilitySubcells^3 sub-cell centres of a cell, per axis, and which of them a closed
+/// box holds (bit x + 4 y + 16 z), by plain comparisons. The one definition of a centre being
+/// inside a box: P's blocked sub-cells and E's pre-filter of the exact cover test (a centre
+/// outside every box is a point of the cell outside their union) both read it.
+struct SubcellCentres {
+  std::array<std::array<double, kPassabilitySubcells>, 3> at{};
+  explicit SubcellCentres(const world::Box& cell) {
+    for (std::size_t a = 0; a < 3; ++a)
+      for (std::size_t s = 0; s < kPassabilitySubcells; ++s)
+        at[a][s] = cell.min[static_cast<int>(a)] +
+                   (static_cast<double>(s) + 0.5) * cell.extent()[static_cast<int>(a)] / kPassabilitySubcells;
   }
-  const std::uint64_t row = ((std::uint64_t{1} << (hi[0] - lo[0] + 1)) - 1) << lo[0];
-  std::uint64_t plane = 0, volume = 0;
-  for (int y = lo[1]; y <= hi[1]; ++y) plane |= row << (n * y);
-  for (int z = lo[2]; z <= hi[2]; ++z) volume |= plane << (n * n * z);
-  return volume;
-}
+  std::uint64_t inside(const world::Box& g) const {
+    std::array<unsigned, 3> in{};  // per axis, bit s: centre s within [g.min, g.max]
+    for (std::size_t a = 0; a < 3; ++a)
+      for (std::size_t s = 0; s < kPassabilitySubcells; ++s)
+        if (at[a][s] >= g.min[static_cast<int>(a)] && at[a][s] <= g.max[static_cast<int>(a)]) in[a] |= 1U << s;
+    std::uint64_t mask = 0;
+    for (unsigned z = 0; z < kPassabilitySubcells; ++z)
+      for (unsigned y = 0; y < kPassabilitySubcells; ++y)
+        if ((in[2] >> z & 1U) && (in[1] >> y & 1U))
+          mask |= static_cast<std::uint64_t>(in[0]) << (kPassabilitySubcells * (y + kPassabilitySubcells * z));
+    return mask;
+  }
+};
+}  // namespace
+
+std::uint64_t subcells_inside(const world::Box& cell, const world::Box& g) { return SubcellCentres(cell).inside(g); }
 
 namespace {
 
@@ -172,30 +186,6 @@ struct BoxCells {
   bool has_inner() const { return (inner_lo.array() <= inner_hi.array()).all(); }
 };
 
-/// The kPassabilitySubcells^3 sub-cell centres of a cell, per axis, and which of them a closed
-/// box holds (bit x + 4 y + 16 z), by plain comparisons: a centre outside every box is a point
-/// of the cell outside their union, so box_covered() need not run.
-struct SubcellCentres {
-  std::array<std::array<double, kPassabilitySubcells>, 3> at{};
-  explicit SubcellCentres(const world::Box& cell) {
-    for (std::size_t a = 0; a < 3; ++a)
-      for (std::size_t s = 0; s < kPassabilitySubcells; ++s)
-        at[a][s] = cell.min[static_cast<int>(a)] +
-                   (static_cast<double>(s) + 0.5) * cell.extent()[static_cast<int>(a)] / kPassabilitySubcells;
-  }
-  std::uint64_t inside(const world::Box& g) const {
-    std::array<unsigned, 3> in{};  // per axis, bit s: centre s within [g.min, g.max]
-    for (std::size_t a = 0; a < 3; ++a)
-      for (std::size_t s = 0; s < kPassabilitySubcells; ++s)
-        if (at[a][s] >= g.min[static_cast<int>(a)] && at[a][s] <= g.max[static_cast<int>(a)]) in[a] |= 1U << s;
-    std::uint64_t mask = 0;
-    for (unsigned z = 0; z < kPassabilitySubcells; ++z)
-      for (unsigned y = 0; y < kPassabilitySubcells; ++y)
-        if ((in[2] >> z & 1U) && (in[1] >> y & 1U))
-          mask |= static_cast<std::uint64_t>(in[0]) << (kPassabilitySubcells * (y + kPassabilitySubcells * z));
-    return mask;
-  }
-};
 
 /// encode()'s working arrays, kept by each thread between calls (issue 16: made afresh, the
 /// ~300 kB of them were mapped and page-faulted on every query, which cost more than the
@@ -367,14 +357,15 @@ std::vector<std::uint8_t> encode(const world::Map& map, const Eigen::Vector3i& d
     const world::Box cell = cell_box(b, dims, cell_coords(dims, idx));
     local.clear();
     double clipped_volume = 0.0;  // sum over the boxes of |box and cell|: the union is no larger
-    std::uint64_t blocked = 0;
+    const SubcellCentres centres(cell);
+    std::uint64_t blocked = 0;  // the sub-cell centres inside some box (for P, and E's pre-filter)
     for (std::uint32_t t = offset[idx]; t < offset[idx + 1]; ++t) {
       const world::Box& g = grown[touching[t]];
       const world::Box clipped{g.min.cwiseMax(cell.min), g.max.cwiseMin(cell.max)};
       // A run of consecutive boxes equal within the cell adds nothing (issue 20: 20 000 copies of a box).
       if (!local.empty() && local.back().min == clipped.min && local.back().max == clipped.max) continue;
       clipped_volume += (clipped.max - clipped.min).cwiseMax(0.0).prod();
-      if (passability) blocked |= subcells_inside(cell, g);
+      blocked |= centres.inside(g);
       local.push_back(clipped);
     }
     // A single box that does not hold the cell does not cover it. Several boxes need the exact
@@ -383,13 +374,7 @@ std::vector<std::uint8_t> encode(const world::Map& map, const Eigen::Vector3i& d
     // union's volume is at most the sum; issue 16: 226k small boxes spent ~50 ms cutting cells
     // they could never fill). The margin keeps rounding of the sum on the safe side.
     constexpr double kVolumeRounding = 1e-9;
-    const auto centres_covered = [&] {
-      const SubcellCentres centres(cell);
-      std::uint64_t covered = 0;
-      for (const world::Box& g : local) covered |= centres.inside(g);  // the centres lie in the cell
-      return covered == kAllCentres;
-    };
-    if (local.size() > 1 && clipped_volume >= cell.extent().prod() * (1.0 - kVolumeRounding) && centres_covered() &&
+    if (local.size() > 1 && clipped_volume >= cell.extent().prod() * (1.0 - kVolumeRounding) && blocked == kAllCentres &&
         box_covered(cell, local, &cover_budget))
       e[idx] = kSolid;
     if (passability && e[idx] == kPartial) box_blocked.emplace_back(static_cast<std::uint32_t>(idx), blocked);

@@ -275,28 +275,36 @@ struct Sgan::Impl {
   void set_input(int x, int y, int z, std::size_t v, float e, float s, float noise, const float* pass = nullptr) {
     if (own_kernels) {
       const Eigen::Vector3i d = cond1.dims;
-      const int padded = ((z + 1) * (d.y() + 2) + y + 1) * (d.x() + 2) + x + 1;
-      const auto p = static_cast<std::size_t>(padded);
-      noise_padded[p] = noise;
-      kernels::SparseInput in{padded, {e, s, 0.0F, 0.0F, 0.0F}};
+      kernels::SparseInput in{((z + 1) * (d.y() + 2) + y + 1) * (d.x() + 2) + x + 1, {e, s, 0.0F, 0.0F, 0.0F}};
       for (int a = 0; a < arch.passability_channels; ++a) in.condition[2 + a] = pass[a];
-      bool nonzero = false;
-      for (std::size_t c = 0; c < condition_padded.size(); ++c) {
-        condition_padded[c][p] = in.condition[c];
-        nonzero = nonzero || in.condition[c] != 0.0F;
-      }
-      if (nonzero) sparse.push_back(in);
-    } else {
-      const auto c = static_cast<std::size_t>(x0.channels);
-      x0.data[c * v] = e;
-      x0.data[c * v + 1] = s;
-      for (int a = 0; a < arch.passability_channels; ++a) x0.data[c * v + 2 + static_cast<std::size_t>(a)] = pass[a];
-      x0.data[c * v + c - 1] = noise;
+      write_own_input(v, in, noise);
+      return;
     }
-    const auto c = static_cast<std::size_t>(cond1.channels);
-    cond1.data[c * v] = e;
-    cond1.data[c * v + 1] = s;
-    for (int a = 0; a < arch.passability_channels; ++a) cond1.data[c * v + 2 + static_cast<std::size_t>(a)] = pass[a];
+    const auto c = static_cast<std::size_t>(x0.channels);
+    x0.data[c * v] = e;
+    x0.data[c * v + 1] = s;
+    for (int a = 0; a < arch.passability_channels; ++a) x0.data[c * v + 2 + static_cast<std::size_t>(a)] = pass[a];
+    x0.data[c * v + c - 1] = noise;
+    const auto nc = static_cast<std::size_t>(cond1.channels);
+    cond1.data[nc * v] = e;
+    cond1.data[nc * v + 1] = s;
+    for (int a = 0; a < arch.passability_channels; ++a) cond1.data[nc * v + 2 + static_cast<std::size_t>(a)] = pass[a];
+  }
+
+  /// One voxel of the own kernels' input, the one writer set_input and set_input_encoded share:
+  /// its conditions (E/2, S, the blocked bits) in the padded planes and in cond1 (voxel v), its
+  /// noise, and the sparse list when a condition, as the float the kernels read, is nonzero.
+  void write_own_input(std::size_t v, const kernels::SparseInput& in, float noise) {
+    const auto p = static_cast<std::size_t>(in.padded);
+    noise_padded[p] = noise;
+    float* cv = cond1.data.data() + v * condition_padded.size();
+    bool nonzero = false;
+    for (std::size_t c = 0; c < condition_padded.size(); ++c) {
+      condition_padded[c][p] = in.condition[c];
+      cv[c] = in.condition[c];
+      nonzero = nonzero || in.condition[c] != 0.0F;
+    }
+    if (nonzero) sparse.push_back(in);
   }
 
   /// The dataset encoding as the own kernels' input (set_input's effect for every voxel, in one
@@ -306,32 +314,20 @@ struct Sgan::Impl {
                          float scale, const float* noise_in) {
     sparse.clear();
     const Eigen::Vector3i d = cond1.dims;
-    const auto nc = static_cast<std::size_t>(cond1.channels);
     const bool reads_p = arch.passability_channels != 0;
-    std::array<float*, kernels::kMaxConditions> planes{};
-    for (std::size_t c = 0; c < nc; ++c) planes[c] = condition_padded[c].data();
-    float* cond = cond1.data.data();
-    float* noise = noise_padded.data();
     std::size_t v = 0;
     for (int z = 0; z < d.z(); ++z)
       for (int y = 0; y < d.y(); ++y) {
         int padded = ((z + 1) * (d.y() + 2) + y + 1) * (d.x() + 2) + 1;
         for (int x = 0; x < d.x(); ++x, ++v, ++padded) {
-          const auto p = static_cast<std::size_t>(padded);
-          noise[p] = noise_in[v];
           // The blocked bits: 0 on free cells (train.py's to_inputs).
           const unsigned blocked = reads_p ? ~static_cast<unsigned>(passability[v]) & kPassAll : 0U;
-          kernels::SparseInput in{padded,
-                                  {scale * static_cast<float>(environment[v]), static_cast<float>(state[v]),
-                                   static_cast<float>(blocked & 1U), static_cast<float>((blocked >> 1) & 1U),
-                                   static_cast<float>((blocked >> 2) & 1U)}};
-          float* cv = cond + v * nc;
-          for (std::size_t c = 0; c < nc; ++c) {
-            planes[c][p] = in.condition[c];
-            cv[c] = in.condition[c];
-          }
-          // As set_input: the voxels where a condition, as the float the kernels read, is nonzero.
-          if (in.condition[0] != 0.0F || (state[v] | blocked) != 0) sparse.push_back(in);
+          write_own_input(v,
+                          kernels::SparseInput{padded,
+                                               {scale * static_cast<float>(environment[v]), static_cast<float>(state[v]),
+                                                static_cast<float>(blocked & 1U), static_cast<float>((blocked >> 1) & 1U),
+                                                static_cast<float>((blocked >> 2) & 1U)}},
+                          noise_in[v]);
         }
       }
   }

@@ -14,6 +14,7 @@
 #include "miner/core/error.hpp"
 #include "miner/core/json_io.hpp"
 #include "miner/core/sha256.hpp"
+#include "miner/core/text.hpp"
 #include "miner/report/svg_plot.hpp"
 #include "miner/world/map.hpp"
 #include "miner/world/voxel_layer.hpp"
@@ -221,9 +222,16 @@ SuiteDefinition load_suite(const std::string& path) {
   if (steps.array_size() > kMaxSteps) steps.fail("at most 16 steering steps, got " + std::to_string(steps.array_size()));
   for (std::size_t i = 0; i < steps.array_size(); ++i) {
     const double x = steps.at(i).positive_number();
-    if (x > 1.0) steps.at(i).fail("a steering step is a fraction of the map's diagonal in (0, 1], got " + steps.at(i).value().dump());
-    if (std::find(s.step_fractions.begin(), s.step_fractions.end(), x) != s.step_fractions.end())
-      steps.at(i).fail("repeated steering step " + f(x, 3));
+    // A step is named in the tables and the figure files by step_label: two steps with one label
+    // would share a column and a plot (seventh campaign W4: 0.0001 and 0.0002 both "0.000", the
+    // second plot written over the first), and below a thousandth of the diagonal a step is no
+    // campaign of the paper's kind.
+    if (x < kMinStepFraction || x > 1.0)
+      steps.at(i).fail("a steering step is a fraction of the map's diagonal in [" + short_number(kMinStepFraction) +
+                       ", 1], got " + steps.at(i).value().dump());
+    for (const double earlier : s.step_fractions)
+      if (step_label(earlier) == step_label(x))
+        steps.at(i).fail("repeated steering step " + step_label(x) + " (steps are told apart by 6 significant digits)");
     s.step_fractions.push_back(x);
   }
   if (root.has("band")) {
@@ -290,6 +298,8 @@ Json map_fingerprint(const world::Map& map) {
   return doc;
 }
 }  // namespace
+
+std::string step_label(double fraction) { return short_number(fraction); }
 
 SuiteBenchResult run_suite_bench(const SuiteBenchOptions& o, const std::string& command, std::ostream* progress) {
   if (o.suite.maps.empty() || o.suite.step_fractions.empty()) throw Error("bench suite: the suite has no map or no step");
@@ -375,7 +385,7 @@ std::string suite_markdown(const SuiteBenchResult& r, const std::string& figure_
      << " iterations (Table I, about 740-1730 over its three maps). Per map and eta (as a fraction of the map's "
         "diagonal): `rrtstar`'s median [IQR] first-solution iterations; **in band** marks a median inside "
         "the paper's range.\n\n| map | preset | extent (m) | resolution (m) | A* cost (m) | straight line (m) |";
-  for (double s : suite.step_fractions) md << " eta = " << f(s, 3) << " x diag |";
+  for (double s : suite.step_fractions) md << " eta = " << step_label(s) << " x diag |";
   md << "\n|---|---|---|---|---|---|";
   for (std::size_t k = 0; k < suite.step_fractions.size(); ++k) md << "---|";
   md << "\n";
@@ -403,7 +413,7 @@ std::string suite_markdown(const SuiteBenchResult& r, const std::string& figure_
   md << "## Steering step sweep: median time to the target (ms) [reached/n]\n\n";
   for (std::size_t i = 0; i < r.cells.size(); i += per_map) {
     md << "### " << r.cells[i].map << "\n\n| planner |";
-    for (std::size_t k = 0; k < per_map; ++k) md << " eta = " << f(suite.step_fractions[k], 3) << " x diag |";
+    for (std::size_t k = 0; k < per_map; ++k) md << " eta = " << step_label(suite.step_fractions[k]) << " x diag |";
     md << "\n|---|";
     for (std::size_t k = 0; k < per_map; ++k) md << "---|";
     md << "\n";
@@ -424,7 +434,7 @@ std::string suite_markdown(const SuiteBenchResult& r, const std::string& figure_
         "the runs that got there and median [IQR] over all n runs.\n\n";
   for (const SuiteCell& c : r.cells) {
     const auto& fr = c.result;
-    md << "### " << c.map << ", eta = " << f(c.step_fraction, 3) << " x diagonal (" << f(fr.steer_step, 2)
+    md << "### " << c.map << ", eta = " << step_label(c.step_fraction) << " x diagonal (" << f(fr.steer_step, 2)
        << " m)" << (in_paper_band(c, suite) ? ", at the paper's difficulty" : "") << "\n\n"
        << "A* cost " << f(fr.reference_cost, 2) << " m, target " << f(fr.target_cost, 2) << " m, straight line "
        << f(fr.lower_bound, 2) << " m, goal radius " << f(fr.goal_radius, 2) << " m, robot radius "
@@ -442,8 +452,8 @@ std::string suite_markdown(const SuiteBenchResult& r, const std::string& figure_
          << s->runs << " | " << median_iqr(ti, 0) << " | " << mean_sd(tt, 2) << " | " << median_iqr(tt, 2) << " |\n";
     }
     md << "\n" << cell_headline(fr, o.planners) << "\n\n";
-    const std::string fig = c.map + "-" + f(c.step_fraction, 3) + "-target.svg";
-    md << "![" << c.map << " eta " << f(c.step_fraction, 3) << "](" << figure_dir << "/" << fig << ")\n\n";
+    const std::string fig = c.map + "-" + step_label(c.step_fraction) + "-target.svg";
+    md << "![" << c.map << " eta " << step_label(c.step_fraction) << "](" << figure_dir << "/" << fig << ")\n\n";
   }
   return md.str();
 }
@@ -461,8 +471,8 @@ std::map<std::string, std::string> suite_figures(const SuiteBenchResult& r) {
       groups.push_back(std::move(g));
     }
     const int width = 110 * static_cast<int>(std::max<std::size_t>(groups.size(), 4));
-    figures[c.map + "-" + f(c.step_fraction, 3) + "-target.svg"] = report::svg_box_plot(
-        {c.map + ", eta " + f(c.step_fraction, 3) + " x diagonal: time to the target", "", "ms (log)", width, 300},
+    figures[c.map + "-" + step_label(c.step_fraction) + "-target.svg"] = report::svg_box_plot(
+        {c.map + ", eta " + step_label(c.step_fraction) + " x diagonal: time to the target", "", "ms (log)", width, 300},
         groups, true);
   }
   return figures;

@@ -39,6 +39,11 @@ struct SuiteMap {
   world::GeneratorOverrides overrides;
 };
 
+/// The smallest steering step a suite may ask for, as a fraction of the map's diagonal.
+inline constexpr double kMinStepFraction = 1e-3;
+/// A step as the tables and figure names show it: 6 significant digits ("0.1", "0.0002").
+std::string step_label(double fraction);
+
 struct SuiteDefinition {
   std::vector<SuiteMap> maps;
   std::vector<double> step_fractions;  ///< eta / diagonal of the map's bounds, each in (0, 1]

@@ -1,5 +1,6 @@
 // `miner bench backend` (REQ-TRAJ-009).
 #include <algorithm>
+#include <map>
 #include <ostream>
 #include <sstream>
 #include <tuple>
@@ -57,6 +58,35 @@ void run_frontend(const FrontendOptions& o, std::ostream& out) {
   std::ostringstream table;
   bench::print_table(result, table);
   emit(o.output, bench::to_json(result), table.str(), out);
+}
+
+/// A figure folder (bench paper, bench suite) is replaced only when it is an earlier one, told
+/// by its manifest (kFiguresMarker): checked before the work, for the default folder too.
+void require_figures_folder(const std::filesystem::path& folder) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::is_directory(folder, ec) || fs::is_empty(folder, ec)) return;
+  if (const std::string problem = folder_marker_problem(folder.string(), kFiguresMarker); !problem.empty())
+    throw Error(problem);
+  for (const auto& entry : fs::directory_iterator(folder, ec)) {
+    const std::string ext = entry.path().extension().string();
+    if (!entry.is_regular_file(ec) || (ext != ".svg" && ext != ".json"))
+      throw Error(folder.string() + ": the folder exists and holds \"" + entry.path().filename().string() +
+                  "\", which this command does not write: it is not an earlier output of this command, so it is not "
+                  "replaced (remove it or choose another folder)");
+  }
+}
+
+/// The figures and their manifest figures.json (format, command, files), written as one folder:
+/// a later run with other maps or steps knows the folder as its own by the manifest (seventh
+/// campaign C6: it was refused for holding none of the new file names).
+void write_figures(const std::filesystem::path& folder, const std::map<std::string, std::string>& figures,
+                   const std::string& command) {
+  std::vector<std::pair<std::string, std::string>> files(figures.begin(), figures.end());
+  Json names = Json::array();
+  for (const auto& f : files) names.push_back(f.first);
+  files.emplace_back(kFiguresMarker.file, dump_json({{"format", kFiguresFormat}, {"command", command}, {"files", names}}));
+  write_folder_atomic(folder.string(), files, kFiguresMarker);
 }
 }  // namespace
 
@@ -243,7 +273,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   pc->add_option("--out,--results", p->results, "the Markdown report to write (.md; --results: its former name)")->capture_default_str()
       ->check(kOutputFileNewFolder & suffix_output(".md", "the report is Markdown"));
   pc->add_option("--figures", p->figures, "folder for the box plots (default: <--out's folder>/results)")
-      ->check(output_folder_for("", {".svg"}));
+      ->check(output_folder_for(kFiguresMarker, {".svg", ".json"}));
   pc->add_flag("--json", p->json, "print every figure as JSON");
   pc->add_flag("--quiet", p->quiet, "no progress on stderr");
   pc->callback([p, pc, &out] {
@@ -256,15 +286,15 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
     namespace fs = std::filesystem;
     const fs::path results(p->results);
     const fs::path figures = p->figures.empty() ? results.parent_path() / "results" : fs::path(p->figures);
+    require_figures_folder(figures);  // the default one too, before the work (seventh campaign C6)
     const auto r = bench::run_paper_bench(p->bench, command, p->quiet ? nullptr : terminal_stream());
     const std::string link = fs::relative(fs::absolute(figures), fs::absolute(results).parent_path()).generic_string();
-    std::vector<std::pair<std::string, std::string>> files;
-    for (const auto& [name, svg] : bench::results_figures(r)) files.emplace_back(name, svg);
-    write_folder_atomic(figures.string(), files);
+    const auto plots = bench::results_figures(r);
+    write_figures(figures, plots, command);
     if (!results.parent_path().empty()) fs::create_directories(results.parent_path());
     write_file_atomic(results.string(), bench::results_markdown(r, link));
     if (p->json) out << dump_json(bench::to_json(r));
-    else out << "wrote " << results.string() << " and " << files.size() << " box plots in " << figures.string() << "\n";
+    else out << "wrote " << results.string() << " and " << plots.size() << " box plots in " << figures.string() << "\n";
   });
 
   struct SuiteOptions {
@@ -291,7 +321,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   sc->add_option("--out,--results", su->results, "the Markdown report to write (.md; --results: its former name)")->capture_default_str()
       ->check(kOutputFileNewFolder & suffix_output(".md", "the report is Markdown"));
   sc->add_option("--figures", su->figures, "folder for the box plots (default: <--out's folder>/suite)")
-      ->check(output_folder_for("", {".svg"}));
+      ->check(output_folder_for(kFiguresMarker, {".svg", ".json"}));
   sc->add_flag("--json", su->json, "print every figure as JSON");
   sc->add_flag("--quiet", su->quiet, "no progress on stderr");
   sc->callback([su, sc, &out] {
@@ -305,15 +335,15 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
     const fs::path results(su->results);
     const fs::path figures = su->figures.empty() ? results.parent_path() / "suite" : fs::path(su->figures);
     const std::string command = command_line(sc, {"--suite", "--runs", "--seed", "--time-limit", "--iterations"});
+    require_figures_folder(figures);  // the default one too, before the work (seventh campaign C6)
     const auto r = bench::run_suite_bench(su->bench, command, su->quiet ? nullptr : terminal_stream());
     const std::string link = fs::relative(fs::absolute(figures), fs::absolute(results).parent_path()).generic_string();
-    std::vector<std::pair<std::string, std::string>> files;
-    for (const auto& [name, svg] : bench::suite_figures(r)) files.emplace_back(name, svg);
-    write_folder_atomic(figures.string(), files);
+    const auto plots = bench::suite_figures(r);
+    write_figures(figures, plots, command);
     if (!results.parent_path().empty()) fs::create_directories(results.parent_path());
     write_file_atomic(results.string(), bench::suite_markdown(r, link));
     if (su->json) out << dump_json(bench::to_json(r));
-    else out << "wrote " << results.string() << " and " << files.size() << " box plots in " << figures.string() << "\n";
+    else out << "wrote " << results.string() << " and " << plots.size() << " box plots in " << figures.string() << "\n";
   });
 
   struct VoxelOptions {

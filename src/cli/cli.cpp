@@ -146,7 +146,7 @@ const CLI::Validator kOutputFolder(
     },
     "OUTPUT FOLDER");
 
-CLI::Validator output_folder_for(const std::string& marker, const std::vector<std::string>& extensions) {
+CLI::Validator output_folder_for(const FolderMarker& marker, const std::vector<std::string>& extensions) {
   return CLI::Validator(
       [marker, extensions](std::string& text) -> std::string {
         namespace fs = std::filesystem;
@@ -167,9 +167,8 @@ CLI::Validator output_folder_for(const std::string& marker, const std::vector<st
               std::find(extensions.begin(), extensions.end(), entry.path().extension().string()) == extensions.end())
             return refused + "\"" + name + "\"" + why;
         }
-        if (!marker.empty() && !fs::is_regular_file(p / marker, ec))
-          return text + " exists and holds no " + marker + ": " + not_ours;
-        return {};
+        // What the folder is goes by its marker's content, not its name (seventh campaign D1).
+        return folder_marker_problem(text, marker);
       },
       "OUTPUT FOLDER");
 }

@@ -124,8 +124,12 @@ extern const CLI::Validator kOutputFile;
 extern const CLI::Validator kOutputFolder;
 /// kOutputFolder for a folder a command replaces as a whole (run folders, datasets, figure
 /// folders): an existing, non-empty one must look like an earlier output of the command, i.e.
-/// hold only regular files with one of `extensions` and, if `marker` is not empty, that file.
-CLI::Validator output_folder_for(const std::string& marker, const std::vector<std::string>& extensions);
+/// hold only regular files with one of `extensions` and, where `marker` names a file, that file
+/// with the command's format (folder_marker_problem; write_folder_atomic applies the same rule).
+CLI::Validator output_folder_for(const FolderMarker& marker, const std::vector<std::string>& extensions);
+/// The format of the manifest (figures.json) a figure folder carries: its files and the command.
+inline constexpr const char* kFiguresFormat = "miner-figures-v1";
+inline const FolderMarker kFiguresMarker{"figures.json", kFiguresFormat, true};
 /// An output that must end in `suffix`, exactly (checked when the line is parsed, exit 2): the
 /// file's content is what the suffix says (issue 20: `--map-out x.bt` was given JSON, `--out
 /// x.bt` of a region JSON, `--out s.json` of a report Markdown). `what` says why.

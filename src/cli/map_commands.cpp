@@ -157,7 +157,7 @@ void run_info(const InfoOptions& o, std::ostream& out) {
       << 100.0 * static_cast<double>(layer.count(world::VoxelState::kOccupied)) / static_cast<double>(layer.size())
       << " % of the voxels occupied (" << (known > 0 ? 100.0 * static_cast<double>(layer.count(world::VoxelState::kOccupied)) / known : 0.0)
       << " % of the known ones), " << 100.0 * static_cast<double>(layer.count(world::VoxelState::kUnknown)) / static_cast<double>(layer.size())
-      << " % unknown" << std::defaultfloat << "\n";
+      << " % unknown" << std::defaultfloat << std::setprecision(6) << "\n";
     h << "unknown:     treated as " << world::to_string(v->policy())
       << (v->policy() == world::UnknownPolicy::kOccupied ? " (the safe default; --unknown free to fly through it)"
                                                          : " (on request)")
@@ -176,7 +176,7 @@ void run_info(const InfoOptions& o, std::ostream& out) {
                                                std::string(map.voxels()->policy() == world::UnknownPolicy::kOccupied ? " or unknown" : "") +
                                                ", grown by the radius)"
                                          : std::string(" % occupied"))
-    << " for robot radius " << std::defaultfloat << radius << " m\n";
+    << " for robot radius " << std::defaultfloat << std::setprecision(6) << radius << " m\n";
   if (map.query()) {
     h << "query:       start " << format_point(map.query()->start) << ", goal "
       << format_point(map.query()->goal) << ", robot radius " << map.query()->robot_radius << " m\n";

@@ -83,6 +83,9 @@ TEST_CASE("A suite file is read strictly", "[REQ-REPORT-008]") {
   CHECK_THROWS_WITH(load_suite(bad("fmt.json", "suite-v1", "suite-v2")), Contains("format: expected"));
   CHECK_THROWS_WITH(load_suite(bad("step.json", "0.4]", "1.5]")), Contains("steps[1]: a steering step is a fraction"));
   CHECK_THROWS_WITH(load_suite(bad("rep.json", "0.4]", "0.1]")), Contains("steps[1]: repeated steering step"));
+  // Steps a label cannot tell apart, or too small to be a campaign (seventh campaign W4).
+  CHECK_THROWS_WITH(load_suite(bad("near.json", "0.4]", "0.10000001]")), Contains("steps[1]: repeated steering step 0.1"));
+  CHECK_THROWS_WITH(load_suite(bad("tiny-step.json", "0.4]", "0.0002]")), Contains("steps[1]: a steering step is a fraction of the map's diagonal in [0.001, 1]"));
   CHECK_THROWS_WITH(load_suite(bad("preset.json", "\"cluttered\"", "\"clutered\"")),
                     Contains("maps[0].preset: unknown preset \"clutered\""));
   CHECK_THROWS_WITH(load_suite(bad("band.json", "[1, 1000000]", "[10, 1]")), Contains("band: hi is below lo"));
@@ -153,8 +156,9 @@ TEST_CASE("The suite runs every planner at every step and reports spread, n and 
   CHECK_THAT(md_miss, Contains("miss [miss, miss]") && Contains("[0/4]"));
   const auto figures = suite_figures(missing);
   REQUIRE(figures.size() == 2);
-  const std::string& svg = figures.begin()->first.find("0.100") != std::string::npos ? figures.begin()->second
+  const std::string& svg = figures.begin()->first.find("-0.1-") != std::string::npos ? figures.begin()->second
                                                                                       : figures.rbegin()->second;
+  CHECK(figures.count("tiny-0.1-target.svg") == 1);  // steps named by 6 significant digits (seventh campaign W4)
   CHECK_THAT(svg, Contains("n=4, 4 missed"));
 
   // Same seed, same records (time fields aside), OMPL's included.

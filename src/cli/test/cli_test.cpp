@@ -855,6 +855,66 @@ TEST_CASE("An option left without its value is named, not the option it swallowe
   CHECK_THAT(r.err, Contains("--merge: needs a value, got the option --out") && !Contains("is required"));
 }
 
+TEST_CASE("A folder is replaced only when its marker file is the command's own by content", "[REQ-CLI-003]") {
+  namespace fs = std::filesystem;
+  // Issue 20, seventh campaign D1: a user's summary.json (or dataset.json), by its name alone, let
+  // `fly` (or `dataset`) replace the folder.
+  const std::string victim = dir() + "/victim-d1";
+  fs::remove_all(victim);
+  fs::create_directories(victim);
+  std::ofstream(victim + "/summary.json") << "precious\n";
+  const Run fly = miner_cli({"fly", "--out", victim, "--quiet"});
+  CHECK(fly.code == 2);
+  CHECK_THAT(fly.err, Contains("holds summary.json, which is not a \"miner-flight-summary-v1\" file"));
+  CHECK(read(victim + "/summary.json") == "precious\n");
+  std::ofstream(victim + "/summary.json") << R"({"format": "someone-else"})";
+  CHECK(miner_cli({"fly", "--out", victim, "--quiet"}).code == 2);
+  const std::string data = dir() + "/victim-d1-data";
+  fs::remove_all(data);
+  fs::create_directories(data);
+  std::ofstream(data + "/dataset.json") << "{}";
+  const Run ds = miner_cli({"dataset", "--preset", "indoor", "--count", "2", "--test-count", "1", "--out", data, "--quiet"});
+  CHECK(ds.code == 2);
+  CHECK_THAT(ds.err, Contains("holds dataset.json, which is not a"));
+  CHECK(read(data + "/dataset.json") == "{}");
+  // The library's own writer keeps the same rule when called without the CLI's check.
+  CHECK_THROWS_WITH(miner::write_folder_atomic(data, {{"dataset.json", "x"}}, miner::FolderMarker{"dataset.json", "miner-dataset-v2"}),
+                    Contains("which is not a \"miner-dataset-v2\" file"));
+  // A command's own earlier output is replaced, by content: a dataset over a dataset.
+  const std::string mine = dir() + "/d1-own-dataset";
+  fs::remove_all(mine);
+  REQUIRE(miner_cli({"dataset", "--preset", "indoor", "--count", "2", "--test-count", "1", "--out", mine, "--quiet"}).code == 0);
+  CHECK(miner_cli({"dataset", "--preset", "indoor", "--count", "2", "--test-count", "1", "--seed", "9", "--out", mine, "--quiet"}).code == 0);
+}
+
+TEST_CASE("A figure folder carries a manifest and a later run with other steps replaces it", "[REQ-CLI-003][REQ-REPORT-008]") {
+  // Issue 20, seventh campaign C6: a second suite with other steps was refused for holding none
+  // of the new file names, and only after its maps were generated.
+  const std::string suite_a = write("c6-a.json", R"({"format": "miner-bench-suite-v1", "steps": [0.2], "band": [1, 1000000],
+    "maps": [{"name": "m", "preset": "cluttered", "seed": 3, "size": [12, 12, 6], "obstacles": 12}]})");
+  const std::string suite_b = write("c6-b.json", R"({"format": "miner-bench-suite-v1", "steps": [0.3], "band": [1, 1000000],
+    "maps": [{"name": "m", "preset": "cluttered", "seed": 3, "size": [12, 12, 6], "obstacles": 12}]})");
+  const std::string out = dir() + "/c6/suite.md";
+  std::filesystem::remove_all(dir() + "/c6");
+  for (const std::string& suite : {suite_a, suite_b}) {
+    const Run r = miner_cli({"bench", "suite", "--suite", suite, "--planners", "rrtstar", "--runs", "1", "--iterations", "300",
+                             "--out", out, "--quiet"});
+    INFO(r.err);
+    REQUIRE(r.code == 0);
+  }
+  const miner::Json manifest = miner::read_json_file(dir() + "/c6/suite/figures.json");
+  CHECK(manifest["format"] == "miner-figures-v1");
+  CHECK(manifest["files"] == miner::Json::array({"m-0.3-target.svg"}));
+  // A folder of the user's is refused before any work, the default one included.
+  const std::string user = dir() + "/c6-user";
+  std::filesystem::create_directories(user + "/suite");
+  std::ofstream(user + "/suite/figures.json") << R"({"format": "mine"})";
+  const Run refused = miner_cli({"bench", "suite", "--suite", suite_a, "--planners", "rrtstar", "--runs", "1", "--out",
+                                 user + "/suite.md", "--quiet"});
+  CHECK(refused.code == 1);
+  CHECK_THAT(refused.err, Contains("holds figures.json, which is not a \"miner-figures-v1\" file"));
+}
+
 TEST_CASE("A real option written as negative zero reads as 0", "[REQ-CLI-002]") {
   // Issue 20, sixth campaign U6: --radius -0 printed "robot radius -0 m" and "robot_radius": -0.0.
   const std::string map = write("pillar-zero.json", kPillarMap);
@@ -1440,12 +1500,13 @@ TEST_CASE("miner bench sim reports the real-time factor", "[REQ-FLIGHT-010]") {
   CHECK(doc["threads"] == 1);
   CHECK(miner_cli({"bench", "sim", "--runs", "0"}).code == 2);
   // A flight that `fly` fails is not timed (issue 20, fourth campaign: every pose an outlier,
-  // the vehicle crashed, and a real-time factor was reported with exit 0).
+  // the vehicle crashed, and a real-time factor was reported with exit 0). Here no command
+  // reaches the N3 for the whole flight: it hovers in its failsafe and never gets there.
   const std::string map = write("sim-4th-map.json", R"({"format": "miner-map-v1", "bounds": {"min": [0,0,0], "max": [4,4,2]},
     "resolution": 0.25, "obstacles": [{"type": "box", "min": [1.5,1.5,0], "max": [2.5,2.5,2]}]})");
   const std::string scenario = write("sim-4th.json", R"({"format": "miner-scenario-v1", "name": "outliers", "map": "sim-4th-map.json",
     "start": [0.5, 0.5, 1], "goal": [0.5, 3.5, 1], "waypoints": [[0.5, 2, 1]], "trajectory": {"order": 4, "v_max": 1.0, "a_max": 1.0},
-    "seed": 1, "hover_after_s": 1.0, "goal_tolerance_m": 0.3, "pose": {"outlier_probability": 1.0}})");
+    "seed": 1, "hover_after_s": 1.0, "goal_tolerance_m": 0.3, "command_dropout_s": [0, 60]})");
   const Run fly = miner_cli({"fly", "--scenario", scenario, "--out", dir() + "/sim-4th-run"});
   REQUIRE(fly.code == 3);
   const Run failed = miner_cli({"bench", "sim", "--scenario", scenario, "--runs", "1"});

@@ -394,7 +394,33 @@ void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& 
 
 void write_file_atomic(const std::string& path, const std::string& content) { write_files_atomic({{path, content}}); }
 
-void write_folder_atomic(const std::string& path, const std::vector<std::pair<std::string, std::string>>& files) {
+std::string folder_marker_problem(const std::string& path, const FolderMarker& marker) {
+  namespace fs = std::filesystem;
+  if (marker.file.empty()) return {};
+  std::error_code ec;
+  const fs::path file = fs::path(path) / marker.file;
+  const std::string not_ours = ": it is not an earlier output of this command, so it is not replaced (remove it or "
+                               "choose another folder)";
+  if (!fs::exists(file, ec))
+    return marker.by_name_fallback ? std::string() : path + ": the folder exists and holds no " + marker.file + not_ours;
+  // A marker is a small JSON file: anything large or unreadable is not one of ours.
+  constexpr std::uintmax_t kMaxMarkerBytes = 64u << 20;
+  std::string format;
+  if (fs::is_regular_file(file, ec) && fs::file_size(file, ec) <= kMaxMarkerBytes) {
+    try {
+      const Json doc = parse_json(read_file_bytes(file.string()), file.string());
+      if (doc.is_object() && doc.contains("format") && doc["format"].is_string()) format = doc["format"].get<std::string>();
+    } catch (const Error&) {
+      format.clear();
+    }
+  }
+  if (format == marker.format) return {};
+  return path + ": the folder holds " + marker.file + ", which is not a \"" + marker.format + "\" file (" +
+         (format.empty() ? std::string("no such \"format\"") : "format \"" + format + "\"") + ")" + not_ours;
+}
+
+void write_folder_atomic(const std::string& path, const std::vector<std::pair<std::string, std::string>>& files,
+                         const FolderMarker& marker) {
   namespace fs = std::filesystem;
   require_path_without_nul(path, "output folder");
   const fs::path target = fs::path(path).lexically_normal();
@@ -423,7 +449,9 @@ void write_folder_atomic(const std::string& path, const std::vector<std::pair<st
                     "it is not replaced (remove it or choose another folder)");
       common = common || names.count(name) > 0;
     }
-    if (!common)
+    if (const std::string problem = folder_marker_problem(path, marker); !problem.empty()) throw Error(problem);
+    const bool marked = !marker.file.empty() && fs::exists(target / marker.file, ec);
+    if (!common && !marked)
       throw Error(path + ": the folder exists and holds none of the files this command writes: it is not an earlier "
                   "output of this command, so it is not replaced (remove it or choose another folder)");
   }

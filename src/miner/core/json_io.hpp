@@ -123,7 +123,23 @@ void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& 
 /// it looks like an earlier output of the same command: nothing but files, each with an
 /// extension among the new files', and one name in common; otherwise it throws naming the
 /// entry (a user's folder, the current folder, a folder holding the inputs are never replaced).
-void write_folder_atomic(const std::string& path, const std::vector<std::pair<std::string, std::string>>& files);
+///
+/// With a marker, "an earlier output" is told by content, not by names: the folder must hold
+/// marker.file, a JSON object whose "format" is marker.format (issue 20, seventh campaign D1: a
+/// user's own summary.json, by its name alone, let `fly --out` replace the folder). Where
+/// by_name_fallback is set (figure folders written before they carried a manifest), a folder
+/// without marker.file is judged by the names rule above.
+struct FolderMarker {
+  std::string file;
+  std::string format;
+  bool by_name_fallback = false;
+};
+void write_folder_atomic(const std::string& path, const std::vector<std::pair<std::string, std::string>>& files,
+                         const FolderMarker& marker = {});
+/// Why the existing non-empty folder `path` is not an earlier output marked by `marker` (empty
+/// when it is, or when the marker is absent and by_name_fallback leaves the judgement to the
+/// names rule): the marker part of write_folder_atomic's rule, for checks made before the work.
+std::string folder_marker_problem(const std::string& path, const FolderMarker& marker);
 
 /// Whether `path` is `folder` or lies inside it, both made absolute and canonical as far as
 /// they exist (links and ".." resolved); false when either cannot be resolved. An output

@@ -60,6 +60,10 @@ class ImuModel {
   Eigen::Vector3d b_a_, b_g_;
 };
 
+/// The largest share of pose fixes that may be outliers: beyond half, the outliers are the
+/// majority and no innovation gate can tell them from the truth.
+inline constexpr double kMaxOutlierProbability = 0.5;
+
 struct PoseParams {
   double rate_hz = 50.0;                ///< 30-100 Hz for VIO / motion capture
   double delay_s = 0.02;                ///< from the instant measured to delivery

@@ -69,6 +69,32 @@ void validate(const VehicleParams& v, const std::string& origin) {
     bad(origin, "rotor_drag_N_s_per_m_rad", "must be finite and in [0, 0.01]");
   if (!std::isfinite(v.quadratic_drag) || v.quadratic_drag < 0.0 || v.quadratic_drag > 100.0)
     bad(origin, "quadratic_drag_N_s2_per_m2", "must be finite and in [0, 100]");
+  // The collision sphere holds the rotors' axes at least: a 1 m arm inside a 0.3 m sphere flew
+  // through obstacles its rotors would hit, counted "collisions 0" (issue 20, seventh campaign W5).
+  if (v.radius < v.arm_length) {
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "%g m is smaller than arm_length_m %g m: the collision sphere must hold the rotors (at least "
+                  "the arm length; add the propeller radius)",
+                  v.radius, v.arm_length);
+    bad(origin, "radius_m", text);
+  }
+  // The rotors must turn the body to the tilt limit in time for the position loop: rest to
+  // rest through kTiltLimitRad under the largest roll/pitch torque (two rotors at w_max, two
+  // at w_min, lever arm_length / sqrt 2) takes 2 sqrt(theta J / tau_max). Seventh campaign C4:
+  // an inertia of 100 kg m^2 was accepted and left the map by hundreds of metres.
+  const double rotor_span = v.thrust_coefficient * (v.rotor_speed_max * v.rotor_speed_max -
+                                                    v.rotor_speed_min * v.rotor_speed_min);
+  const double torque_max = 2.0 * rotor_span * v.arm_length / std::sqrt(2.0);
+  const double tilt_time = 2.0 * std::sqrt(kTiltLimitRad * std::max(v.inertia.x(), v.inertia.y()) / torque_max);
+  if (!(tilt_time <= kMaxTiltTime)) {
+    char text[260];
+    std::snprintf(text, sizeof text,
+                  "the rotors' largest roll/pitch torque %g N m turns this inertia to the %g deg tilt limit in %g s at "
+                  "best, more than the %g s a position loop can wait: the vehicle cannot follow a trajectory",
+                  torque_max, kN3MaxTiltDeg, tilt_time, kMaxTiltTime);
+    bad(origin, "inertia_kg_m2", text);
+  }
   // The drag's lag, mass over the linear coefficients at full rotor speed, is a plant time
   // constant too: a 1 g vehicle with 100 N s/m of drag is as stiff as a 10 us motor.
   const double linear_coefficient = v.linear_drag.maxCoeff() + 4.0 * v.rotor_drag * v.rotor_speed_max;

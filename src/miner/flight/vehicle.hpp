@@ -29,6 +29,11 @@ inline constexpr const char* kVehicleFormat = "miner-vehicle-v1";
 /// time, so a motor constant of 1e-9 s needed millions of steps per N3 tick and failed there
 /// (issue 20, sixth campaign U9). 1 ms keeps even a 0.5x model mismatch to a few steps per tick.
 inline constexpr double kMinPlantTimeConstant = 1e-3;
+
+/// The longest a vehicle may take to tilt from level to the N3's tilt limit at full differential
+/// thrust (rest to rest), s. A position loop of ~1 Hz bandwidth waits about this long for the
+/// attitude it asks for; an N3-class 1.5 kg quadrotor takes ~0.15 s.
+inline constexpr double kMaxTiltTime = 1.0;
 /// Standard gravity used by the dynamics, the N3 and the estimator alike (m/s^2).
 using miner::kGravity;
 

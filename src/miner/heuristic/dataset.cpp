@@ -432,7 +432,7 @@ Json write_dataset(const DatasetOptions& o, const std::string& dir, std::ostream
   doc.update(format_fields());
   if (o.shard_count > 1) doc["part"] = {{"index", o.shard_index}, {"count", o.shard_count}};
   files.emplace_back("dataset.json", dump_json(doc));
-  write_folder_atomic(dir, files);
+  write_folder_atomic(dir, files, FolderMarker{"dataset.json", kDatasetFormat});
   return doc;
 }
 
@@ -512,7 +512,7 @@ Json merge_dataset_parts(const std::vector<std::string>& parts, const std::strin
     throw Error("dataset merge: a shard is named dataset.json, the name of the dataset's description");
   // Shard files in the unsharded run's order (split by split), then dataset.json.
   files.emplace_back("dataset.json", dump_json(doc));
-  write_folder_atomic(dir, files);
+  write_folder_atomic(dir, files, FolderMarker{"dataset.json", kDatasetFormat});
   return doc;
 }
 

@@ -60,7 +60,7 @@ std::vector<std::string> RunFolder::names() const {
 void RunFolder::write() const {
   auto files = files_;
   files.emplace_back("summary.json", dump_json(summary_));
-  write_folder_atomic(dir_, files);
+  write_folder_atomic(dir_, files, FolderMarker{"summary.json", flight::kSummaryFormat});
 }
 
 }  // namespace miner::pipeline

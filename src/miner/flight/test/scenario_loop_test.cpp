@@ -51,6 +51,17 @@ TEST_CASE("The embedded default scenario is the fixture file and flies to its go
   CHECK(r.summary["position_mse"].size() == 3);
 }
 
+TEST_CASE("A reference whose drag the vehicle cannot overcome is refused before flight", "[REQ-FLIGHT-007]") {
+  // Issue 20, seventh campaign C4: 100 N s/m of drag at ~1 m/s asked ~100 N of a ~40 N vehicle,
+  // was flown and left the map, blamed on the flight.
+  Eigen::MatrixX3d points(3, 3);
+  points << 5, 5, 3, 8, 7, 4, 11, 6, 3;
+  auto s = miner::testing::open_room_scenario(points, 1.0, 1.0, 9);
+  CHECK_NOTHROW(pipeline::build_reference(s));  // the default drag is well inside the envelope
+  s.vehicle.linear_drag = Eigen::Vector3d(100.0, 100.0, 100.0);
+  CHECK_THROWS_WITH(pipeline::build_reference(s), Contains("N of drag at") && Contains("lower trajectory.v_max"));
+}
+
 TEST_CASE("Same scenario and seed give the same flight log bytes: another seed does not", "[REQ-FLIGHT-009]") {
   Eigen::MatrixX3d points(3, 3);
   points << 5, 5, 3, 8, 7, 4, 11, 6, 3;

@@ -74,6 +74,17 @@ TEST_CASE("Plant time constants shorter than the integrator can take are refused
   miner::Json doc = vehicle_doc();
   doc["motor_time_constant_up_s"] = flight::kMinPlantTimeConstant;  // the bound itself is accepted
   CHECK_NOTHROW(flight::vehicle_from_json(doc, "v.json"));
+  // The collision sphere holds the rotors (seventh campaign W5: 1 m arms in a 0.3 m sphere flew).
+  doc = vehicle_doc();
+  doc["arm_length_m"] = 1.0;
+  expect_vehicle_error(doc, "v.json: radius_m: 0.3 m is smaller than arm_length_m 1 m");
+  // Seventh campaign C4: an inertia the rotors cannot turn in time.
+  doc = vehicle_doc();
+  doc["inertia_kg_m2"] = {100.0, 100.0, 150.0};
+  expect_vehicle_error(doc, "v.json: inertia_kg_m2: the rotors' largest roll/pitch torque");
+  doc = vehicle_doc();
+  doc["inertia_kg_m2"] = {0.5, 0.5, 0.9};  // ~0.6 s: slow, and flyable
+  CHECK_NOTHROW(flight::vehicle_from_json(doc, "v.json"));
   // A light vehicle under heavy drag lags faster than 1 ms (mass 0.05 kg / 100 N s/m = 0.5 ms).
   doc = vehicle_doc();
   doc["mass_kg"] = 0.05;

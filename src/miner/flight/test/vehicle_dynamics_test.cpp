@@ -92,6 +92,22 @@ TEST_CASE("Plant time constants shorter than the integrator can take are refused
   expect_vehicle_error(doc, "v.json: linear_drag_N_s_per_m: mass 0.05 kg over the linear drag 100 N s/m");
 }
 
+TEST_CASE("The drag lag counts rotor drag at full rotor speed", "[REQ-FLIGHT-001]") {
+  // Linear drag alone lags 0.04 kg / 0.15 N s/m = 0.27 s; with rotor drag 0.01 N s/m/(rad/s) at
+  // 1340 rad/s on four rotors (53.6 N s/m) the lag is 0.74 ms: below kMinPlantTimeConstant.
+  miner::Json doc = vehicle_doc();
+  doc["mass_kg"] = 0.04;
+  doc["rotor_speed_min_rad_s"] = 0.0;
+  doc["rotor_drag_N_s_per_m_rad"] = 0.01;
+  const flight::VehicleParams v = flight::vehicle_from_json(vehicle_doc(), "v.json");
+  REQUIRE(v.rotor_speed_max == 1340.0);
+  REQUIRE(v.linear_drag.maxCoeff() == Approx(0.15));
+  expect_vehicle_error(doc, "v.json: linear_drag_N_s_per_m: mass 0.04 kg over the linear drag 53.75 N s/m (at full rotor speed)");
+  // Half that rotor drag lags 1.5 ms: accepted.
+  doc["rotor_drag_N_s_per_m_rad"] = 0.005;
+  CHECK_NOTHROW(flight::vehicle_from_json(doc, "v.json"));
+}
+
 TEST_CASE("An integrator that runs out of steps says so in the program's words", "[REQ-FLIGHT-002]") {
   const flight::VehicleParams v;
   flight::Integrator integrator(v, flight::IntegratorOptions{1e-6, 2});  // two internal steps per tick

@@ -131,6 +131,17 @@ TEST_CASE("A region must match the map's bounds and hold at least one cell", "[R
   CHECK_THROWS_AS(empty.sample(*std::make_unique<miner::Rng>(1)), miner::Error);
 }
 
+TEST_CASE("Hops through H enter cells whose probability equals the threshold", "[REQ-PLAN-005][REQ-PLAN-020]") {
+  // H is p >= threshold (REQ-PLAN-005): a chain whose middle cells sit exactly on the threshold
+  // (as the A*-dilated region's p = threshold = 1 does everywhere) still joins its ends.
+  const HeuristicRegion r(Box{{0, 0, 0}, {4, 1, 1}}, I(4, 1, 1), {0.9, 0.5, 0.5, 0.9}, 0.5);
+  REQUIRE(r.contains(V(1.5, 0.5, 0.5)));
+  CHECK(r.hops_to(V(0.5, 0.5, 0.5)) == std::vector<int>{0, 1, 2, 3});
+  CHECK(r.hops_to(V(3.5, 0.5, 0.5)) == std::vector<int>{3, 2, 1, 0});
+  const HeuristicRegion ones(Box{{0, 0, 0}, {3, 1, 1}}, I(3, 1, 1), {1.0, 1.0, 1.0}, 1.0);
+  CHECK(ones.hops_to(V(2.5, 0.5, 0.5)) == std::vector<int>{2, 1, 0});
+}
+
 TEST_CASE("Hops through H and a path's share in H are measured on the region's cells", "[REQ-PLAN-020]") {
   // 4 x 2 x 1 cells over [0,8] x [0,2] x [0,1]; H = cells 0, 1, 2 (the row y = 0, x < 6) and 7.
   std::vector<double> p(8, 0.0);

@@ -157,3 +157,22 @@ TEST_CASE("Paths are resampled at a fixed spacing, ends included", "[REQ-WORLD-0
   CHECK(poses[2].isApprox(V(1.5, 0.5, 0)));
   CHECK(poses[3] == V(1.5, 1.0, 0));
 }
+
+TEST_CASE("A scan casts exactly the rays its bound counts: a full turn at the first and the last pose", "[REQ-WORLD-016]") {
+  // 2.5 m at 1 m spacing: poses at 0, 1, 2 and the end (4 poses). A 90 deg field of 8 x 2 rays;
+  // the two end poses turn a full circle at the same angular spacing (32 x 2 rays each).
+  const Map map = scene();
+  ScanOptions o = noiseless();
+  o.h_fov_deg = 90.0;
+  o.h_rays = 8;
+  o.v_rays = 2;
+  o.spacing = 1.0;
+  const std::vector<V> path{V(1, 4, 1.5), V(3.5, 4, 1.5)};
+  const ScanResult scan = scan_map(map, path, o);
+  CHECK(scan.poses == 4);
+  CHECK(scan.rays == 2 * 32 * 2 + 2 * 8 * 2);
+  CHECK(scan_ray_bound(o, 2.5) == Approx(160.0));
+  o.spin_at_ends = false;
+  CHECK(scan_map(map, path, o).rays == 4 * 8 * 2);
+  CHECK(scan_ray_bound(o, 2.5) == Approx(64.0));
+}

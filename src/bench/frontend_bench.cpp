@@ -379,6 +379,13 @@ void check_run_record(const JsonField& r, double lower_bound) {
     if (st.at("iteration").value().is_number_unsigned() && r.at("iterations").value().is_number_unsigned() &&
         st.at("iteration").value().get<std::uint64_t>() > r.at("iterations").value().get<std::uint64_t>())
       st.at("iteration").fail("comes after the run's last iteration " + r.at("iterations").value().dump());
+    // Our planners' trees hold the root and at most one new vertex per iteration (seventh
+    // campaign W3: 1e9 nodes at iteration 84 were averaged in). OMPL's may add batches.
+    const bool ours = r.at("planner").value().is_string() && r.at("planner").string().rfind("ompl:", 0) != 0;
+    if (ours && st.at("nodes").value().is_number_unsigned() && st.at("iteration").value().is_number_unsigned() &&
+        st.at("nodes").value().get<std::uint64_t>() > st.at("iteration").value().get<std::uint64_t>() + 1)
+      st.at("nodes").fail(st.at("nodes").value().dump() + " vertices at iteration " + st.at("iteration").value().dump() +
+                          ": a tree of " + r.at("planner").string() + " holds its root and at most one vertex per iteration");
   }
 }
 

@@ -154,6 +154,9 @@ PaperBenchResult run_paper_bench(const PaperBenchOptions& o, const std::string& 
   // More heuristic samples than the given folder's test split holds is refused before any run,
   // naming this command's option (session 23 review: it failed after every other table, naming
   // bench heuristic's --samples). The count is the test shards' the folder holds.
+  // The folder's test split is read and checked whole before any campaign (seventh campaign
+  // C5: a corrupt shard was found after 20 s of campaigns).
+  if (!o.heuristic_data.empty()) (void)heuristic::read_split(o.heuristic_data, "test");
   if (!o.heuristic_data.empty() && o.heuristic_samples_given) {
     const std::size_t held = heuristic::split_samples_held(o.heuristic_data, "test");
     if (held < static_cast<std::size_t>(o.heuristic_samples))

@@ -599,6 +599,32 @@ std::string unknown_option(CLI::App* cmd, const std::string& path, const std::ve
   return {};
 }
 
+/// A list option's value with an empty piece ("5,", ",5", "5,,6"): CLI11 drops the empty piece,
+/// so `--segments 5,` ran as `--segments 5` (issue 20, seventh campaign C10). Empty when none.
+std::string empty_list_piece(CLI::App* cmd, const std::vector<std::string>& args) {
+  const CLI::Option* list = nullptr;  // the delimited option whose values follow
+  for (const std::string& a : args) {
+    if (a == "--") break;
+    const std::size_t dashes = a.rfind("--", 0) == 0 ? 2 : 1;
+    const bool option = a.size() > dashes && a[0] == '-' && std::isalpha(static_cast<unsigned char>(a[dashes]));
+    std::string value = a;
+    if (option) {
+      const std::size_t eq = a.find('=');
+      const CLI::Option* o = cmd->get_option_no_throw(a.substr(0, eq));
+      list = o != nullptr && o->get_delimiter() != '\0' ? o : nullptr;
+      if (list == nullptr || eq == std::string::npos) continue;
+      value = a.substr(eq + 1);
+    }
+    if (list == nullptr) continue;
+    const char d = list->get_delimiter();
+    if (value.find(d) == std::string::npos) continue;
+    if (value.front() == d || value.back() == d || value.find(std::string(2, d)) != std::string::npos)
+      return list->get_name() + ": \"" + value + "\" has an empty value between its '" + std::string(1, d) +
+             "' separators (give each value once, e.g. 5,12)";
+  }
+  return {};
+}
+
 }  // namespace
 
 std::string cli_reference_markdown() {
@@ -757,6 +783,10 @@ int parse_line(CLI::App& app, const std::vector<std::string>& args, std::ostream
     const std::string unknown = unknown_option(cmd, path, args);
     if (!unknown.empty()) {
       err << "miner: usage error: " << unknown << "\nrun '" << path << " --help' for usage\n";
+      return static_cast<int>(ExitCode::kUsage);
+    }
+    if (const std::string empty = empty_list_piece(cmd, args); !empty.empty()) {
+      err << "miner: usage error: " << empty << "\nrun '" << path << " --help' for usage\n";
       return static_cast<int>(ExitCode::kUsage);
     }
   }

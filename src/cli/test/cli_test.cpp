@@ -457,6 +457,13 @@ TEST_CASE("Fifth campaign: empty shards, coinciding ends, far clouds and shard p
                                dir() + "/part-paper.md"});
   CHECK(paper.code == 1);
   CHECK_THAT(paper.err, Contains(part + ": is a part of a sharded dataset") && Contains("dataset --merge"));
+  // A corrupt folder is refused before any campaign (seventh campaign C5), naming the shard.
+  const std::string corrupt = dir() + "/paper-corrupt-data";
+  REQUIRE(miner_cli({"dataset", "--preset", "indoor", "--count", "2", "--test-count", "1", "--out", corrupt, "--quiet"}).code == 0);
+  std::filesystem::resize_file(corrupt + "/test-00000.bin", 10);
+  const Run early = miner_cli({"bench", "paper", "--heuristic-data", corrupt, "--out", dir() + "/paper-corrupt.md", "--quiet"});
+  CHECK(early.code == 1);
+  CHECK_THAT(early.err, Contains("test-00000.bin"));
   // And `dataset` itself says which samples a part holds (U12).
   const Run part_summary = miner_cli({"dataset", "--preset", "indoor", "--count", "4", "--test-count", "2", "--shard-size",
                                       "1", "--shard", "1/2", "--out", dir() + "/part-5th-b"});
@@ -796,7 +803,8 @@ TEST_CASE("No output replaces an input, and outputs are probed for writing befor
   std::filesystem::create_directories(holder);
   const std::string scenario = holder + "/s.json";
   std::ofstream(scenario) << "{}\n";  // refused before it is read
-  std::ofstream(holder + "/summary.json") << "{}\n";  // an earlier run folder, or the folder rule answers first
+  // An earlier run folder (its summary.json carries the run's format), or the folder rule answers first.
+  std::ofstream(holder + "/summary.json") << R"({"format": "miner-flight-summary-v1"})" << "\n";
   const Run inside = miner_cli({"fly", "--scenario", scenario, "--out", holder});
   CHECK(inside.code == 2);
   CHECK_THAT(inside.err, Contains("is, or holds, the input"));
@@ -807,7 +815,7 @@ TEST_CASE("No output replaces an input, and outputs are probed for writing befor
   std::filesystem::create_directories(data);
   std::filesystem::copy_file(std::string(MINER_SOURCE_DIR) + "/fixtures/maps/indoor-1.json", data + "/path.json",
                              std::filesystem::copy_options::overwrite_existing);
-  std::ofstream(data + "/summary.json") << "{}\n";
+  std::ofstream(data + "/summary.json") << R"({"format": "miner-flight-summary-v1"})" << "\n";
   miner::Json sc = miner::read_json_file(std::string(MINER_SOURCE_DIR) + "/fixtures/scenarios/default.json");
   sc["map"] = "fly-data/path.json";
   sc["vehicle"] = std::string(MINER_SOURCE_DIR) + "/fixtures/vehicles/n3-1500g.json";
@@ -913,6 +921,19 @@ TEST_CASE("A figure folder carries a manifest and a later run with other steps r
                                  user + "/suite.md", "--quiet"});
   CHECK(refused.code == 1);
   CHECK_THAT(refused.err, Contains("holds figures.json, which is not a \"miner-figures-v1\" file"));
+}
+
+TEST_CASE("A list option's value with an empty piece is refused, not shortened", "[REQ-CLI-002]") {
+  // Issue 20, seventh campaign C10: `--segments 5,` ran as `--segments 5`.
+  for (const char* bad : {"5,", ",5", "5,,12"}) {
+    const Run r = miner_cli({"bench", "backend", "--segments", bad, "--budget", "0.001"});
+    INFO(bad);
+    CHECK(r.code == 2);
+    CHECK_THAT(r.err, Contains("--segments: \"" + std::string(bad) + "\" has an empty value"));
+  }
+  const Run eq = miner_cli({"bench", "backend", "--segments=5,", "--budget", "0.001"});
+  CHECK(eq.code == 2);
+  CHECK_THAT(eq.err, Contains("has an empty value"));
 }
 
 TEST_CASE("A real option written as negative zero reads as 0", "[REQ-CLI-002]") {
@@ -1369,6 +1390,7 @@ TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[RE
     // Third campaign: counts that wrap or are not whole, times below zero or absurd, a stage after
     // the run's end, an unsolved run with a cost, unknown keys in the summaries and throughput.
     doctor([&](miner::Json& d) { solved(d)["first"]["nodes"] = -3; }, "first.nodes: expected null or an integer >= 0");
+    doctor([&](miner::Json& d) { solved(d)["first"]["nodes"] = 1000000000; }, "first.nodes: 1000000000 vertices at iteration");
     doctor([&](miner::Json& d) { solved(d)["iterations"] = 99.5; }, "iterations: expected null or an integer >= 0");
     doctor([&](miner::Json& d) { solved(d)["first"]["time_ms"] = -1.0; }, "time_ms: a time must be in [0, 1e9] ms");
     doctor([&](miner::Json& d) { solved(d)["first"]["time_ms"] = 1e300; }, "time_ms: a time must be in [0, 1e9] ms");

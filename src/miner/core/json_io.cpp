@@ -112,7 +112,14 @@ Json parse_json(const std::string& text, const std::string& origin) {
       const bool whole = parsed_end == token.c_str() + token.size();
       if (whole && bad_number.empty() &&
           ((nonzero && std::fabs(v) < std::numeric_limits<double>::min()) || std::isinf(v))) {
-        bad_number = "the number " + token + " at byte " + std::to_string(i) + " is " +
+        // A long literal is shown by its start and length, not echoed whole (seventh campaign C1:
+        // 400 digits in one message).
+        constexpr std::size_t kShownDigits = 24;
+        const std::string shown = token.size() <= kShownDigits
+                                      ? token
+                                      : token.substr(0, kShownDigits) + "... (" + std::to_string(token.size()) +
+                                            " characters)";
+        bad_number = "the number " + shown + " at byte " + std::to_string(i) + " is " +
                      (std::isinf(v) ? "beyond the largest double" : "below the smallest normal double (2.2e-308)") +
                      ": it would not be read as written";
         bad_number_byte = i;

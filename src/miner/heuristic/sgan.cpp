@@ -810,6 +810,17 @@ std::vector<double> reference_errors(const Sgan& sgan, const std::string& refere
   if (meta.has("weights")) (void)meta.at("weights").string();
   const JsonField samples = meta.at("samples");
   if (samples.integer() < 1) samples.fail("must be >= 1");
+  // Every tensor belongs to a sample the meta counts: one of a sample past meta.samples would be
+  // left unchecked (seventh campaign C11: a second sample was ignored without notice).
+  for (const auto& [name, tensor] : ref.tensors) {
+    const std::size_t dot = name.find('.');
+    const std::string index = name.substr(0, dot);
+    const bool numbered = dot != std::string::npos && !index.empty() && index.size() <= 9 &&
+                          index.find_first_not_of("0123456789") == std::string::npos;
+    if (!numbered || std::stoll(index) >= samples.integer())
+      samples.fail("the file holds the tensor \"" + name + "\", which is not one of samples 0.." +
+                   std::to_string(samples.integer() - 1) + " (tensors are named <sample>.<input or output>)");
+  }
   // An input the network is given must be finite: a NaN there was reported as the weights and
   // the reference not belonging together (sixth campaign U8). Named by tensor and element.
   const auto finite_input = [&](const std::string& name, const std::vector<int>& tensor_shape) -> const std::vector<float>& {
@@ -834,6 +845,13 @@ std::vector<double> reference_errors(const Sgan& sgan, const std::string& refere
     for (std::size_t i = 0; i < out.size(); ++i) {
       const double diff = std::abs(static_cast<double>(out[i]) - static_cast<double>(want[i]));
       // std::max would skip a NaN and report agreement (issue 20: an all-NaN reference "agreed").
+      // The inputs are finite (checked above): a non-finite C++ output is the weights' overflow,
+      // a non-finite reference output the reference's fault (seventh campaign C2: the weights'
+      // overflow was blamed on the reference).
+      if (!std::isfinite(out[i]))
+        throw Error(sgan.path() + ": the weights overflow a layer: on " + reference_path + "'s inputs, " + p + "output[" +
+                    std::to_string(i) + "] is " + std::to_string(out[i]) + " (the reference has " +
+                    std::to_string(want[i]) + ")");
       if (!std::isfinite(diff))
         throw Error(reference_path + ": " + p + "output[" + std::to_string(i) + "]: C++ gives " +
                     std::to_string(out[i]) + ", the reference " + std::to_string(want[i]) +

@@ -58,8 +58,9 @@ Scenario scenario_from_json(const Json& doc, const std::string& origin, const st
     if (s.name.empty() || s.name.size() > 128 || s.name[0] == '.' ||
         s.name.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789._+-") !=
             std::string::npos)
-      root.at("name").fail("must be 1 to 128 letters, digits or . _ + - not starting with '.', got \"" + s.name +
-                           "\"");
+      // Quoted as JSON writes it, so a newline in the name is shown as \n (seventh campaign C7).
+      root.at("name").fail("must be 1 to 128 letters, digits or . _ + - not starting with '.', got " +
+                           root.at("name").value().dump());
   }
 
   const JsonField map_field = root.at("map");
@@ -76,8 +77,17 @@ Scenario scenario_from_json(const Json& doc, const std::string& origin, const st
   }
   if (root.has("vehicle")) {
     const JsonField v = root.at("vehicle");
-    s.vehicle = v.value().is_string() ? load_vehicle(resolve(base_dir, v.string()))
-                                      : vehicle_from_json(v.value(), origin + ": vehicle");
+    if (v.value().is_string()) {
+      // A vehicle file that cannot be read is named as the scenario's field, as the map is
+      // (seventh campaign C3: "nope.json: cannot open file" named neither).
+      try {
+        s.vehicle = load_vehicle(resolve(base_dir, v.string()));
+      } catch (const Error& e) {
+        v.fail(e.what());
+      }
+    } else {
+      s.vehicle = vehicle_from_json(v.value(), origin + ": vehicle");
+    }
   }
 
   const auto& query = s.map->query();
@@ -291,8 +301,13 @@ Json self_contained_scenario(Json doc, const std::string& base_dir) {
                                 .string();
     }
   }
-  if (doc.contains("vehicle") && doc["vehicle"].is_string())
-    doc["vehicle"] = read_json_file(resolve(base_dir, doc["vehicle"].get<std::string>()));
+  if (doc.contains("vehicle") && doc["vehicle"].is_string()) {
+    try {
+      doc["vehicle"] = read_json_file(resolve(base_dir, doc["vehicle"].get<std::string>()));
+    } catch (const Error&) {
+      // left as the path: scenario_from_json names the fault through the scenario's field
+    }
+  }
   for (const auto& [block, key] : {std::pair{"trajectory", "file"}, std::pair{"planner", "weights"}}) {
     if (doc.contains(block) && doc[block].is_object() && doc[block].contains(key) && doc[block][key].is_string())
       doc[block][key] = absolute(doc[block][key].get<std::string>());

@@ -258,12 +258,19 @@ AllocationResult optimise_allocation(const MincoProblem& problem, const Allocati
     // The objective or its gradient not finite where Ceres starts: the problem lies outside
     // what double precision can optimise (issue 20, fifth campaign: rho 1e9 with limits 1e6
     // gave an 81 s segment, "Initial cost and jacobian evaluation failed", and exit 0).
+    // The legs' lengths are named too: a 1e6 m leg was blamed on rho and the limits alone
+    // (seventh campaign C9).
     if (summary.termination_type == ceres::FAILURE &&
-        summary.message.rfind("Initial cost and jacobian evaluation failed", 0) == 0)
+        summary.message.rfind("Initial cost and jacobian evaluation failed", 0) == 0) {
+      double longest = 0.0;
+      for (Eigen::Index i = 0; i + 1 < problem.points.rows(); ++i)
+        longest = std::max(longest, (problem.points.row(i + 1) - problem.points.row(i)).norm());
       throw Error("allocation: the optimiser could not evaluate the objective J + rho sum T or its gradient at the "
-                  "start (Ceres: " + summary.message + "): rho " + short_number(o.rho) + " and the limits (v_max " +
-                  short_number(o.limits.v_max) + ", a_max " + short_number(o.limits.a_max) +
-                  ") put it beyond double precision; use a smaller rho or tighter limits, or give durations");
+                  "start (Ceres: " + summary.message + "): rho " + short_number(o.rho) + ", the limits (v_max " +
+                  short_number(o.limits.v_max) + ", a_max " + short_number(o.limits.a_max) + ") and legs up to " +
+                  short_number(longest) + " m long put it beyond double precision; use a smaller rho, tighter limits "
+                  "or shorter legs, or give durations");
+    }
     for (std::size_t i = 0; i < M; ++i) T[i] = std::exp(tau[i]);
     Evaluation e;
     if (evaluate(base, T, o, solver, e) && e.F < best.F) best = std::move(e);  // never worse than before

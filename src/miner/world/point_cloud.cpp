@@ -495,7 +495,12 @@ std::shared_ptr<const VoxelLayer> integrate_clouds(const std::vector<CloudScan>&
                   " lies beyond OctoMap's key range at this resolution (32767 voxels from the origin)");
     finite_points += scans[s].cloud.points.size();
   }
-  if (finite_points == 0) throw Error("point clouds: no finite point to integrate (non-finite points are skipped)");
+  // Named by the clouds' files (seventh campaign C8: an empty PLY named none).
+  if (finite_points == 0) {
+    std::string names;
+    for (std::size_t s = 0; s < scans.size(); ++s) names += (s ? ", " : "") + label(s);
+    throw Error(names + ": no finite point to integrate (non-finite points are skipped)");
+  }
   // Each point's ray walks |point - origin| / res voxels (at most max_range / res): bound the
   // total before OctoMap starts (it integrates ~1e7 voxels per second).
   constexpr double kMaxRaySteps = 2e9;

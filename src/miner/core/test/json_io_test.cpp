@@ -83,6 +83,9 @@ TEST_CASE("A number the JSON library would not read as written is refused, namin
                     Contains("s.json: the number 1e-400 at byte 17 is below the smallest normal double"));
   CHECK_THROWS_WITH(miner::parse_json(R"({"v": [1, -2.5e-320]})", "s.json"), Contains("-2.5e-320"));
   CHECK_THROWS_WITH(miner::parse_json(R"({"v": 1e400})", "s.json"), Contains("beyond the largest double"));
+  // A long literal is shown by its start and its length (seventh campaign C1).
+  CHECK_THROWS_WITH(miner::parse_json("{\"v\": 1" + std::string(400, '0') + "}", "s.json"),
+                    Contains("the number 100000000000000000000000... (401 characters) at byte 6 is beyond the largest double"));
   // Zeros written any way, the smallest normal double and ordinary numbers are read.
   const miner::Json ok = miner::parse_json(R"({"a": 0, "b": -0.0, "c": 0e-500, "d": 2.3e-308, "e": -12.5e3, "k1e-400": "1e-400"})", "ok.json");
   CHECK(ok["c"].get<double>() == 0.0);

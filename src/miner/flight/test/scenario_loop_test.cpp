@@ -86,6 +86,15 @@ TEST_CASE("Bad scenarios are refused before flight with the fault named", "[REQ-
   doc = default_doc();
   doc["trajectory"]["a_max"] = 9.0;
   expect_scenario_error(doc, "deg of tilt");
+  // Seventh campaign C3: a vehicle file that cannot be read is named through the field; C7: a
+  // name with a newline is quoted with the newline escaped.
+  doc = default_doc();
+  doc["vehicle"] = "no-such-vehicle.json";
+  expect_scenario_error(doc, ": vehicle: ");
+  expect_scenario_error(doc, "no-such-vehicle.json: cannot open");
+  doc = default_doc();
+  doc["name"] = "two\nlines";
+  expect_scenario_error(doc, "name: must be 1 to 128 letters, digits or . _ + - not starting with '.', got \"two\\nlines\"");
   doc = default_doc();
   doc["pose"]["rate_hz"] = 60;
   expect_scenario_error(doc, "must divide the N3 loop rate");

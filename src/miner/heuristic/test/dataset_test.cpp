@@ -503,3 +503,37 @@ TEST_CASE("The progress bar draws only to a given stream and ends its line", "[R
   miner::ProgressBar quiet(nullptr, "work", 4);
   quiet.update(2);  // no stream: nothing happens, nothing crashes
 }
+
+TEST_CASE("Channel S is exactly the clipped cubes around the start and goal cells", "[REQ-HEUR-002]") {
+  // Held-out audit 5 (h5-heur-04): S losing the cubes' top layer kept 27 <= count <= 54.
+  namespace h = miner::heuristic;
+  const miner::world::Box bounds{{0, 0, 0}, {8, 8, 8}};
+  const Eigen::Vector3i dims(8, 8, 8);
+  for (const auto& [start, goal] : {std::pair{Eigen::Vector3d(1.5, 1.5, 1.5), Eigen::Vector3d(6.5, 6.5, 6.5)},
+                                    std::pair{Eigen::Vector3d(0.5, 3.5, 0.5), Eigen::Vector3d(7.5, 7.5, 7.5)}}) {
+    const std::vector<std::uint8_t> s = h::encode_state(bounds, dims, start, goal, 1);
+    for (int k = 0; k < 8; ++k)
+      for (int j = 0; j < 8; ++j)
+        for (int i = 0; i < 8; ++i) {
+          const Eigen::Vector3i c(i, j, k);
+          const auto near = [&](const Eigen::Vector3d& p) {
+            return ((c - p.cast<int>()).cwiseAbs().array() <= 1).all();  // cells of 1 m: floor of p
+          };
+          INFO(i << " " << j << " " << k);
+          CHECK((s[h::cell_index(dims, i, j, k)] != 0) == (near(start) || near(goal)));
+        }
+  }
+}
+
+TEST_CASE("A cell whose faces lie on a single grown box's faces is solid", "[REQ-HEUR-002][REQ-HEUR-012]") {
+  // Held-out audit 5 (h5-heur-02): a cell whose top face lies exactly on the box's top face was
+  // counted partial; solid cells in the other tests lay strictly inside boxes.
+  namespace h = miner::heuristic;
+  const miner::world::Map map(miner::world::Box{{0, 0, 0}, {4, 4, 4}}, 1.0, {miner::world::Box{{0, 0, 0}, {2, 2, 2}}});
+  const Eigen::Vector3i dims(4, 4, 4);
+  const std::vector<std::uint8_t> e = h::encode_environment(map, dims, 0.0);
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 2; ++i) CHECK(e[h::cell_index(dims, i, j, k)] == h::kSolid);
+  CHECK(e[h::cell_index(dims, 3, 3, 3)] == h::kFree);
+}

@@ -184,6 +184,12 @@ TEST_CASE("A reference's meta refuses an unknown key, suggesting the known one",
   miner::write_file_atomic(path, with_header(shipped, h));
   CHECK_THROWS_WITH(heuristic::reference_errors(heuristic::Sgan::builtin(), path),
                     Contains("meta.sampels") && Contains("samples"));
+  // A sample the meta does not count is not skipped silently (seventh campaign C11).
+  h = header_of(shipped);
+  h["meta"]["samples"] = 1;
+  miner::write_file_atomic(path, with_header(shipped, h));
+  CHECK_THROWS_WITH(heuristic::reference_errors(heuristic::Sgan::builtin(), path),
+                    Contains("meta.samples: the file holds the tensor \"1.") && Contains("not one of samples 0..0"));
   h = header_of(shipped);
   h["meta"]["weights"] = 7;
   miner::write_file_atomic(path, with_header(shipped, h));
@@ -209,6 +215,9 @@ TEST_CASE("Weights that overflow a layer give an error naming the file, never a 
   miner::Rng rng(1);
   CHECK_THROWS_WITH(g.predict(env, state, passability_for(g, env), miner::world::Box{{0, 0, 0}, {10, 10, 5}}, 0.2, rng),
                     Contains("huge.bin") && Contains("not a probability"));
+  // `sgan check` blames the weights too, not the reference (seventh campaign C2).
+  CHECK_THROWS_WITH(heuristic::reference_errors(g, kFixtures + "reference.bin"),
+                    Contains("huge.bin: the weights overflow a layer") && Contains("0.output["));
 }
 
 TEST_CASE("MINER's own kernels and oneDNN's agree with each other and with PyTorch", "[REQ-HEUR-005]") {

@@ -145,7 +145,7 @@ TEST_CASE("An objective the optimiser cannot evaluate is refused, not answered",
   o.limits = Limits{1e6, 1e6};
   o.rho = 1e9;
   CHECK_THROWS_WITH(optimise_allocation(p, o), Contains("allocation: the optimiser could not evaluate") &&
-                                                   Contains("use a smaller rho or tighter limits"));
+                                                   Contains("use a smaller rho, tighter limits or shorter legs"));
 }
 
 TEST_CASE("Optimised allocation bounds its work: more segments than it optimises are refused up front", "[REQ-TRAJ-011]") {

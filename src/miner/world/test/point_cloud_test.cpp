@@ -304,6 +304,8 @@ TEST_CASE("Malformed point clouds are refused naming the fault, never crash", "[
   PointCloud none;
   none.skipped = 3;
   CHECK_THROWS_WITH(integrate_clouds({{none, V(0, 0, 0), ""}}, 0.05, 0.0), Contains("no finite point"));
+  CHECK_THROWS_WITH(integrate_clouds({{none, V(0, 0, 0), "empty.ply"}}, 0.05, 0.0),
+                    Contains("empty.ply: no finite point"));  // named by its file (seventh campaign C8)
   PointCloud one;
   one.points = {V(1, 0, 0)};
   CHECK_THROWS_WITH(integrate_clouds({{one, V(1e308, 0, 0), ""}}, 0.05, 0.0), Contains("cloud 0: the sensor origin"));

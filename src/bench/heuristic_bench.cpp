@@ -82,6 +82,9 @@ HeuristicBenchResult run_heuristic_bench(const HeuristicBenchOptions& o, std::os
                   std::to_string(f.split.size()) + " samples (give at most that many, or " +
                   (o.samples_option == "--samples" ? "0 for all)" : "leave the option out for all)"));
     if (o.samples > 0) f.split.resize(static_cast<std::size_t>(o.samples));
+    // The measured samples are the generator's: each is made again and compared byte for byte,
+    // so truth edited within its levels and re-hashed is refused (seventh campaign W2).
+    heuristic::verify_samples(data, f.split);
     const Eigen::Vector3i dims(meta["dims"][0].get<int>(), meta["dims"][1].get<int>(), meta["dims"][2].get<int>());
     if (dims != sgan.architecture().dims)
       throw Error(data + ": the dataset's grid differs from the weights' grid (" + sgan.path() + ")");

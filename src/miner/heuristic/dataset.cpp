@@ -302,6 +302,7 @@ void validate(const DatasetOptions& o) {
 Sample make_sample(const DatasetOptions& o, std::uint64_t k) {
   const world::GeneratorPreset preset = world::generator_preset(o.preset);
   Sample s;
+  s.k = k;
   s.map_seed = splitmix64(o.seed ^ k);
   const world::Map map = world::generate_map(preset, s.map_seed);
   const double r = preset.robot_radius;
@@ -541,6 +542,39 @@ void require_whole_split(const std::string& dir, const std::string& split, const
 }
 }  // namespace
 
+void verify_samples(const std::string& dir, const std::vector<Sample>& samples) {
+  const std::string origin = dir + "/dataset.json";
+  const Json doc = read_json_file(origin);
+  const DatasetLayout L = read_layout(doc, origin);  // checks every field used below
+  DatasetOptions o;
+  o.preset = doc["preset"].get<std::string>();
+  o.seed = L.seed;
+  o.dims = L.dims;
+  o.dilation = doc["dilation"].get<int>();
+  o.min_separation = doc["min_separation"].get<double>();
+  const char* const channels[] = {"environment", "state", "target", "passability"};
+  for (const Sample& read : samples) {
+    const Sample made = make_sample(o, read.k);
+    const std::string which = dir + ": sample k = " + std::to_string(read.k) + ": ";
+    const std::string why = " differs from the sample regenerated from dataset.json's options (the dataset was "
+                            "edited after it was written, or by another version of the generator)";
+    if (read.map_seed != made.map_seed || read.start != made.start || read.goal != made.goal ||
+        read.astar_cost != made.astar_cost)
+      throw Error(which + "its index entry (map_seed, start, goal or astar_cost)" + why);
+    const std::vector<std::uint8_t>* got[] = {&read.environment, &read.state, &read.target, &read.passability};
+    const std::vector<std::uint8_t>* want[] = {&made.environment, &made.state, &made.target, &made.passability};
+    for (int c = 0; c < 4; ++c)
+      for (std::size_t i = 0; i < want[c]->size(); ++i)
+        if (i >= got[c]->size() || (*got[c])[i] != (*want[c])[i]) {
+          const Eigen::Vector3i cell = cell_coords(o.dims, i);
+          throw Error(which + "channel " + channels[c] + " at cell (" + std::to_string(cell.x()) + ", " +
+                      std::to_string(cell.y()) + ", " + std::to_string(cell.z()) + ") holds " +
+                      (i < got[c]->size() ? std::to_string((*got[c])[i]) : std::string("nothing")) + ", the generator " +
+                      std::to_string((*want[c])[i]) + ":" + why);
+        }
+  }
+}
+
 std::size_t split_samples_held(const std::string& dir, const std::string& split) {
   const int sp = split_index(split);
   const SplitLayout S = read_layout(read_json_file(dir + "/dataset.json"), dir + "/dataset.json").splits[sp];
@@ -560,6 +594,7 @@ std::vector<Sample> read_split(const std::string& dir, const std::string& split)
       const Json& meta = index[out.size()];
       const JsonField f(meta, split + "-index[" + std::to_string(out.size()) + "]", dir + "/" + S.index);
       Sample sample;
+      sample.k = meta.at("k").get<std::uint64_t>();
       sample.map_seed = meta.at("map_seed").get<std::uint64_t>();
       sample.start = f.at("start").vec3();
       sample.goal = f.at("goal").vec3();

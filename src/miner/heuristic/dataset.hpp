@@ -68,6 +68,7 @@ struct DatasetOptions {
 void validate(const DatasetOptions& o);
 
 struct Sample {
+  std::uint64_t k = 0;  ///< its number in the dataset (make_sample's k)
   std::uint64_t map_seed = 0;
   Eigen::Vector3d start = Eigen::Vector3d::Zero();
   Eigen::Vector3d goal = Eigen::Vector3d::Zero();
@@ -91,6 +92,12 @@ Json write_dataset(const DatasetOptions& o, const std::string& dir, std::ostream
 /// into `dir`, byte for byte the folder an unsharded run writes. Throws miner::Error
 /// naming the mismatch or the missing part; `dir` is written as a whole.
 Json merge_dataset_parts(const std::vector<std::string>& parts, const std::string& dir);
+
+/// Regenerates each of `samples` (read from the dataset folder `dir` by read_split) with
+/// make_sample from the folder's own options and the sample's k, and refuses the first that
+/// differs, naming the sample, the channel (or field) and the cell: a shard edited within its
+/// levels and re-hashed changed published figures silently (issue 20, seventh campaign W2).
+void verify_samples(const std::string& dir, const std::vector<Sample>& samples);
 
 /// The samples the folder holds of split `split`, from dataset.json alone (checked as read_split
 /// checks it: a part of a sharded dataset is refused, naming `dataset --merge`).

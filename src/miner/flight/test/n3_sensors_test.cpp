@@ -97,6 +97,23 @@ TEST_CASE("The N3 saturates tilt at 35 deg, thrust at 0-100 % and yaw rate at 15
   CHECK(flight::wrap_angle(fc.setpoint().yaw - yaw0) == Approx(deg2rad(150)).margin(deg2rad(150) * dt * 2));
 }
 
+TEST_CASE("N3 vertical-velocity mode holds altitude while tilted: thrust m g / cos(tilt)", "[REQ-FLIGHT-003]") {
+  // Held-out audit 5 (h5-flight-06): without the tilt cosine the vehicle sank while tilted; the
+  // thrust checks used thrust mode or saturation only.
+  const flight::VehicleParams v;
+  n3::Config config;
+  n3::FlightController fc(v, config);
+  const flight::QuadState hover = flight::hover_state(v, {0, 0, 5});
+  fc.obtain_control(0.0);
+  n3::Command hold;
+  hold.flag = n3::kHorizontalAngle | n3::kVerticalVelocity | n3::kYawAngle | n3::kFrameGround;
+  hold.x = deg2rad(30);  // roll 30 deg, vertical speed 0 at rest: no P or I term yet
+  REQUIRE(fc.submit(hold, 0.0) == n3::Status::kAccepted);
+  fc.step(config.latency_s, hover);
+  CHECK(fc.setpoint().roll == Approx(deg2rad(30)));
+  CHECK(fc.setpoint().thrust == Approx(v.mass * miner::kGravity / std::cos(deg2rad(30))).epsilon(1e-9));
+}
+
 TEST_CASE("N3 commands take effect only after the command latency", "[REQ-FLIGHT-003]") {
   const flight::VehicleParams v;
   n3::Config config;

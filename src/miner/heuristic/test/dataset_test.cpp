@@ -537,3 +537,28 @@ TEST_CASE("A cell whose faces lie on a single grown box's faces is solid", "[REQ
       for (int i = 0; i < 2; ++i) CHECK(e[h::cell_index(dims, i, j, k)] == h::kSolid);
   CHECK(e[h::cell_index(dims, 3, 3, 3)] == h::kFree);
 }
+
+TEST_CASE("A sample whose bytes differ from the generator's is refused naming the channel and cell", "[REQ-HEUR-001][REQ-REPORT-006]") {
+  // Issue 20, seventh campaign W2: T edited within its levels, the SHA-256 recomputed, was
+  // measured as the truth.
+  auto o = small_options();
+  o.dims = Eigen::Vector3i(8, 8, 4);
+  const std::string dir = temp_dir() + "/verify";
+  std::filesystem::remove_all(dir);
+  heuristic::write_dataset(o, dir, nullptr);
+  std::vector<heuristic::Sample> test = heuristic::read_split(dir, "test");
+  REQUIRE(test.size() == 1);
+  CHECK(test[0].k == 4);  // test samples follow the count
+  CHECK_NOTHROW(heuristic::verify_samples(dir, test));
+  auto edited = test;
+  const std::size_t cell = heuristic::cell_index(o.dims, 3, 2, 1);
+  edited[0].target[cell] ^= 1;
+  CHECK_THROWS_WITH(heuristic::verify_samples(dir, edited),
+                    Contains("sample k = 4: channel target at cell (3, 2, 1) holds") && Contains("regenerated"));
+  edited = test;
+  edited[0].environment[0] = edited[0].environment[0] == 0 ? 1 : 0;
+  CHECK_THROWS_WITH(heuristic::verify_samples(dir, edited), Contains("channel environment at cell (0, 0, 0)"));
+  edited = test;
+  edited[0].astar_cost += 1.0;
+  CHECK_THROWS_WITH(heuristic::verify_samples(dir, edited), Contains("its index entry"));
+}

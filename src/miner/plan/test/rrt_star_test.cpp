@@ -212,6 +212,12 @@ TEST_CASE("Invalid planner options and a missing or mismatched region are refuse
   o.guided_local_fraction = 0.5;
   o.steer_step = NAN;
   CHECK_THROWS_WITH(miner::plan::plan(problem, o, &region), Contains("steer_step"));
+  // A step below a tenth of the map's cells (seventh campaign H1: near sets grew with every vertex).
+  o.steer_step = 0.09 * problem.map->resolution();
+  CHECK_THROWS_WITH(miner::plan::plan(problem, o, &region), Contains("is below a tenth of the map's resolution"));
+  o.steer_step = 0.1 * problem.map->resolution();
+  o.max_iterations = 10;
+  CHECK_NOTHROW(miner::plan::plan(problem, o, &region));
   o.steer_step = 0;
   o.target_cost = INFINITY;
   CHECK_THROWS_WITH(miner::plan::plan(problem, o, &region), Contains("target_cost"));

@@ -92,3 +92,23 @@ TEST_CASE("A heuristic cell the voxel layer covers only in part is partial, not 
                          world::VoxelSource{full, world::UnknownPolicy::kFree, "", ""});
   CHECK(heuristic::encode_environment(whole, dims, 0.0)[heuristic::cell_index(dims, 0, 0, 0)] == kSolid);
 }
+
+TEST_CASE("P of a voxel map reads the voxel holding each sub-cell's centre", "[REQ-HEUR-015]") {
+  // Held-out audit 5 (h5-heur-05): sub-cells that read the voxel at their corner passed the tests,
+  // whose voxels lined up with the sub-cells. Here voxels of 0.2 m and sub-cells of 0.25 m: the
+  // occupied slab x in [0.4, 0.6] holds the corner x = 0.5 of the third sub-cell column but no
+  // sub-cell centre (0.125, 0.375, 0.625, 0.875), so the 1 m cell is partial and still passes on
+  // every axis.
+  const Eigen::Vector3i vdims(20, 20, 20);
+  std::vector<std::uint8_t> s(static_cast<std::size_t>(vdims.prod()), static_cast<std::uint8_t>(world::VoxelState::kFree));
+  for (int z = 0; z < 5; ++z)
+    for (int y = 0; y < 5; ++y)
+      s[(static_cast<std::size_t>(z) * 20 + static_cast<std::size_t>(y)) * 20 + 2] =
+          static_cast<std::uint8_t>(world::VoxelState::kOccupied);
+  auto layer = std::make_shared<const world::VoxelLayer>(Eigen::Vector3i::Zero(), 0.2, vdims, std::move(s));
+  const world::Map map = world::Map::from_voxels({layer, world::UnknownPolicy::kOccupied, "", ""});
+  const Eigen::Vector3i dims(4, 4, 4);
+  const heuristic::Encoding enc = heuristic::encode_environment_passability(map, dims, 0.0);
+  REQUIRE(enc.environment[heuristic::cell_index(dims, 0, 0, 0)] == kPartial);
+  CHECK(enc.passability[heuristic::cell_index(dims, 0, 0, 0)] == heuristic::kPassAll);
+}

@@ -176,3 +176,49 @@ TEST_CASE("A scan casts exactly the rays its bound counts: a full turn at the fi
   CHECK(scan_map(map, path, o).rays == 4 * 8 * 2);
   CHECK(scan_ray_bound(o, 2.5) == Approx(64.0));
 }
+
+TEST_CASE("The ray fan is centred on the heading: one ray goes straight ahead", "[REQ-WORLD-016]") {
+  // Held-out audit 5 (h5-world-02): a fan that starts at the heading instead of centring on it
+  // turned every ray by half a ray's spacing; nothing checked the rays' directions.
+  const Map map(Box{{0, 0, 0}, {12, 8, 4}}, 0.2, {Box{{6, 0, 0}, {6.4, 8, 4}}});
+  ScanOptions o = noiseless();
+  o.h_fov_deg = 90.0;
+  o.h_rays = 1;
+  o.v_fov_deg = 0.0;
+  o.v_rays = 1;
+  o.spin_at_ends = false;
+  const ScanResult scan = scan_map(map, {V(1, 4.1, 1.5), V(2, 4.1, 1.5)}, o);  // heading +x
+  std::size_t occupied = 0;
+  for (std::size_t i = 0; i < scan.layer->size(); ++i) {
+    if (scan.layer->state(i) != VoxelState::kOccupied) continue;
+    ++occupied;
+    const V c = scan.layer->cell_center(scan.layer->coords(i));
+    INFO(c.transpose());
+    CHECK(std::abs(c.y() - 4.1) <= 0.1 + 1e-9);  // the voxel holding y = 4.1, straight ahead
+    CHECK(std::abs(c.z() - 1.5) <= 0.1 + 1e-9);
+    CHECK(c.x() == Approx(6.1));                   // the wall's first voxel
+  }
+  CHECK(occupied >= 1);
+}
+
+TEST_CASE("The swept volume never frees a voxel an obstacle's corner reaches into", "[REQ-WORLD-016]") {
+  // Held-out audit 5 (h5-world-01): the sweep tested half a voxel's side instead of its half
+  // diagonal; the scene's faces lay on voxel edges, so no obstacle met a voxel only near its
+  // corner. Here the block's corner (5.19, 3.19) lies inside voxel [5.0, 5.2] x [3.0, 3.2], whose
+  // centre is 0.127 m from it: beyond half a side (0.1 m), within the half diagonal (0.173 m).
+  const Map map(Box{{0, 0, 0}, {12, 8, 4}}, 0.2, {Box{{5.19, 3.19, 0}, {6, 4, 4}}});
+  ScanOptions o = noiseless();
+  o.h_fov_deg = 10.0;
+  o.h_rays = 1;
+  o.v_fov_deg = 0.0;
+  o.v_rays = 1;
+  o.spin_at_ends = false;
+  o.body_radius = 1.0;  // the path at y = 2.5 sweeps the voxel (0.6 m away)
+  const ScanResult scan = scan_map(map, {V(3, 2.5, 1.5), V(4.8, 2.5, 1.5)}, o);
+  const Eigen::Vector3i corner = scan.layer->clamped_cell(V(5.1, 3.1, 1.5));
+  CHECK(scan.layer->cell_center(corner).isApprox(V(5.1, 3.1, 1.5)));
+  CHECK(scan.layer->state(scan.layer->index(corner.x(), corner.y(), corner.z())) != VoxelState::kFree);
+  // Its neighbour that the block does not reach is swept free.
+  const Eigen::Vector3i clear = scan.layer->clamped_cell(V(4.9, 3.1, 1.5));
+  CHECK(scan.layer->state(scan.layer->index(clear.x(), clear.y(), clear.z())) == VoxelState::kFree);
+}

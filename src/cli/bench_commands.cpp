@@ -61,20 +61,12 @@ void run_frontend(const FrontendOptions& o, std::ostream& out) {
 }
 
 /// A figure folder (bench paper, bench suite) is replaced only when it is an earlier one, told
-/// by its manifest (kFiguresMarker): checked before the work, for the default folder too.
+/// by its manifest (kFiguresMarker): the --figures option's own check, applied before the work
+/// to the folder used, the default one too.
 void require_figures_folder(const std::filesystem::path& folder) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  if (!fs::is_directory(folder, ec) || fs::is_empty(folder, ec)) return;
-  if (const std::string problem = folder_marker_problem(folder.string(), kFiguresMarker); !problem.empty())
+  std::string path = folder.string();
+  if (const std::string problem = output_folder_for(kFiguresMarker, {".svg", ".json"})(path); !problem.empty())
     throw Error(problem);
-  for (const auto& entry : fs::directory_iterator(folder, ec)) {
-    const std::string ext = entry.path().extension().string();
-    if (!entry.is_regular_file(ec) || (ext != ".svg" && ext != ".json"))
-      throw Error(folder.string() + ": the folder exists and holds \"" + entry.path().filename().string() +
-                  "\", which this command does not write: it is not an earlier output of this command, so it is not "
-                  "replaced (remove it or choose another folder)");
-  }
 }
 
 /// The figures and their manifest figures.json (format, command, files), written as one folder:

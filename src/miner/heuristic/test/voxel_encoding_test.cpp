@@ -29,6 +29,16 @@ world::Map layer_map(world::UnknownPolicy policy) {
   return world::Map::from_voxels({layer, policy, "", ""});
 }
 
+/// Bounds [0, 4]^3 m at 0.5 m holding a layer of `voxels` occupied voxels from the origin;
+/// the space the layer leaves out is unknown, read as free.
+world::Map occupied_block(const Eigen::Vector3i& voxels) {
+  auto layer = std::make_shared<const world::VoxelLayer>(
+      Eigen::Vector3i::Zero(), 0.5, voxels,
+      std::vector<std::uint8_t>(static_cast<std::size_t>(voxels.prod()), static_cast<std::uint8_t>(world::VoxelState::kOccupied)));
+  return world::Map(world::Box{{0, 0, 0}, {4, 4, 4}}, 0.5, {}, std::nullopt,
+                    world::VoxelSource{layer, world::UnknownPolicy::kFree, "", ""});
+}
+
 }  // namespace
 
 TEST_CASE("Channel E of a voxel map comes from its occupancy", "[REQ-HEUR-012]") {
@@ -73,23 +83,13 @@ TEST_CASE("A heuristic cell the voxel layer covers only in part is partial, not 
   // the other tests always covered whole cells. A fully occupied layer of 3 x 4 x 4 voxels of
   // 0.5 m (x in [0, 1.5] m) inside bounds of 4 m whose unknown space is free: the 2 m cells at
   // x in [0, 2] hold only occupied voxel centres, yet 0.5 m of each is free.
-  const Eigen::Vector3i vdims(3, 4, 4);
-  auto layer = std::make_shared<const world::VoxelLayer>(
-      Eigen::Vector3i::Zero(), 0.5, vdims,
-      std::vector<std::uint8_t>(static_cast<std::size_t>(vdims.prod()), static_cast<std::uint8_t>(world::VoxelState::kOccupied)));
-  const world::Map map(world::Box{{0, 0, 0}, {4, 4, 4}}, 0.5, {}, std::nullopt,
-                       world::VoxelSource{layer, world::UnknownPolicy::kFree, "", ""});
+  const world::Map map = occupied_block(Eigen::Vector3i(3, 4, 4));
   const Eigen::Vector3i dims(2, 2, 2);
   const std::vector<std::uint8_t> e = heuristic::encode_environment(map, dims, 0.0);
   CHECK(e[heuristic::cell_index(dims, 0, 0, 0)] == kPartial);
   CHECK(e[heuristic::cell_index(dims, 1, 0, 0)] == kFree);
   // Covered whole (the layer widened to x in [0, 2] m), the same cell is solid.
-  const Eigen::Vector3i wide(4, 4, 4);
-  auto full = std::make_shared<const world::VoxelLayer>(
-      Eigen::Vector3i::Zero(), 0.5, wide,
-      std::vector<std::uint8_t>(static_cast<std::size_t>(wide.prod()), static_cast<std::uint8_t>(world::VoxelState::kOccupied)));
-  const world::Map whole(world::Box{{0, 0, 0}, {4, 4, 4}}, 0.5, {}, std::nullopt,
-                         world::VoxelSource{full, world::UnknownPolicy::kFree, "", ""});
+  const world::Map whole = occupied_block(Eigen::Vector3i(4, 4, 4));
   CHECK(heuristic::encode_environment(whole, dims, 0.0)[heuristic::cell_index(dims, 0, 0, 0)] == kSolid);
 }
 

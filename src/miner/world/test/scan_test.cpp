@@ -25,6 +25,18 @@ ScanOptions noiseless() {
   return o;
 }
 
+/// One noiseless horizontal ray straight along the heading (a fan of h_fov with one ray, no
+/// vertical spread, no turn at the ends): a scan whose every ray is known.
+ScanOptions one_ray(double h_fov_deg) {
+  ScanOptions o = noiseless();
+  o.h_fov_deg = h_fov_deg;
+  o.h_rays = 1;
+  o.v_fov_deg = 0.0;
+  o.v_rays = 1;
+  o.spin_at_ends = false;
+  return o;
+}
+
 }  // namespace
 
 TEST_CASE("A scan marks free space along rays, surfaces as occupied, the rest unknown", "[REQ-WORLD-016]") {
@@ -181,12 +193,7 @@ TEST_CASE("The ray fan is centred on the heading: one ray goes straight ahead", 
   // Held-out audit 5 (h5-world-02): a fan that starts at the heading instead of centring on it
   // turned every ray by half a ray's spacing; nothing checked the rays' directions.
   const Map map(Box{{0, 0, 0}, {12, 8, 4}}, 0.2, {Box{{6, 0, 0}, {6.4, 8, 4}}});
-  ScanOptions o = noiseless();
-  o.h_fov_deg = 90.0;
-  o.h_rays = 1;
-  o.v_fov_deg = 0.0;
-  o.v_rays = 1;
-  o.spin_at_ends = false;
+  const ScanOptions o = one_ray(90.0);
   const ScanResult scan = scan_map(map, {V(1, 4.1, 1.5), V(2, 4.1, 1.5)}, o);  // heading +x
   std::size_t occupied = 0;
   for (std::size_t i = 0; i < scan.layer->size(); ++i) {
@@ -207,12 +214,7 @@ TEST_CASE("The swept volume never frees a voxel an obstacle's corner reaches int
   // corner. Here the block's corner (5.19, 3.19) lies inside voxel [5.0, 5.2] x [3.0, 3.2], whose
   // centre is 0.127 m from it: beyond half a side (0.1 m), within the half diagonal (0.173 m).
   const Map map(Box{{0, 0, 0}, {12, 8, 4}}, 0.2, {Box{{5.19, 3.19, 0}, {6, 4, 4}}});
-  ScanOptions o = noiseless();
-  o.h_fov_deg = 10.0;
-  o.h_rays = 1;
-  o.v_fov_deg = 0.0;
-  o.v_rays = 1;
-  o.spin_at_ends = false;
+  ScanOptions o = one_ray(10.0);
   o.body_radius = 1.0;  // the path at y = 2.5 sweeps the voxel (0.6 m away)
   const ScanResult scan = scan_map(map, {V(3, 2.5, 1.5), V(4.8, 2.5, 1.5)}, o);
   const Eigen::Vector3i corner = scan.layer->clamped_cell(V(5.1, 3.1, 1.5));

@@ -12,6 +12,7 @@
 #include "cli/cli.hpp"
 #include "miner/core/error.hpp"
 #include "miner/core/stopwatch.hpp"
+#include "miner/core/text.hpp"
 #include "miner/flight/closed_loop.hpp"
 #include "miner/pipeline/run_folder.hpp"
 #include "miner/report/flight_report.hpp"
@@ -99,6 +100,11 @@ void run_fly(const FlyCliOptions& o, std::ostream& out) {
     for (std::size_t i = 0; i < names.size(); ++i) out << (i ? ", " : "") << names[i];
     out << ")\nreport: " << dir << "/report.html\n";
   }
+  if (r.left_world)
+    throw NoSolution("the vehicle left the map at t = " + short_number(r.left_world_time_s) + " s at " +
+                     format_point(r.left_world_position) + " (bounds " + format_point(s.map->bounds().min) + " to " +
+                     format_point(s.map->bounds().max) + "): the flight stopped there, collisions " +
+                     std::to_string(r.collisions));
   if (!r.goal_reached)
     throw NoSolution("the flight did not reach the goal (final error " + std::to_string(r.final_position_error) +
                      " m, speed " + std::to_string(r.final_speed) + " m/s, collisions " +

@@ -1906,3 +1906,24 @@ TEST_CASE("miner map import turns a point cloud into a voxel map that plans", "[
   CHECK_THAT(miner_cli({"map", "import", "--cloud", write("c.txt", "x"), "--origin", "0", "0", "0", "--out", bt}).err,
              Contains("must be a .ply or .pcd file"));
 }
+
+TEST_CASE("A flight that leaves the map stops there: exit 3 naming when and where", "[REQ-FLIGHT-009][REQ-CLI-001]") {
+  // Issue 20, seventh campaign: such a vehicle flew on hundreds of metres off its map and the
+  // flight was blamed on "did not reach the goal". Half the thrust the controller assumes
+  // (plant mismatch) cannot be flown: the vehicle sinks through the floor of the 10 x 10 x 5 m map.
+  miner::Json sc = miner::read_json_file(std::string(MINER_SOURCE_DIR) + "/fixtures/scenarios/default.json");
+  sc["map"] = std::string(MINER_SOURCE_DIR) + "/fixtures/maps/indoor-1.json";
+  sc["vehicle"] = std::string(MINER_SOURCE_DIR) + "/fixtures/vehicles/n3-1500g.json";
+  sc["mismatch"] = {{"thrust_coefficient", 0.5}};
+  const std::string scenario = write("sinks.json", sc.dump());
+  const std::string run = dir() + "/sinks-run";
+  const Run r = miner_cli({"fly", "--scenario", scenario, "--out", run, "--quiet"});
+  CHECK(r.code == 3);
+  CHECK_THAT(r.err, Contains("the vehicle left the map at t = ") && Contains("(bounds (0, 0, 0) to (10, 10, 5))") &&
+                        Contains("the flight stopped there"));
+  const miner::Json summary = miner::read_json_file(run + "/summary.json");
+  REQUIRE(summary["left_map"].is_object());
+  CHECK(summary["left_map"]["position"][2].get<double>() < 0.0);  // through the floor
+  CHECK(summary["flight_time_s"].get<double>() == summary["left_map"]["time_s"].get<double>());
+  CHECK(summary["goal_reached"] == false);
+}

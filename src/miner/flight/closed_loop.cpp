@@ -134,8 +134,18 @@ FlightResult fly(const FlightSetup& s, const ReferenceTrajectory& reference, con
   bool was_colliding = false;
   n3::Command last_command;
 
+  long ticks = total_ticks;
   for (long k = 0; k < total_ticks; ++k) {
     const double t = static_cast<double>(k) * dt;
+    // Outside the world nothing is left to simulate (no map, no obstacles, no goal to fly
+    // back to): the flight ends the first N3 tick the vehicle is out, and says where.
+    if (s.world && !s.world->contains(truth.p)) {
+      out.left_world = true;
+      out.left_world_time_s = t;
+      out.left_world_position = truth.p;
+      ticks = k;
+      break;
+    }
     if (s.wind.enabled) {
       wind = wind_model.step(t, truth.v);
       wind_sq += wind.squaredNorm();
@@ -249,8 +259,8 @@ FlightResult fly(const FlightSetup& s, const ReferenceTrajectory& reference, con
     }
   }
 
-  out.ticks = total_ticks;
-  out.flight_time = static_cast<double>(total_ticks) * dt;
+  out.ticks = ticks;
+  out.flight_time = static_cast<double>(ticks) * dt;
   if (tracked > 0) {
     out.position_mse = sum_p2 / static_cast<double>(tracked);
     out.velocity_mse = sum_v2 / static_cast<double>(tracked);
@@ -262,7 +272,7 @@ FlightResult fly(const FlightSetup& s, const ReferenceTrajectory& reference, con
   // At rest means below the speed the position loop holds against sensor noise.
   constexpr double kRestSpeed = 0.2;
   out.goal_reached = out.final_position_error <= s.goal_tolerance && out.final_speed <= kRestSpeed &&
-                     out.collisions == 0;
+                     out.collisions == 0 && !out.left_world;
   out.final_sigma = ekf.covariance().diagonal().cwiseSqrt();
   out.final_estimate = ekf.current();
   out.final_truth = NavState{truth.p, truth.v, truth.q, imu.accel_bias(), imu.gyro_bias()};
@@ -275,7 +285,7 @@ FlightResult fly(const FlightSetup& s, const ReferenceTrajectory& reference, con
   out.rhs_evaluations = integrator.rhs_evaluations();
   out.pose_losses = pose_source.losses();
   out.pose_drift = pose_source.drift();
-  out.wind_rms = total_ticks > 0 ? std::sqrt(wind_sq / static_cast<double>(total_ticks)) : 0.0;
+  out.wind_rms = ticks > 0 ? std::sqrt(wind_sq / static_cast<double>(ticks)) : 0.0;
   out.battery_used_wh = battery.energy_used_wh();
 
   double length = 0.0;
@@ -300,6 +310,9 @@ FlightResult fly(const FlightSetup& s, const ReferenceTrajectory& reference, con
       {"final_speed", out.final_speed},
       {"collisions", out.collisions},
       {"collision_time_s", out.collision_time_s},
+      {"left_map", out.left_world ? Json{{"time_s", out.left_world_time_s},
+                                         {"position", vec_json(out.left_world_position)}}
+                                  : Json(nullptr)},
       {"position_mse", vec_json(out.position_mse)},
       {"velocity_mse", vec_json(out.velocity_mse)},
       {"max_position_error", out.max_position_error},

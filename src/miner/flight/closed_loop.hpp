@@ -16,6 +16,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "miner/core/json_io.hpp"
 #include "miner/flight/controller.hpp"
@@ -60,6 +61,9 @@ struct FlightSetup {
   /// Whether the vehicle at a position touches an obstacle (counted as a collision); empty:
   /// nothing to touch.
   std::function<bool(const Eigen::Vector3d&)> collides;
+  /// The world the flight happens in: the flight stops the first tick the vehicle is outside
+  /// it (FlightResult::left_world); empty: unbounded.
+  std::optional<Eigen::AlignedBox3d> world;
 };
 
 /// The trajectory a flight follows, and what the flight's summary says of it.
@@ -92,6 +96,10 @@ struct FlightResult {
   int collisions = 0;             ///< entries into the map inflated by the vehicle radius
   double collision_time_s = 0.0;
   bool goal_reached = false;
+  /// The vehicle left FlightSetup::world: the flight stopped there (never goal_reached).
+  bool left_world = false;
+  double left_world_time_s = 0.0;                        ///< simulated seconds
+  Eigen::Vector3d left_world_position = Eigen::Vector3d::Zero();
   double final_position_error = 0.0;
   double final_speed = 0.0;
   double flight_time = 0.0;       ///< simulated seconds

@@ -545,6 +545,7 @@ flight::FlightResult fly(const Scenario& scenario, const ReferencePlan& referenc
   const std::shared_ptr<const world::Map> map = scenario.map;
   const double radius = scenario.vehicle.radius;
   setup.collides = [map, radius](const Eigen::Vector3d& p) { return !map->is_free(p, radius); };
+  setup.world = Eigen::AlignedBox3d(map->bounds().min, map->bounds().max);
   return flight::fly(setup, reference, options);
 }
 

@@ -399,7 +399,9 @@ std::string render_flight_report(const FlightReportInput& in) {
   h += ", minimum-" + std::string(s.order == 3 ? "jerk" : "snap") + " MINCO trajectory, " +
        std::to_string(r.trajectory.segments()) + " segments, " + fixed(r.trajectory.total_duration(), 2) +
        " s. Goal " + (f.goal_reached ? "reached" : "NOT reached") + " (" + fixed(f.final_position_error, 3) +
-       " m off), " + std::to_string(f.collisions) + " collisions.</p>\n";
+       " m off), " + std::to_string(f.collisions) + " collisions." +
+       (f.left_world ? " The vehicle left the map at " + fixed(f.left_world_time_s, 2) + " s: the flight stopped there." : "") +
+       "</p>\n";
   h += "<h2>3D view</h2>\n<div id=\"layers\"></div>\n<div id=\"view3d\"><div id=\"view-overlay\"></div></div>\n"
        "<div id=\"playback\"><button id=\"playback-play\" type=\"button\">play</button> "
        "<input id=\"playback-slider\" type=\"range\" min=\"0\" max=\"" + fixed(f.log.empty() ? 0.0 : f.log.back()[0], 2) +

@@ -239,6 +239,8 @@ PYBIND11_MODULE(_miner, m) {
       .def_readonly("max_position_error", &miner::flight::FlightResult::max_position_error)
       .def_readonly("collisions", &miner::flight::FlightResult::collisions)
       .def_readonly("goal_reached", &miner::flight::FlightResult::goal_reached)
+      .def_readonly("left_world", &miner::flight::FlightResult::left_world)
+      .def_readonly("left_world_time_s", &miner::flight::FlightResult::left_world_time_s)
       .def_readonly("flight_time", &miner::flight::FlightResult::flight_time)
       .def_property_readonly("summary", [](const miner::flight::FlightResult& r) { return r.summary.dump(2); })
       .def_property_readonly("log_columns", [](const miner::flight::FlightResult&) { return miner::flight::flight_log_columns(); })

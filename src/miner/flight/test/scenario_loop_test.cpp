@@ -307,3 +307,47 @@ TEST_CASE("The pipeline owns the run folder: its files in order, the summary nam
   CHECK(pipeline::run_folder_conflict("/data/maps", doc, "/data").value_or("") == "/data/maps/m.json");
   CHECK_FALSE(pipeline::run_folder_conflict("/data/runs/a", doc, "/data").has_value());
 }
+
+TEST_CASE("A flight stops the first tick the vehicle is outside its world and says where", "[REQ-FLIGHT-009]") {
+  // Issue 20, seventh campaign: a vehicle that could not hold its reference flew on hundreds of
+  // metres off its 10 x 10 x 5 m map, the flight simulated to its end.
+  Eigen::MatrixX3d points(3, 3);
+  points << 5, 5, 3, 8, 7, 4, 11, 6, 3;
+  const auto s = miner::testing::open_room_scenario(points, 1.0, 1.0, 9);
+  const auto ref = pipeline::build_reference(s);
+  flight::FlightSetup setup = s;
+  const flight::FlightResult whole = flight::fly(setup, ref);
+  CHECK_FALSE(whole.left_world);
+  CHECK(whole.summary["left_map"].is_null());
+
+  // The reference runs from x = 5 to x = 11: a world ending at x = 8 is left on the way.
+  constexpr double kWallX = 8.0;
+  setup.world = Eigen::AlignedBox3d(Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(kWallX, 20, 10));
+  const flight::FlightResult r = flight::fly(setup, ref);
+  REQUIRE(r.left_world);
+  CHECK_FALSE(r.goal_reached);
+  // Stopped at the first N3 tick outside: past the wall by at most one tick's travel.
+  const double n3_dt = 1.0 / s.n3.rate_hz;
+  CHECK(r.left_world_position.x() > kWallX);
+  CHECK(r.left_world_position.x() < kWallX + 5.0 * n3_dt);
+  // Every earlier tick of the whole flight is the same (the world does not change the flight
+  // before it is left), and nothing after it was simulated.
+  REQUIRE(!r.log.empty());
+  CHECK(r.log.back()[0] < r.left_world_time_s);
+  CHECK(r.log.size() < whole.log.size());
+  for (std::size_t i = 0; i < r.log.size(); ++i) REQUIRE(r.log[i] == whole.log[i]);
+  const double true_x_at_stop = whole.log[r.log.size()][7];
+  CHECK(true_x_at_stop > kWallX - 1e-9);  // the first logged row at or after the stop is out
+  CHECK(r.flight_time == Approx(r.left_world_time_s));
+  CHECK(static_cast<double>(r.ticks) * n3_dt == Approx(r.left_world_time_s));
+  CHECK(r.summary["left_map"]["time_s"].get<double>() == r.left_world_time_s);
+  CHECK(r.summary["left_map"]["position"][0].get<double>() == r.left_world_position.x());
+
+  // pipeline::fly bounds the flight by the scenario's map.
+  auto small = s;
+  small.map = std::make_shared<const miner::world::Map>(miner::world::Box{{0, 0, 0}, {kWallX, 20, 10}}, 0.5,
+                                                        std::vector<miner::world::Box>{});
+  const flight::FlightResult p = pipeline::fly(small, ref);
+  CHECK(p.left_world);
+  CHECK(p.left_world_time_s == r.left_world_time_s);
+}

@@ -821,6 +821,30 @@ std::vector<double> reference_errors(const Sgan& sgan, const std::string& refere
       samples.fail("the file holds the tensor \"" + name + "\", which is not one of samples 0.." +
                    std::to_string(samples.integer() - 1) + " (tensors are named <sample>.<input or output>)");
   }
+  // A reference written for another network (another grid, other input channels) is named as
+  // such, both networks described, not by the first tensor it lacks (issue 20, seventh campaign:
+  // a 16^3 reference against 32^3 weights said "no tensor '0.passability'").
+  {
+    const auto has = [&](const std::string& name) { return ref.tensors.count(name) != 0; };
+    const auto network = [](const std::vector<int>& grid, bool scale, bool passability) {
+      std::string text = std::to_string(grid.size() == 3 ? grid[2] : 0) + " x " +
+                         std::to_string(grid.size() == 3 ? grid[1] : 0) + " x " +
+                         std::to_string(grid.size() == 3 ? grid[0] : 0) + " cells";
+      text += scale ? ", with scale inputs" : ", no scale inputs";
+      text += passability ? ", with passability inputs" : ", no passability inputs";
+      return text;
+    };
+    const auto env = ref.tensors.find("0.environment");
+    const std::vector<int> ref_grid = env == ref.tensors.end() ? std::vector<int>{} : env->second.shape;
+    const bool ref_scale = has("0.scale"), ref_pass = has("0.passability");
+    const auto& arch = sgan.architecture();
+    if (env != ref.tensors.end() && (ref_grid != shape || ref_scale != (arch.scale_channels != 0) ||
+                                     ref_pass != (arch.passability_channels != 0)))
+      throw Error(reference_path + ": its sample 0 is for a network of " + network(ref_grid, ref_scale, ref_pass) +
+                  ", but " + sgan.path() + " is a network of " +
+                  network(shape, arch.scale_channels != 0, arch.passability_channels != 0) +
+                  ": a reference checks the weights that wrote it (see its meta.weights)");
+  }
   // An input the network is given must be finite: a NaN there was reported as the weights and
   // the reference not belonging together (sixth campaign U8). Named by tensor and element.
   const auto finite_input = [&](const std::string& name, const std::vector<int>& tensor_shape) -> const std::vector<float>& {

@@ -144,6 +144,21 @@ TEST_CASE("The shipped generator agrees with the PyTorch reference tensors to 1e
   CHECK_THROWS_WITH(heuristic::reference_errors(g, kFixtures + "sgan.bin"), Contains("sgan-reference"));
 }
 
+TEST_CASE("A reference of another network is named as such: both grids and inputs", "[REQ-HEUR-005]") {
+  // Issue 20, seventh campaign: the 16^3 reference against the 32^3 weights said only
+  // "no tensor '0.passability'".
+  const heuristic::Sgan big = heuristic::Sgan::builtin();
+  const heuristic::Sgan small = heuristic::Sgan::load(kFixtures + "grid16/sgan.bin");
+  CHECK_THROWS_WITH(heuristic::reference_errors(big, kFixtures + "grid16/reference.bin"),
+                    Contains("grid16/reference.bin: its sample 0 is for a network of 16 x 16 x 16 cells, with scale "
+                             "inputs, no passability inputs") &&
+                        Contains("is a network of 32 x 32 x 32 cells, with scale inputs, with passability inputs"));
+  CHECK_THROWS_WITH(heuristic::reference_errors(small, kFixtures + "reference.bin"),
+                    Contains("for a network of 32 x 32 x 32 cells") && Contains("is a network of 16 x 16 x 16 cells"));
+  // Each with its own reference agrees.
+  CHECK(heuristic::reference_errors(small, kFixtures + "grid16/reference.bin").size() >= 1);
+}
+
 TEST_CASE("A reference whose outputs are not finite is refused, never agreed with", "[REQ-HEUR-005]") {
   // The shipped reference with one output cell set to NaN and its checksum redone: a NaN
   // difference used to be skipped by std::max, and an all-NaN reference "agreed" with 0 error.

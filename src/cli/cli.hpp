@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 
 #include "miner/core/json_io.hpp"
+#include "miner/plan/rrt_star.hpp"
 #include "miner/world/map.hpp"
 
 namespace CLI {
@@ -106,10 +107,10 @@ CLI::Validator integer_in(long long lo, long long hi);
 CLI::Validator one_of(const std::string& what, const std::vector<std::string>& names);
 /// A map generator preset (`map gen --preset`, `dataset --preset`).
 extern const CLI::Validator kMapPreset;
-/// Resource bounds of the command line (issue 20: bounded work, named in --help). An iteration
-/// budget above 1e7 holds a tree of ~1 GB; more than 1e5 runs of a campaign, or 1e4 boxes
-/// placed by a generator whose placement is quadratic, run for hours.
-inline constexpr int kMaxIterations = 10000000;
+/// Resource bounds of the command line (issue 20: bounded work, named in --help). The iteration
+/// budget is the planner's (plan::kMaxIterations, a run of ~40 s); more than 1e5 runs of a
+/// campaign, or 1e4 boxes placed by a generator whose placement is quadratic, run for hours.
+inline constexpr int kMaxIterations = static_cast<int>(plan::kMaxIterations);
 inline constexpr int kMaxRuns = 100000;
 inline constexpr int kMaxObstacles = 10000;
 /// CLI::Range(1, kMaxIterations) and CLI::Range(1, kMaxRuns).

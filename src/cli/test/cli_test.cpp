@@ -619,9 +619,12 @@ TEST_CASE("Resource bounds: counts, budgets and tolerances outside their range a
       {{"map", "gen", "--preset", "cluttered", "--obstacles", "2000000000", "--out", dir() + "/b.json"}, "--obstacles"},
       {{"bench", "voxels", "--map", map, "--queries", "18446744073709551615"}, "--queries"},
       {{"bench", "voxels", "--map", map, "--repeats", "2147483647"}, "--repeats"},
+      {{"bench", "voxels", "--map", map, "--queries", "1000001"}, "--queries"},  // 10^7 took ~30 s
+      {{"bench", "voxels", "--map", map, "--repeats", "101"}, "--repeats"},     // 1000 took 27 s
       {{"bench", "sim", "--runs", "2000000000"}, "--runs"},
       {{"bench", "sim", "--rtol", "1e-300"}, "--rtol"},
       {{"plan", "--map", map, "--iterations", "2000000000"}, "--iterations"},
+      {{"plan", "--map", map, "--iterations", "1000001"}, "--iterations"},  // 10^7 ran for minutes
       {{"bench", "frontend", "--map", map, "--throughput-iterations", "18446744073709551615"}, "--throughput-iterations"},
       {{"map", "gen", "--preset", "cluttered", "--resolution", "nan", "--out", dir() + "/b.json"}, "--resolution"}};
   for (const auto& [args, option] : cases) {
@@ -1243,6 +1246,11 @@ TEST_CASE("miner fly runs sGAN region, MINER RRT*, MINCO and flight and keeps ev
   doc["planner"]["region"] = "sgan";
   doc["planner"]["iterations"] = 0;
   CHECK(miner_cli({"fly", "--scenario", write("bad-iter.json", doc.dump()), "--out", dir() + "/never"}).code == 1);
+  // Past the planner's largest budget (seventh campaign H2: 10^7 planned for ~15 minutes).
+  doc["planner"]["iterations"] = 1000001;
+  const Run too_many = miner_cli({"fly", "--scenario", write("big-iter.json", doc.dump()), "--out", dir() + "/never"});
+  CHECK(too_many.code == 1);
+  CHECK_THAT(too_many.err, Contains("big-iter.json: planner.iterations: must be in [1, 1000000], got 1000001"));
   CHECK_FALSE(std::filesystem::exists(dir() + "/never"));
 
   // A failing run leaves the earlier folder whole.

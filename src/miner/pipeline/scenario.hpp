@@ -29,6 +29,7 @@
 #include "miner/core/json_io.hpp"
 #include "miner/flight/closed_loop.hpp"
 #include "miner/plan/heuristic_region.hpp"
+#include "miner/plan/rrt_star.hpp"
 #include "miner/traj/polynomial_trajectory.hpp"
 #include "miner/traj/time_allocation.hpp"
 #include "miner/traj/trapezoidal_allocation.hpp"
@@ -53,8 +54,8 @@ inline constexpr double kMaxAcceleration = 50.0;   ///< m/s^2
 inline constexpr double kMaxGoalTolerance = 5.0;   ///< m
 /// The planning margin grows the robot radius; 10 m is the largest robot radius a map takes.
 inline constexpr double kMaxPlanningMargin = 10.0;  ///< m
-/// The planner's iteration budget (the CLI's --iterations bound: a tree of ~1 GB).
-inline constexpr long long kMaxPlannerIterations = 10000000;
+/// The planner's iteration budget (plan::kMaxIterations, the CLI's --iterations bound).
+inline constexpr long long kMaxPlannerIterations = static_cast<long long>(plan::kMaxIterations);
 
 /// A whole run as the paper's system does it: the world, how the reference is found (given
 /// waypoints, a trajectory file, or MINER RRT* on the sGAN's region), its limits, and the

@@ -438,6 +438,9 @@ PlanResult plan(const PlanningProblem& problem, const PlannerOptions& options, c
   if (!(options.rewire_factor >= 1.0 && std::isfinite(options.rewire_factor))) {
     throw Error("rewire_factor: must be a finite number >= 1 (Lemma 2's radius condition)");
   }
+  if (options.max_iterations > kMaxIterations)
+    throw Error("max_iterations: " + std::to_string(options.max_iterations) + " is above the largest budget " +
+                std::to_string(kMaxIterations) + " (a run of minutes; see plan::kMaxIterations)");
   if (options.target_cost) require_finite(*options.target_cost, "target_cost");
   if (options.safeguard_iterations < 1) throw Error("safeguard_iterations: must be >= 1 (k_0 of the safeguard)");
   if (options.planner == PlannerKind::kMiner) {

@@ -61,6 +61,11 @@ PlannerKind planner_from_name(const std::string& name);
 /// All four, in the order above.
 std::vector<PlannerKind> all_planners();
 
+/// The largest iteration budget a run takes: 10^6 iterations grow a tree of ~100 MB and take
+/// about 40 s on a 10 m map on one core (the near sets grow as log n); 10^7 took minutes (issue
+/// 20, seventh campaign H2). Five times the largest default budget (a benchmark's 2 x 10^5).
+inline constexpr std::size_t kMaxIterations = 1000000;
+
 /// Parameters of a planning run, with their defaults (REQ-PLAN-007).
 struct PlannerOptions {
   PlannerKind planner = PlannerKind::kRrtStar;

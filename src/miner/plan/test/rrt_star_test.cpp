@@ -224,6 +224,10 @@ TEST_CASE("Invalid planner options and a missing or mismatched region are refuse
   o.target_cost.reset();
   o.safeguard_iterations = 0;
   CHECK_THROWS_WITH(miner::plan::plan(problem, o, &region), Contains("safeguard_iterations"));
+  o.safeguard_iterations = 300;
+  // A budget past 10^6 iterations (seventh campaign H2: 10^7 from a scenario ran ~15 minutes).
+  o.max_iterations = miner::plan::kMaxIterations + 1;
+  CHECK_THROWS_WITH(miner::plan::plan(problem, o, &region), Contains("max_iterations: 1000001 is above the largest budget"));
   CHECK_THROWS_WITH(miner::plan::planner_from_name("rrt"), Contains("rrtstar, informed, guided, miner"));
   CHECK(miner::plan::planner_from_name("guided") == PlannerKind::kGuided);
   PlanningProblem no_map;
@@ -294,6 +298,38 @@ TEST_CASE("The safeguard keeps full trust in a region the solution runs through 
   // The other planners draw nothing from H.
   o.planner = PlannerKind::kRrtStar;
   CHECK(miner::plan::plan(problem, o, &good).region_samples == 0);
+}
+
+TEST_CASE("Before a solution the trust falls once no vertex comes strictly fewer H-hops from the goal", "[REQ-PLAN-020]") {
+  // H is a straight tube of cells from x_init to x_goal through a wall the grid does not see
+  // (closed: x_goal is unreachable, so the whole run is before a first solution). The tree
+  // reaches the tube's last cell before the wall early and then only adds vertices there or
+  // farther back: ties with the fewest hops so far are no progress (held-out audit 5
+  // h5-plan-01 counted them), so tau_t = k_0 / (t - t_p) falls as the stall lengthens.
+  const auto map = miner::testing::closed_wall_map();
+  const auto problem = PlanningProblem::make(map, V(1, 1.5, 0.5), V(9, 1.5, 0.5), 0.1);
+  std::vector<double> p(10 * 10 * 3, 0.0);
+  const HeuristicRegion shape(map.bounds(), I(10, 10, 3), p, 0.5);
+  for (int i = 0; i < 10; ++i) p[shape.index(i, 1, 0)] = 1.0;
+  const HeuristicRegion tube(map.bounds(), I(10, 10, 3), p, 0.5, "tube");
+  REQUIRE(tube.hops_to(problem.goal).at(static_cast<std::size_t>(shape.index(3, 1, 0))) == 6);
+  PlannerOptions o;
+  o.planner = PlannerKind::kMiner;
+  o.max_iterations = 4000;
+  o.seed = 5;
+  const PlanResult r = miner::plan::plan(problem, o, &tube);
+  REQUIRE_FALSE(r.solved);
+  // tau = k_0 / (t - t_p) exactly: t - t_p is a whole number of iterations, at least k_0.
+  const double stalled = static_cast<double>(o.safeguard_iterations) / r.region_trust;
+  CHECK(stalled == Approx(std::round(stalled)).margin(1e-6));
+  CHECK(stalled >= static_cast<double>(o.safeguard_iterations));
+  // The last strict progress (reaching the tube's last cell before the wall) came in the first
+  // half of the run: the trust at the end is at most k_0 / 2000.
+  CHECK(r.region_trust <= static_cast<double>(o.safeguard_iterations) / 2000.0);
+  // The region then gets far fewer samples than the paper's fixed mu_2 gives it.
+  o.safeguard = false;
+  const PlanResult paper = miner::plan::plan(problem, o, &tube);
+  CHECK(r.region_samples < paper.region_samples / 2);
 }
 
 namespace {

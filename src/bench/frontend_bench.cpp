@@ -518,9 +518,15 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
       }
     }
   }
-  // Everything but the per-shard fields must agree.
+  // Everything but the per-shard fields must agree; the throughput check's iteration count is a
+  // setting (shard 0 measures it, the merge keeps shard 0's rates: parts given other counts are
+  // other campaigns; issue 20, --throughput-iterations merged across parts that disagreed).
   const auto settings = [](nlohmann::json j) {
-    for (const char* k : {"planners", "run_records", "shard", "total_s", "throughput", "region"}) j.erase(k);
+    for (const char* k : {"planners", "run_records", "shard", "total_s", "region"}) j.erase(k);
+    if (j.contains("throughput") && j["throughput"].is_object()) {
+      j["throughput"].erase("rrtstar_iterations_per_s");
+      j["throughput"].erase("ompl_rrtstar_iterations_per_s");
+    }
     return j;
   };
   const nlohmann::json common = settings(parts.front());

@@ -17,6 +17,7 @@
 #include "bench/ompl_planners.hpp"
 #include "miner/core/error.hpp"
 #include "miner/core/json_io.hpp"
+#include "miner/core/text.hpp"
 #include "miner/flight/closed_loop.hpp"
 #include "miner/pipeline/scenario.hpp"
 #include "miner/heuristic/dataset.hpp"
@@ -238,18 +239,24 @@ PaperBenchResult run_paper_bench(const PaperBenchOptions& o, const std::string& 
     fo.weights_file = o.weights;
     fo.throughput_iterations = 0;
     const auto& q = *maps[i].query();
+    out.grid_resolution.push_back(maps[i].resolution());
     out.frontend.push_back(
         run_frontend_bench(maps[i], map_label(o.maps[i]), q.start, q.goal, q.robot_radius, fo, progress));
   }
-  // Table II: the back end on the path MINER (sGAN) found in run 0, else RRT*'s.
+  // Table II: the back end on the path of MINER (sGAN)'s first solved run, else RRT*'s.
   BackendBenchOptions bo;
   bo.budget_s = o.backend_budget_s;
   bo.methods = {"minco", "closed-form", "kkt-qp", "dense-lu"};
   for (const auto& fr : out.frontend) {
     const plan::PlanResult* path = nullptr;
+    std::string source;
     for (const char* who : {"miner-sgan", "rrtstar"})
       for (const auto& run : fr.runs)
-        if (!path && run.planner == who && run.result.solved) path = &run.result;
+        if (!path && run.planner == who && run.result.solved) {
+          path = &run.result;
+          source = std::string(who) + " run " + std::to_string(run.run);
+        }
+    out.backend_source.push_back(source);
     if (!path) {
       out.backend.emplace_back();
       out.backend_segments.push_back(0);
@@ -300,7 +307,8 @@ PaperBenchResult run_paper_bench(const PaperBenchOptions& o, const std::string& 
     if (progress) *progress << "flying " << s.name << "\n";
     const auto reference = pipeline::build_reference(s);
     const auto r = pipeline::fly(s, reference);
-    out.tracking.push_back({s.name, r.position_mse, r.velocity_mse, r.max_position_error, r.collisions, r.goal_reached});
+    out.tracking.push_back({s.name, r.position_mse, r.velocity_mse, r.max_position_error, r.collisions, r.goal_reached,
+                            reference_label(s, reference)});
   }
   out.total_s = std::chrono::duration<double>(Clock::now() - t0).count();
   return out;
@@ -336,6 +344,14 @@ std::map<std::string, std::string> results_figures(const PaperBenchResult& r) {
 
 std::uint64_t unseen_heuristic_seed(std::uint64_t seed) { return seed ^ kUnseenSalt; }
 
+std::string reference_label(const pipeline::Scenario& s, const pipeline::ReferencePlan& reference) {
+  const std::string minco = std::string("min-") + (s.order == 3 ? "jerk" : "snap") + " MINCO";
+  if (reference.source == "file") return "trajectory file";
+  if (reference.source == "waypoints") return minco + " through the scenario's waypoints";
+  return "MINER RRT* on the " + (reference.region ? reference.region->source() : std::string("no")) + " region + " +
+         minco;
+}
+
 std::string results_markdown(const PaperBenchResult& r, const std::string& figure_dir) {
   std::ostringstream md;
   md << "# Results: the paper's tables reproduced\n\n"
@@ -346,14 +362,15 @@ std::string results_markdown(const PaperBenchResult& r, const std::string& figur
 
   md << "## Table I: front end (medians over " << r.options.runs << " runs per planner)\n\n"
      << "Columns as in the paper: initial = first solution, optimal = first time the cost is at or below the "
-        "target (the A* path's length on the 0.5 m grid; the paper's \"asymptotic optimal cost\" is not "
-        "given). \"Ours\" is MINER RRT* sampling the sGAN's filtered region with the region's time "
-        "(encoding, inference, filter) included. A dash: no value (fewer than half the runs got there, "
+        "target (the A* path's length on the map's own grid, its resolution in each map's heading; the paper's "
+        "\"asymptotic optimal cost\" is not given). \"Ours\" is MINER RRT* sampling the sGAN's filtered region with "
+        "the region's time (encoding, inference, filter) included. A dash: no value (fewer than half the runs got there, "
         "or OMPL does not report it). OMPL's planners run under a " << f(r.options.time_limit_s, 1)
      << " s limit per run.\n\n";
   for (std::size_t i = 0; i < r.frontend.size(); ++i) {
     const auto& fr = r.frontend[i];
-    md << "### Map " << (i + 1) << " (" << fr.map << ", A* cost " << f(fr.reference_cost, 1) << " m)\n\n"
+    md << "### Map " << (i + 1) << " (" << fr.map << ", A* cost " << f(fr.reference_cost, 1) << " m on its "
+       << short_number(r.grid_resolution.at(i)) << " m grid)\n\n"
        << "| method | source | success | initial iteration | initial nodes | initial cost (m) | initial time (ms) "
           "| optimal iteration | optimal nodes | optimal time (ms) | n | target reached | optimal time mean ± sd (ms, reached runs) "
           "| optimal time median [IQR] (ms, misses as +inf) |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
@@ -408,7 +425,8 @@ std::string results_markdown(const PaperBenchResult& r, const std::string& figur
 
   md << "## Table II: front end + back end (ms)\n\n"
      << "Initial time: median time to the first solution (Table I). Back end: minimum jerk / minimum snap solve "
-        "on the waypoints of MINER's run-0 path on the same map, durations by trapezoidal allocation (v_max 2, "
+        "on the waypoints of a path found on the same map (MINER (sGAN)'s first solved run, else RRT*'s; which one "
+        "is listed below the table), durations by trapezoidal allocation (v_max 2, "
         "a_max 1), median of timed batches. The paper's MINCO row is Wang et al.'s code; ours is this "
         "project's O(M) solver.\n\n"
      << "| method | source |";
@@ -449,27 +467,31 @@ std::string results_markdown(const PaperBenchResult& r, const std::string& figur
   md << "\n| dense LU (extra baseline) | MINER |";
   for (std::size_t i = 0; i < r.frontend.size(); ++i)
     md << " " << backend_ms(i, "dense-lu", 3) << "/" << backend_ms(i, "dense-lu", 4) << " |";
-  md << "\n\nPath segments per map:";
-  for (std::size_t i = 0; i < r.frontend.size(); ++i) md << " " << r.frontend[i].map << " " << r.backend_segments[i] << ";";
+  md << "\n\nPath per map:";
+  for (std::size_t i = 0; i < r.frontend.size(); ++i)
+    md << " " << r.frontend[i].map << " "
+       << (r.backend_source.at(i).empty() ? std::string("none (neither miner-sgan nor rrtstar solved it)")
+                                          : r.backend_source[i] + ", " + std::to_string(r.backend_segments[i]) + " segments")
+       << ";";
   md << " OMPL has no trajectory back end, so it has no row here.\n\n";
 
   md << "## Tracking error (MSE)\n\n"
      << "The paper flew a real quadrotor (Map1, Map2); ours are closed-loop simulations (CVODE dynamics, emulated "
-        "N3, EKF on noisy IMU and pose, SE(3) PID) of the indoor scenarios, sGAN + MINER + min-snap reference. "
+        "N3, EKF on noisy IMU and pose, SE(3) PID) of the scenarios listed, each row naming its reference. "
         "m^2 and (m/s)^2.\n\n"
-     << "| env. | source | pos. x | pos. y | pos. z | vel. x | vel. y | vel. z | max error (m) | collisions |\n"
-     << "|---|---|---|---|---|---|---|---|---|---|\n";
+     << "| env. | source | pos. x | pos. y | pos. z | vel. x | vel. y | vel. z | max error (m) | collisions | reference |\n"
+     << "|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (int k = 0; k < 2; ++k) {
     md << "| Map" << (k + 1) << " | paper (real flight) |";
     for (double v : kPaperMse[k]) md << " " << f(v, 4) << " |";
-    md << " — | — |\n";
+    md << " — | — | real flight |\n";
   }
   for (const auto& t : r.tracking) {
     md << "| " << t.env << " | MINER (simulation) |";
     for (int a = 0; a < 3; ++a) md << " " << f(t.position_mse[a], 4) << " |";
     for (int a = 0; a < 3; ++a) md << " " << f(t.velocity_mse[a], 4) << " |";
     md << " " << f(t.max_position_error, 3) << " | " << t.collisions << (t.goal_reached ? "" : " (goal NOT reached)")
-       << " |\n";
+       << " | " << t.reference << " |\n";
   }
   return md.str();
 }
@@ -488,7 +510,8 @@ nlohmann::json to_json(const PaperBenchResult& r) {
                              {"velocity_mse", {t.velocity_mse.x(), t.velocity_mse.y(), t.velocity_mse.z()}},
                              {"max_position_error", t.max_position_error},
                              {"collisions", t.collisions},
-                             {"goal_reached", t.goal_reached}});
+                             {"goal_reached", t.goal_reached},
+                             {"reference", t.reference}});
   return j;
 }
 

@@ -14,6 +14,7 @@
 #include "bench/backend_bench.hpp"
 #include "bench/frontend_bench.hpp"
 #include "bench/heuristic_bench.hpp"
+#include "miner/pipeline/scenario.hpp"
 
 namespace miner::bench {
 
@@ -51,13 +52,17 @@ struct TrackingRow {
   double max_position_error = 0.0;
   int collisions = 0;
   bool goal_reached = false;
+  std::string reference;  ///< what the flown reference is ("MINER RRT* on the sgan region + min-snap MINCO")
 };
 
 struct PaperBenchResult {
   PaperBenchOptions options;
   std::vector<FrontendBenchResult> frontend;            ///< one per map
-  std::vector<std::vector<BackendRecord>> backend;      ///< one per map, on miner-sgan's run-0 path
+  std::vector<double> grid_resolution;                  ///< one per map: the grid of its A* reference (m)
+  std::vector<std::vector<BackendRecord>> backend;      ///< one per map, on backend_source's path
   std::vector<std::size_t> backend_segments;            ///< that path's segment count
+  /// One per map: whose path the back end ran on ("miner-sgan run 0"; empty: none solved).
+  std::vector<std::string> backend_source;
   HeuristicBenchResult heuristic;
   std::vector<TrackingRow> tracking;
   std::string commit;                                   ///< `git describe --always --dirty`, or "unknown"
@@ -72,6 +77,10 @@ struct PaperBenchResult {
 /// set holds, whatever seed the bench is given. The test split of the bench's own seed would
 /// not do: with --count 1 its maps k >= 1 are the first training maps of that seed.
 std::uint64_t unseen_heuristic_seed(std::uint64_t seed);
+
+/// What a flown reference is, as the tracking table names it: "MINER RRT* on the sgan region +
+/// min-snap MINCO", "min-jerk MINCO through the scenario's waypoints", "trajectory file".
+std::string reference_label(const pipeline::Scenario& s, const pipeline::ReferencePlan& reference);
 
 PaperBenchResult run_paper_bench(const PaperBenchOptions& options, const std::string& command, std::ostream* progress);
 

@@ -102,6 +102,9 @@ std::filesystem::path nearest_existing(std::filesystem::path p) {
 /// that is not a regular file (a device, FIFO or socket would be replaced by the write's
 /// rename; issue 20). A symbolic link is judged by what it points to (the write goes through
 /// it). Empty when usable.
+/// Links followed when an output's target is named: the kernel's own limit (MAXSYMLINKS).
+constexpr int kMaxLinkHops = 40;
+
 std::string output_file_problem(const std::string& text) {
   namespace fs = std::filesystem;
   const fs::path p(text);
@@ -112,6 +115,21 @@ std::string output_file_problem(const std::string& text) {
   if (fs::exists(st) && !fs::is_regular_file(st) && !fs::is_directory(st))
     return text + " exists and is not a regular file (a device, FIFO or socket): outputs are written as regular files, "
                   "which would replace it";
+  // An output is written through a symbolic link into its target (REQ-CORE-004), and the name's
+  // suffix chooses what is written (.json, .bt, .md ...): a link whose target has another suffix
+  // would put one kind of file under another's name (issue 20: `--out x.json` linking to y.png).
+  fs::path target = p;
+  for (int hop = 0; hop < kMaxLinkHops && fs::is_symlink(fs::symlink_status(target, ec)); ++hop) {
+    const fs::path next = fs::read_symlink(target, ec);
+    if (ec) break;
+    target = next.is_absolute() ? next : target.parent_path() / next;
+  }
+  if (target != p && target.extension() != p.extension())
+    return text + " is a symbolic link to " + target.string() + ": the file written there would hold what the name " +
+           (p.extension().empty() ? std::string("without a suffix") : "ending in " + p.extension().string()) +
+           " asks for, under a name " +
+           (target.extension().empty() ? std::string("without one") : "ending in " + target.extension().string()) +
+           " (give the target's own name, or a link with the same suffix)";
   return {};
 }
 

@@ -557,7 +557,7 @@ TEST_CASE("Output paths are checked before any work", "[REQ-CLI-003]") {
 }
 
 TEST_CASE("Outputs never replace a FIFO, device or a user's folder, go through links, and long names are refused first",
-          "[REQ-CLI-003]") {
+          "[REQ-CLI-003][REQ-CORE-004]") {
   namespace fs = std::filesystem;
   const std::string map = write("pillar-fifo.json", kPillarMap);
   const std::vector<std::string> astar{"astar", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5"};
@@ -582,6 +582,28 @@ TEST_CASE("Outputs never replace a FIFO, device or a user's folder, go through l
   REQUIRE(miner_cli(with_out(link)).code == 0);
   CHECK(fs::is_symlink(fs::symlink_status(link)));
   CHECK_THAT(read(target), Contains("\"cost\""));
+  // ... but only into a target of the same suffix: the suffix says what is written (issue 20: a
+  // link named .json wrote JSON into a .png). Relative links and chains of links are followed.
+  write("picture.png", "PNG");
+  const std::string png_link = dir() + "/png-link.json", chain = dir() + "/chain.json";
+  fs::remove(png_link);
+  fs::remove(chain);
+  fs::create_symlink("picture.png", png_link);
+  fs::create_symlink("png-link.json", chain);
+  for (const std::string& bad : {png_link, chain}) {
+    const Run to_png = miner_cli(with_out(bad));
+    CHECK(to_png.code == 2);
+    CHECK_THAT(to_png.err, Contains("is a symbolic link to ") && Contains("picture.png") &&
+                               Contains("ending in .json asks for, under a name ending in .png"));
+  }
+  CHECK(read(dir() + "/picture.png") == "PNG");
+  const std::string bt_link = dir() + "/map-link.json";
+  fs::remove(bt_link);
+  fs::create_symlink(dir() + "/a-map.bt", bt_link);  // dangling: the target does not exist yet
+  const Run map_to_bt = miner_cli({"map", "gen", "--preset", "cluttered", "--out", bt_link});
+  CHECK(map_to_bt.code == 2);
+  CHECK_THAT(map_to_bt.err, Contains("under a name ending in .bt"));
+  CHECK_FALSE(fs::exists(dir() + "/a-map.bt"));
   // A 250-byte name is a legal name and is written; 256 bytes is refused before the work.
   const std::string legal = dir() + "/" + std::string(245, 'n') + ".json";
   CHECK(miner_cli(with_out(legal)).code == 0);

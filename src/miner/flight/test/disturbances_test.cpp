@@ -297,7 +297,13 @@ TEST_CASE("A drained battery under a heavy plant saturates the thrust: the fligh
   CHECK(full.saturation_time_s < 0.5);
   const auto drained = run(0.02);
   CHECK_FALSE(drained.goal_reached);
-  CHECK(drained.saturation_time_s > 3.0);
+  // It sinks through the room's floor, where the flight stops (REQ-FLIGHT-009), saturated for
+  // most of the time it flew.
+  CHECK(drained.left_world);
+  CHECK(drained.left_world_position.z() < 0.0);
+  INFO("saturated " << drained.saturation_time_s << " s of " << drained.flight_time << " s");
+  CHECK(drained.saturation_time_s > 0.5 * drained.flight_time);
+  CHECK(drained.saturation_time_s > 1.0);
   CHECK(drained.battery_min_voltage < full.battery_min_voltage);
   CHECK(drained.summary["events"]["saturation_time_s"].get<double>() == drained.saturation_time_s);
 }

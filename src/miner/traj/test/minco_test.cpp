@@ -136,6 +136,8 @@ TEST_CASE("Bad problems are refused with the field named", "[REQ-TRAJ-007]") {
   CHECK_THROWS_WITH(validate(p), Contains("durations: expected 2 values (one per segment), got 1"));
   CHECK_THROWS_WITH(validate(rest_to_rest(3, line({0}), {})), Contains("points: need at least 2 points"));
   CHECK_THROWS_WITH(validate(rest_to_rest(3, line({0, 1, 1}), {1, 1})), Contains("points[1] and points[2] coincide"));
+  // The first pair too (held-out audit 6, h6-traj-02: the check started at the second pair).
+  CHECK_THROWS_WITH(validate(rest_to_rest(3, line({0, 0, 1}), {1, 1})), Contains("points[0] and points[1] coincide"));
   CHECK_THROWS_WITH(validate(rest_to_rest(5, line({0, 1}), {1})), Contains("order: must be 3 (minimum jerk) or 4 (minimum snap), got 5"));
   p = good;
   p.head = Eigen::MatrixX3d::Zero(4, 3);
@@ -297,4 +299,34 @@ TEST_CASE("Each optimality condition is checked: a jump in any one derivative s.
         }
       }
   }
+}
+
+TEST_CASE("The waypoint polish moves no coefficient whose change would move a derivative past its damage bound",
+          "[REQ-TRAJ-010]") {
+  // One jerk segment, T = 1, x(t) = 1e-3 t + t^2 + t^3 + t^4 + t^5: the smallest term |c_j| T^j
+  // is the velocity's (j = 1), so the polish reaches for c_1 first. Moving c_j by the miss r
+  // moves derivative k (1 <= k <= min(j, 2s-2)) by r j!/(j-k)! against its scale
+  // scaled[k] = sum_{j>=k} |c_j| T^j j!/(j-k)! (14.001 for the velocity). Held-out audit 6,
+  // h6-traj-06: the bound skipped k = j (for j = 1 every derivative), so c_1 moved.
+  MincoProblem p;
+  p.order = 3;
+  p.durations = {1.0};
+  Eigen::MatrixX3d c = Eigen::MatrixX3d::Zero(6, 3);
+  c.col(0) << 0.0, 1e-3, 1.0, 1.0, 1.0, 1.0;
+  const double end = c.col(0).sum();
+  const auto polished = [&](double miss) {
+    p.points = Eigen::MatrixX3d::Zero(2, 3);
+    p.points(1, 0) = end + miss;
+    PolynomialTrajectory t(3, {1.0}, c);
+    polish_waypoints(p, t);
+    return Eigen::VectorXd(t.coefficients().col(0));
+  };
+  // r = 1e-9: any move changes the velocity by >= r / 14.001 ~ 7e-11 of its scale, past the
+  // bound kPolishDamage = 1e-12: nothing moves.
+  CHECK(polished(1e-9) == Eigen::VectorXd(c.col(0)));
+  // r = 1e-14: c_1 moves by 1e-14 (7e-16 of the velocity's scale), the end meets the waypoint.
+  const Eigen::VectorXd small = polished(1e-14);
+  CHECK(small(1) != c(1, 0));
+  CHECK(small(1) == Approx(1e-3 + 1e-14).margin(2e-15));  // the waypoint is end + 1e-14 to an ulp of 4
+  for (int j = 2; j < 6; ++j) CHECK(small(j) == c(j, 0));
 }

@@ -102,6 +102,27 @@ TEST_CASE("A trajectory answer file is read strictly: junctions meet, the cost i
   miner::Json kink = good;
   kink["coefficients"][1][1][1] = kink["coefficients"][1][1][1].get<double>() + 0.05;  // velocity y
   CHECK_THROWS_WITH(trajectory_from_answer_json(kink, "a.json"), Contains("the velocity at the start of segment 1"));
+  // Every derivative 0..s-1 meets, the highest (s-1) too, for jerk and snap (held-out audit 6,
+  // h6-traj-04: the last one went unchecked). Row k of a segment is t^k's coefficient: the
+  // k-th derivative at its start is k! times it.
+  for (const int order : {3, 4}) {
+    miner::Json doc = problem();
+    doc["order"] = order;
+    if (order == 4) {
+      doc["head"].push_back({0, 0, 0});
+      doc["tail"].push_back({0, 0, 0});
+    }
+    const miner::Json answer = answer_to_json(solve_minco(problem_from_json(doc, "p.json")));
+    REQUIRE_NOTHROW(trajectory_from_answer_json(answer, "a.json"));
+    const char* const names[] = {"position", "velocity", "acceleration", "jerk"};
+    for (int k = 0; k < order; ++k) {
+      INFO("order " << order << ", derivative " << k);
+      miner::Json bent = answer;
+      bent["coefficients"][1][k][2] = bent["coefficients"][1][k][2].get<double>() + 0.05;
+      CHECK_THROWS_WITH(trajectory_from_answer_json(bent, "a.json"),
+                        Contains(std::string("the ") + names[k] + " at the start of segment 1"));
+    }
+  }
   miner::Json extra = good;
   extra["extra"] = 1;
   CHECK_THROWS_WITH(trajectory_from_answer_json(extra, "a.json"), Contains("a.json: extra: unknown key"));

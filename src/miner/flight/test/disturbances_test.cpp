@@ -463,6 +463,14 @@ TEST_CASE("Scenario disturbance sections are strict and named in their errors", 
   // gusts one after the other are not.
   nlohmann::json many = nlohmann::json::array();
   for (int i = 0; i < 1001; ++i) many.push_back({{"start_s", i}, {"duration_s", 0.5}, {"peak_m_s", {1, 0, 0}}});
+  // The pose stream's delay and its jitter together at most 1 s (held-out audit 6, h6-flight-04:
+  // the jitter alone was bounded); exactly 1 s is kept.
+  refused("pose", {{"delay_s", 0.8}, {"delay_jitter_s", 0.5}}, "pose.delay_jitter_s: delay_s + delay_jitter_s must be at most 1 s");
+  {
+    nlohmann::json second = base;
+    second["pose"] = {{"delay_s", 0.5}, {"delay_jitter_s", 0.5}};
+    CHECK_NOTHROW(pipeline::scenario_from_json(second, "ok.json", ""));
+  }
   refused("wind", {{"gusts", many}}, "wind.gusts");
   refused("wind", {{"gusts", many}}, "at most 1000");
   nlohmann::json stacked = nlohmann::json::array();

@@ -1,5 +1,7 @@
 #include <catch2/catch.hpp>
 
+#include <array>
+
 #include <cmath>
 
 #include "miner/core/error.hpp"
@@ -85,6 +87,21 @@ TEST_CASE("Plant time constants shorter than the integrator can take are refused
   CHECK_NOTHROW(flight::vehicle_from_json(doc, "v.json"));
   doc["inertia_kg_m2"] = {0.25, 0.25, 0.5000001};
   expect_vehicle_error(doc, "triangle inequality");
+  // Each moment against the sum of the two others, on every axis (held-out audit 6, h6-flight-06
+  // compared one with twice a single other): 0.05 > 0.02 + 0.028 is refused wherever it sits, the
+  // unequal but valid 0.03, 0.01, 0.035 accepted in every order.
+  const std::vector<std::array<double, 3>> bad_moments{{0.02, 0.05, 0.028}, {0.05, 0.028, 0.02}, {0.028, 0.02, 0.05}};
+  for (const auto& m : bad_moments) {
+    doc["inertia_kg_m2"] = {m[0], m[1], m[2]};
+    expect_vehicle_error(doc, "triangle inequality");
+  }
+  const std::vector<std::array<double, 3>> good_moments{{0.03, 0.01, 0.035}, {0.01, 0.035, 0.03}, {0.035, 0.03, 0.01},
+                                                        {0.03, 0.035, 0.01}, {0.01, 0.03, 0.035}, {0.035, 0.01, 0.03}};
+  for (const auto& m : good_moments) {
+    doc["inertia_kg_m2"] = {m[0], m[1], m[2]};
+    INFO(doc["inertia_kg_m2"].dump());
+    CHECK_NOTHROW(flight::vehicle_from_json(doc, "v.json"));
+  }
   // Seventh campaign C4: an inertia the rotors cannot turn in time.
   doc = vehicle_doc();
   doc["inertia_kg_m2"] = {100.0, 100.0, 150.0};

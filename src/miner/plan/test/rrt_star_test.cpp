@@ -200,6 +200,10 @@ TEST_CASE("Invalid planner options and a missing or mismatched region are refuse
   o.mu_1 = 0.5;
   o.mu_2 = -0.1;
   CHECK_THROWS_WITH(miner::plan::plan(problem, o, &region), Contains("mu_2"));
+  // mu = 1 leaves no uniform sample (Lemma 1 needs P(uniform) > 0): refused for mu_2 as for
+  // mu_1 above (held-out audit 6, h6-plan-05 accepted mu_2 = 1).
+  o.mu_2 = 1.0;
+  CHECK_THROWS_WITH(miner::plan::plan(problem, o, &region), Contains("mu_2"));
   o.mu_2 = 0.9;
   o.goal_bias = 1.0;
   CHECK_THROWS_WITH(miner::plan::plan(problem, o, &region), Contains("goal_bias"));

@@ -44,6 +44,13 @@ TEST_CASE("Cells whose centre lies outside the bounds are occupied", "[REQ-WORLD
   CHECK(grid.dims() == I(3, 1, 1));
   CHECK_FALSE(grid.occupied(I(1, 0, 0)));
   CHECK(grid.occupied(I(2, 0, 0)));
+  // A centre exactly on the bounds' max is inside (the bounds are closed): that layer is free,
+  // on every axis (held-out audit 6, h6-world-03 blocked it).
+  const Map edge(Box{{0, 0, 0}, {2.5, 1.5, 3.5}}, 1.0, {});  // last centres at 2.5, 1.5, 3.5
+  const VoxelGrid on_edge(edge, 0.0);
+  REQUIRE(on_edge.dims() == I(3, 2, 4));
+  CHECK(on_edge.cell_center(I(2, 1, 3)) == V(2.5, 1.5, 3.5));
+  CHECK(on_edge.occupied_count() == 0);
 }
 
 TEST_CASE("Cell lookup: indices, centres, the upper bound, outside points", "[REQ-WORLD-006]") {

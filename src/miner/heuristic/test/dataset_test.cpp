@@ -58,7 +58,11 @@ TEST_CASE("Environment cells are free, partial where a grown obstacle meets them
   const miner::world::Map map(Box{{0, 0, 0}, {8, 8, 4}}, 0.5,
                               {Box{{1.0, 1.0, 0.0}, {2.0, 3.0, 1.0}}, Box{{5.3, 5.9, 2.2}, {5.4, 6.0, 2.3}}});
   const Eigen::Vector3i dims(8, 8, 4);  // 1 m cells
-  const double r = 0.2;
+  // r = 0 puts the first box's faces on cell edges: a cell whose closed box only touches it is
+  // met, on its low face as on its high one (held-out audit 6, h6-heuristic-05 missed the
+  // touch on the low face).
+  for (const double r : {0.2, 0.0}) {
+  INFO("robot radius " << r);
   const auto e = heuristic::encode_environment(map, dims, r);
   for (int k = 0; k < 4; ++k)
     for (int j = 0; j < 8; ++j)
@@ -85,6 +89,11 @@ TEST_CASE("Environment cells are free, partial where a grown obstacle meets them
         CHECK(e[(static_cast<std::size_t>(k) * 8 + j) * 8 + i] == (covered ? 2 : hit ? 1 : 0));
       }
   CHECK(e[(0 * 8 + 1) * 8 + 1] == heuristic::kSolid);  // [1,2]x[1,2]x[0,1] inside [0.8,2.2]x[0.8,3.2]x[-0.2,1.2]
+  if (r == 0.0) {
+    CHECK(e[(0 * 8 + 1) * 8 + 2] == heuristic::kPartial);  // [2,3]x[1,2]x[0,1] touches x = 2 on its low face
+    CHECK(e[(0 * 8 + 1) * 8 + 0] == heuristic::kPartial);  // [0,1]x[1,2]x[0,1] touches x = 1 on its high face
+  }
+  }
 }
 
 TEST_CASE("A cell covered only by the union of two boxes is covered: a gap of any width is found", "[REQ-HEUR-002]") {

@@ -343,6 +343,9 @@ TEST_CASE("The network is told its cells' metric size: sigma = log2(cell / radiu
   CHECK_THROWS_WITH(heuristic::scale_input(box, Eigen::Vector3i(32, 32, 32), -0.1, 4.0), Contains("radius"));
   // A point robot, and cells of 2^12 radii, get the limit instead of infinity or 3.
   for (double r : {0.0, 2.0 / 4096.0}) CHECK(heuristic::scale_input(box, Eigen::Vector3i(32, 32, 32), r, 4.0)[0] == 2.0f);
+  // ... and a robot far wider than the cells (cells of 2^-12 radii: sigma -3) gets -2, the
+  // lower limit (held-out audit 6, h6-heuristic-06 clamped only from above).
+  CHECK(heuristic::scale_input(box, Eigen::Vector3i(32, 32, 32), 2.0 * 4096.0, 4.0)[0] == -2.0f);
   const miner::world::Box flat{Eigen::Vector3d::Zero(), Eigen::Vector3d(64, 32, 0)};
   CHECK_THROWS_WITH(heuristic::scale_input(flat, Eigen::Vector3i(32, 32, 32), 0.5, 4.0), Contains("cells"));
   // The shipped network takes sigma, and it changes the answer: the same E, S and noise on a
@@ -399,6 +402,18 @@ TEST_CASE("A missing, truncated, altered or mismatched weights file is refused n
   CHECK_THROWS_WITH(heuristic::parse_tensor_file(tensor_blob({{"kind", "k"}, {"tensors", tensors}}, std::vector<float>(648)),
                                                  "x.bin", "k"),
                     Contains("past the data"));
+  // Data the tensors do not tile is refused, a gap between two and bytes after the last alike
+  // (held-out audit 6, h6-heuristic-01 let trailing bytes through).
+  {
+    miner::Json one = miner::Json::array();
+    one.push_back({{"name", "a"}, {"shape", {4}}, {"offset", 0}, {"count", 4}});
+    CHECK_NOTHROW(heuristic::parse_tensor_file(tensor_blob({{"kind", "k"}, {"tensors", one}}, std::vector<float>(4)), "x.bin", "k"));
+    CHECK_THROWS_WITH(heuristic::parse_tensor_file(tensor_blob({{"kind", "k"}, {"tensors", one}}, std::vector<float>(5)), "x.bin", "k"),
+                      Contains("x.bin") && Contains("data bytes 16 to 20 belong to no tensor"));
+    one[0]["offset"] = 4;
+    CHECK_THROWS_WITH(heuristic::parse_tensor_file(tensor_blob({{"kind", "k"}, {"tensors", one}}, std::vector<float>(5)), "x.bin", "k"),
+                      Contains("data bytes 0 to 4 belong to no tensor"));
+  }
   // Issue 20: the header is strict. Unknown keys anywhere, a wrong layer list, tensors that
   // share bytes or leave bytes over, and an input scale the network never saw are refused.
   {

@@ -140,3 +140,20 @@ TEST_CASE("Segments reaching far beyond a voxel map get the answer of their part
   // Entirely beside the map, beyond the radius: free.
   CHECK_FALSE(map.segment_collision(V(-far, -5, -5), V(far, -5, -5), 1.0));
 }
+
+TEST_CASE("A voxel map's grid grows a blocked voxel by the robot radius: cubes that only touch stay free",
+          "[REQ-WORLD-006][REQ-WORLD-012]") {
+  // A cell is occupied iff its open interior comes within r of a blocked voxel's cube: with
+  // r = 0 a neighbour only touches it (held-out audit 6, h6-world-04 took distance 0 as
+  // meeting at r = 0: every neighbour blocked).
+  const Map open = Map::from_voxels({small_layer(), UnknownPolicy::kFree, "", ""});
+  const VoxelGrid bare(open, 0.0);
+  CHECK(bare.occupied_count() == 1);
+  CHECK(bare.occupied(Eigen::Vector3i(2, 2, 2)));
+  // r just under a cell: the 26 neighbours (cube distance 0) join, a cell one gap away
+  // (distance 1) does not; at r = 1 it does (the rounding slack on r^2 errs towards occupied).
+  const VoxelGrid under(open, 1.0 - 1e-6);
+  CHECK(under.occupied_count() == 27);
+  CHECK_FALSE(under.occupied(Eigen::Vector3i(0, 2, 2)));
+  CHECK(VoxelGrid(open, 1.0).occupied(Eigen::Vector3i(0, 2, 2)));
+}

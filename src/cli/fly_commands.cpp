@@ -1,5 +1,6 @@
 // `miner fly` (REQ-FLIGHT-009) and `miner bench sim` (REQ-FLIGHT-010).
 #include <chrono>
+#include <cstdint>
 #include <filesystem>
 #include <iomanip>
 #include <memory>
@@ -23,12 +24,16 @@ namespace {
 
 struct ScenarioOptions {
   std::string scenario;  ///< empty: the embedded default
-  long long seed = -1;   ///< < 0: the scenario's
+  /// --seed, when given: any of 0..2^64-1 (issue 20, eighth campaign W1: a signed holder
+  /// clamped every seed from 2^63 on to 2^63 - 1).
+  std::uint64_t seed = 0;
+  CLI::Option* seed_option = nullptr;
+  bool seed_given() const { return seed_option != nullptr && seed_option->count() > 0; }
 };
 
 void add_scenario_options(CLI::App* cmd, ScenarioOptions& o) {
   cmd->add_option("--scenario", o.scenario, "miner-scenario-v1 file (default: the embedded indoor-1 scenario)");
-  cmd->add_option("--seed", o.seed, "override the scenario's seed")->check(kUnsigned64);
+  o.seed_option = cmd->add_option("--seed", o.seed, "override the scenario's seed")->check(kUnsigned64);
 }
 
 /// The scenario document as read once: --scenario's file, or the embedded default.
@@ -37,15 +42,19 @@ struct ScenarioDocument {
   std::string origin, base_dir;
 };
 
+/// --seed overrides the document's own seed, so that what the run folder keeps of the scenario
+/// flies the same flight again (eighth campaign W2: scenario.json kept the file's seed).
 ScenarioDocument read_scenario_document(const ScenarioOptions& o) {
-  if (o.scenario.empty()) return {pipeline::default_scenario_document(), "<default scenario>", ""};
-  return {read_json_file(o.scenario), o.scenario, std::filesystem::path(o.scenario).parent_path().string()};
+  ScenarioDocument d = o.scenario.empty()
+                           ? ScenarioDocument{pipeline::default_scenario_document(), "<default scenario>", ""}
+                           : ScenarioDocument{read_json_file(o.scenario), o.scenario,
+                                              std::filesystem::path(o.scenario).parent_path().string()};
+  if (o.seed_given() && d.doc.is_object()) d.doc["seed"] = o.seed;
+  return d;
 }
 
-pipeline::Scenario resolve_scenario(const ScenarioOptions& o, const ScenarioDocument& d) {
-  pipeline::Scenario s = pipeline::scenario_from_json(d.doc, d.origin, d.base_dir);
-  if (o.seed >= 0) s.seed = static_cast<std::uint64_t>(o.seed);
-  return s;
+pipeline::Scenario resolve_scenario(const ScenarioOptions&, const ScenarioDocument& d) {
+  return pipeline::scenario_from_json(d.doc, d.origin, d.base_dir);
 }
 
 struct FlyCliOptions {

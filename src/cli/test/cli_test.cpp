@@ -1967,3 +1967,21 @@ TEST_CASE("A flight that leaves the map stops there: exit 3 naming when and wher
   CHECK(summary["flight_time_s"].get<double>() == summary["left_map"]["time_s"].get<double>());
   CHECK(summary["goal_reached"] == false);
 }
+
+TEST_CASE("fly --seed takes every 64-bit seed and the run folder keeps it: flying its scenario again gives the same bytes",
+          "[REQ-FLIGHT-009][REQ-CLI-002]") {
+  // Issue 20, eighth campaign W1: seeds from 2^63 on were clamped to 2^63 - 1; W2: the run
+  // folder's scenario.json kept the file's seed, so its replay flew another flight.
+  const std::string run = dir() + "/seed-max", again = dir() + "/seed-max-again";
+  const Run r = miner_cli({"fly", "--seed", "18446744073709551615", "--out", run});
+  REQUIRE(r.code == 0);
+  CHECK_THAT(r.out, Contains("(seed 18446744073709551615,"));
+  CHECK(miner::read_json_file(run + "/scenario.json")["seed"].get<std::uint64_t>() == 18446744073709551615ULL);
+  CHECK(miner::read_json_file(run + "/summary.json")["seed"].get<std::uint64_t>() == 18446744073709551615ULL);
+  REQUIRE(miner_cli({"fly", "--scenario", run + "/scenario.json", "--out", again, "--quiet"}).code == 0);
+  CHECK(read(again + "/flight_log.csv") == read(run + "/flight_log.csv"));
+  // 2^63 and 2^63 - 1 are two seeds, two flights.
+  REQUIRE(miner_cli({"fly", "--seed", "9223372036854775808", "--out", dir() + "/seed-263", "--quiet"}).code == 0);
+  REQUIRE(miner_cli({"fly", "--seed", "9223372036854775807", "--out", dir() + "/seed-263-1", "--quiet"}).code == 0);
+  CHECK(read(dir() + "/seed-263/flight_log.csv") != read(dir() + "/seed-263-1/flight_log.csv"));
+}

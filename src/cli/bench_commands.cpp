@@ -69,6 +69,15 @@ void require_figures_folder(const std::filesystem::path& folder) {
     throw Error(problem);
 }
 
+/// The default figures folder of a report: beside it, named after it (docs/results.md ->
+/// docs/results/), so that two reports in one folder never share one figures folder, which
+/// each run replaces whole (issue 20, eighth campaign D1, D2: a second report's run deleted the
+/// first one's box plots). A name that is all suffix (".md") gets "-figures" added.
+std::filesystem::path default_figures_folder(const std::filesystem::path& results) {
+  const std::filesystem::path stem = results.stem();
+  return results.parent_path() / (stem == results.filename() ? stem.string() + "-figures" : stem.string());
+}
+
 /// The figures and their manifest figures.json (format, command, files), written as one folder:
 /// a later run with other maps or steps knows the folder as its own by the manifest (seventh
 /// campaign C6: it was refused for holding none of the new file names).
@@ -230,7 +239,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   struct PaperOptions {
     bench::PaperBenchOptions bench;
     std::string results = "docs/results.md";
-    std::string figures;  // empty: <results folder>/results
+    std::string figures;  // empty: default_figures_folder(results)
     bool json = false;
     bool quiet = false;
   };
@@ -264,7 +273,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
       ->check(integer_in(1, 256));
   pc->add_option("--out,--results", p->results, "the Markdown report to write (.md; --results: its former name)")->capture_default_str()
       ->check(kOutputFileNewFolder & suffix_output(".md", "the report is Markdown"));
-  pc->add_option("--figures", p->figures, "folder for the box plots (default: <--out's folder>/results)")
+  pc->add_option("--figures", p->figures, "folder for the box plots (default: beside --out, named after it: docs/results.md -> docs/results)")
       ->check(output_folder_for(kFiguresMarker, {".svg", ".json"}));
   pc->add_flag("--json", p->json, "print every figure as JSON");
   pc->add_flag("--quiet", p->quiet, "no progress on stderr");
@@ -277,7 +286,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
     const std::string command = command_line(pc, {"--runs", "--seed", "--time-limit", "--heuristic-samples"});
     namespace fs = std::filesystem;
     const fs::path results(p->results);
-    const fs::path figures = p->figures.empty() ? results.parent_path() / "results" : fs::path(p->figures);
+    const fs::path figures = p->figures.empty() ? default_figures_folder(results) : fs::path(p->figures);
     require_figures_folder(figures);  // the default one too, before the work (seventh campaign C6)
     const auto r = bench::run_paper_bench(p->bench, command, p->quiet ? nullptr : terminal_stream());
     const std::string link = fs::relative(fs::absolute(figures), fs::absolute(results).parent_path()).generic_string();
@@ -293,7 +302,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
     bench::SuiteBenchOptions bench;
     std::string suite = "fixtures/bench/suite.json";
     std::string results = "docs/suite.md";
-    std::string figures;  // empty: <results folder>/suite
+    std::string figures;  // empty: default_figures_folder(results)
     bool json = false;
     bool quiet = false;
   };
@@ -312,7 +321,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   sc->add_option("--weights", su->bench.weights, "sGAN weights (default: the shipped ones)");
   sc->add_option("--out,--results", su->results, "the Markdown report to write (.md; --results: its former name)")->capture_default_str()
       ->check(kOutputFileNewFolder & suffix_output(".md", "the report is Markdown"));
-  sc->add_option("--figures", su->figures, "folder for the box plots (default: <--out's folder>/suite)")
+  sc->add_option("--figures", su->figures, "folder for the box plots (default: beside --out, named after it: docs/suite.md -> docs/suite)")
       ->check(output_folder_for(kFiguresMarker, {".svg", ".json"}));
   sc->add_flag("--json", su->json, "print every figure as JSON");
   sc->add_flag("--quiet", su->quiet, "no progress on stderr");
@@ -325,7 +334,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
     su->bench.suite = bench::load_suite(su->suite);
     su->bench.suite_file = su->suite;
     const fs::path results(su->results);
-    const fs::path figures = su->figures.empty() ? results.parent_path() / "suite" : fs::path(su->figures);
+    const fs::path figures = su->figures.empty() ? default_figures_folder(results) : fs::path(su->figures);
     const std::string command = command_line(sc, {"--suite", "--runs", "--seed", "--time-limit", "--iterations"});
     require_figures_folder(figures);  // the default one too, before the work (seventh campaign C6)
     const auto r = bench::run_suite_bench(su->bench, command, su->quiet ? nullptr : terminal_stream());

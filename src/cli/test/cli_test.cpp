@@ -938,6 +938,15 @@ TEST_CASE("A figure folder carries a manifest and a later run with other steps r
   const miner::Json manifest = miner::read_json_file(dir() + "/c6/suite/figures.json");
   CHECK(manifest["format"] == "miner-figures-v1");
   CHECK(manifest["files"] == miner::Json::array({"m-0.3-target.svg"}));
+  // Another report in the same folder gets its own figures folder, named after it: the first
+  // report's plots stay (eighth campaign D1, D2: a shared default folder was replaced whole).
+  const Run other = miner_cli({"bench", "suite", "--suite", suite_a, "--planners", "rrtstar", "--runs", "1", "--iterations",
+                               "300", "--out", dir() + "/c6/other.md", "--quiet"});
+  REQUIRE(other.code == 0);
+  CHECK(miner::read_json_file(dir() + "/c6/suite/figures.json") == manifest);
+  CHECK(std::filesystem::exists(dir() + "/c6/suite/m-0.3-target.svg"));
+  CHECK(miner::read_json_file(dir() + "/c6/other/figures.json")["files"] == miner::Json::array({"m-0.2-target.svg"}));
+  CHECK_THAT(read(dir() + "/c6/other.md"), Contains("](other/m-0.2-target.svg)"));
   // A folder of the user's is refused before any work, the default one included.
   const std::string user = dir() + "/c6-user";
   std::filesystem::create_directories(user + "/suite");

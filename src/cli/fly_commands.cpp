@@ -109,15 +109,21 @@ void run_fly(const FlyCliOptions& o, std::ostream& out) {
     for (std::size_t i = 0; i < names.size(); ++i) out << (i ? ", " : "") << names[i];
     out << ")\nreport: " << dir << "/report.html\n";
   }
+  // What ended the flight first: an empty battery stops the rotors (eighth campaign W3).
+  const std::string depleted =
+      r.battery_depleted_s ? "; the battery was depleted at t = " + short_number(*r.battery_depleted_s) + " s (" +
+                                 short_number(s.battery.capacity_wh * s.battery.initial_charge) +
+                                 " Wh stored: battery.capacity_wh x battery.initial_charge)"
+                           : "";
   if (r.left_world)
     throw NoSolution("the vehicle left the map at t = " + short_number(r.left_world_time_s) + " s at " +
                      format_point(r.left_world_position) + " (bounds " + format_point(s.map->bounds().min) + " to " +
                      format_point(s.map->bounds().max) + "): the flight stopped there, collisions " +
-                     std::to_string(r.collisions));
+                     std::to_string(r.collisions) + depleted);
   if (!r.goal_reached)
     throw NoSolution("the flight did not reach the goal (final error " + std::to_string(r.final_position_error) +
                      " m, speed " + std::to_string(r.final_speed) + " m/s, collisions " +
-                     std::to_string(r.collisions) + ")");
+                     std::to_string(r.collisions) + ")" + depleted);
 }
 
 struct SimBenchCliOptions {

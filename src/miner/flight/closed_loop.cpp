@@ -256,6 +256,7 @@ FlightResult fly(const FlightSetup& s, const ReferenceTrajectory& reference, con
     if (s.battery.enabled) {
       battery.step(plant, truth.rotor, dt);
       out.battery_min_voltage = std::min(out.battery_min_voltage, battery.voltage());
+      if (battery.depleted() && !out.battery_depleted_s) out.battery_depleted_s = t + dt;
     }
   }
 
@@ -334,7 +335,9 @@ FlightResult fly(const FlightSetup& s, const ReferenceTrajectory& reference, con
   if (s.wind.enabled) met["wind"] = {{"rms_m_s", out.wind_rms}, {"max_m_s", out.wind_max}};
   if (s.mismatch.any()) met["mismatch"] = to_json(s.mismatch);
   if (s.battery.enabled)
-    met["battery"] = {{"min_voltage_v", out.battery_min_voltage}, {"used_wh", out.battery_used_wh}};
+    met["battery"] = {{"min_voltage_v", out.battery_min_voltage},
+                      {"used_wh", out.battery_used_wh},
+                      {"depleted_at_s", out.battery_depleted_s ? Json(*out.battery_depleted_s) : Json(nullptr)}};
   if (s.pose.vio()) met["pose_drift_m"] = vec_json(out.pose_drift);
   if (!met.empty()) out.summary["disturbances"] = met;
   return out;

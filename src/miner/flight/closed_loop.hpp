@@ -115,6 +115,8 @@ struct FlightResult {
   double wind_rms = 0.0, wind_max = 0.0;     ///< m/s, |w| over the flight
   double battery_min_voltage = 0.0;          ///< V (0 without a battery model)
   double battery_used_wh = 0.0;
+  /// Simulated time the battery was depleted (Battery::depleted), if it was.
+  std::optional<double> battery_depleted_s;
   Eigen::Vector3d pose_drift = Eigen::Vector3d::Zero();  ///< the VIO frame's drift at the end (m)
   long n3_rejected_commands = 0;
   long rhs_evaluations = 0;

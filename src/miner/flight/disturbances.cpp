@@ -236,11 +236,17 @@ double Battery::terminal_voltage(const BatteryParams& b, double charge, double p
 }
 
 double Battery::step(const VehicleParams& plant, const Eigen::Vector4d& w, double dt) {
+  if (depleted_) return voltage_;
   const double p = power(plant, params_, w);
   voltage_ = terminal_voltage(params_, charge_, p);
-  const double wh = p * dt / 3600.0;
+  const double stored_wh = charge_ * params_.capacity_wh;
+  const double wh = std::min(p * dt / 3600.0, stored_wh);
   used_wh_ += wh;
-  charge_ = std::max(0.0, charge_ - wh / params_.capacity_wh);
+  charge_ = std::max(0.0, (stored_wh - wh) / params_.capacity_wh);
+  if (charge_ <= 0.0 && p > 0.0) {
+    depleted_ = true;
+    voltage_ = 0.0;
+  }
   return voltage_;
 }
 

@@ -127,7 +127,8 @@ class Battery {
  public:
   explicit Battery(const BatteryParams& params);
   /// Draws the electrical power of rotor speeds w for dt seconds; returns the terminal
-  /// voltage during the interval.
+  /// voltage during the interval. It never gives more than it stores: once the charge is spent
+  /// the pack is depleted (voltage 0; issue 20, eighth campaign W3: 0.5 Wh gave 2.67 Wh).
   double step(const VehicleParams& plant, const Eigen::Vector4d& w, double dt);
   /// Electrical power (W) of rotor speeds w.
   static double power(const VehicleParams& plant, const BatteryParams& b, const Eigen::Vector4d& w);
@@ -136,6 +137,9 @@ class Battery {
   double voltage() const { return voltage_; }
   double charge() const { return charge_; }
   double energy_used_wh() const { return used_wh_; }
+  /// The pack is empty: its stored energy is spent, the ESCs' low-voltage cutoff holds the
+  /// voltage (and the rotors) at 0 from then on.
+  bool depleted() const { return depleted_; }
   /// Highest rotor speed the motors reach at the present voltage (rad/s).
   double rotor_speed_limit(const VehicleParams& plant) const {
     return plant.rotor_speed_max * voltage_ / params_.full_voltage;
@@ -144,6 +148,7 @@ class Battery {
  private:
   BatteryParams params_;
   double charge_, voltage_, used_wh_ = 0.0;
+  bool depleted_ = false;
 };
 
 }  // namespace miner::flight

@@ -308,6 +308,35 @@ TEST_CASE("A drained battery under a heavy plant saturates the thrust: the fligh
   CHECK(drained.summary["events"]["saturation_time_s"].get<double>() == drained.saturation_time_s);
 }
 
+TEST_CASE("A pack too small for the flight is depleted: it gives what it stored, no more, and the flight fails",
+          "[REQ-FLIGHT-014]") {
+  // Issue 20, eighth campaign W3: 0.5 Wh stored gave 2.67 Wh and the flight reached its goal.
+  Eigen::MatrixX3d points(2, 3);
+  points << 5, 5, 3, 8, 6, 3.5;
+  pipeline::Scenario s = miner::testing::open_room_scenario(points, 1.0, 0.5, 3);
+  s.battery.enabled = true;
+  s.battery.capacity_wh = 0.1;  // ~180 W hover: ~2 s of flight in 0.1 Wh
+  s.battery.initial_charge = 1.0;
+  const auto r = pipeline::fly(s, pipeline::build_reference(s));
+  CHECK_FALSE(r.goal_reached);
+  REQUIRE(r.battery_depleted_s.has_value());
+  CHECK(*r.battery_depleted_s > 0.0);
+  CHECK(*r.battery_depleted_s < r.flight_time);
+  CHECK(r.battery_used_wh == Approx(s.battery.capacity_wh * s.battery.initial_charge).epsilon(1e-12));
+  CHECK(r.battery_min_voltage == 0.0);
+  // The rotors stop: the vehicle falls out through the floor of the room.
+  CHECK(r.left_world);
+  CHECK(r.left_world_position.z() < 0.0);
+  CHECK(r.summary["disturbances"]["battery"]["depleted_at_s"].get<double>() == *r.battery_depleted_s);
+  // A full-sized pack lasts: no depletion, reported as null.
+  s.battery.capacity_wh = 60.0;
+  const auto full = pipeline::fly(s, pipeline::build_reference(s));
+  CHECK(full.goal_reached);
+  CHECK_FALSE(full.battery_depleted_s.has_value());
+  CHECK(full.summary["disturbances"]["battery"]["depleted_at_s"].is_null());
+  CHECK(full.battery_used_wh < 60.0);
+}
+
 TEST_CASE("The VIO pose stream drifts as a random walk, loses tracking at its rate and jitters within bounds", "[REQ-FLIGHT-015]") {
   flight::PoseParams p;
   p.outlier_probability = 0.0;

@@ -69,6 +69,19 @@ void validate(const VehicleParams& v, const std::string& origin) {
     bad(origin, "rotor_drag_N_s_per_m_rad", "must be finite and in [0, 0.01]");
   if (!std::isfinite(v.quadratic_drag) || v.quadratic_drag < 0.0 || v.quadratic_drag > 100.0)
     bad(origin, "quadratic_drag_N_s2_per_m2", "must be finite and in [0, 100]");
+  // The rotors' own range first: the checks below derive torques and lags from it (issue 20,
+  // eighth campaign U1: min > max was blamed on the inertia, with a negative torque).
+  if (!std::isfinite(v.rotor_speed_min) || v.rotor_speed_min < 0.0 ||
+      v.rotor_speed_min >= v.rotor_speed_max)
+    bad(origin, "rotor_speed_min_rad_s", "must satisfy 0 <= min < rotor_speed_max_rad_s");
+  if (v.thrust_to_weight() < min_thrust_to_weight())
+    bad(origin, "rotor_speed_max_rad_s",
+        "maximum thrust " + std::to_string(v.max_thrust()) + " N gives a thrust-to-weight ratio of " +
+            std::to_string(v.thrust_to_weight()) + " < " + std::to_string(min_thrust_to_weight()) +
+            " (weight " + std::to_string(v.weight()) +
+            " N): the vehicle cannot hold altitude at the 35 deg tilt limit");
+  if (4.0 * v.thrust_coefficient * v.rotor_speed_min * v.rotor_speed_min >= v.weight())
+    bad(origin, "rotor_speed_min_rad_s", "idle thrust carries the whole weight: the vehicle cannot descend");
   // The collision sphere holds the rotors' axes at least: a 1 m arm inside a 0.3 m sphere flew
   // through obstacles its rotors would hit, counted "collisions 0" (issue 20, seventh campaign W5).
   if (v.radius < v.arm_length) {
@@ -106,17 +119,6 @@ void validate(const VehicleParams& v, const std::string& origin) {
                   v.mass, linear_coefficient, v.mass / linear_coefficient, kMinPlantTimeConstant);
     bad(origin, "linear_drag_N_s_per_m", text);
   }
-  if (!std::isfinite(v.rotor_speed_min) || v.rotor_speed_min < 0.0 ||
-      v.rotor_speed_min >= v.rotor_speed_max)
-    bad(origin, "rotor_speed_min_rad_s", "must satisfy 0 <= min < rotor_speed_max_rad_s");
-  if (v.thrust_to_weight() < min_thrust_to_weight())
-    bad(origin, "rotor_speed_max_rad_s",
-        "maximum thrust " + std::to_string(v.max_thrust()) + " N gives a thrust-to-weight ratio of " +
-            std::to_string(v.thrust_to_weight()) + " < " + std::to_string(min_thrust_to_weight()) +
-            " (weight " + std::to_string(v.weight()) +
-            " N): the vehicle cannot hold altitude at the 35 deg tilt limit");
-  if (4.0 * v.thrust_coefficient * v.rotor_speed_min * v.rotor_speed_min >= v.weight())
-    bad(origin, "rotor_speed_min_rad_s", "idle thrust carries the whole weight: the vehicle cannot descend");
 }
 
 VehicleParams vehicle_from_json(const Json& doc, const std::string& origin) {

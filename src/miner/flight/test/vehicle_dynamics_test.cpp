@@ -53,6 +53,11 @@ TEST_CASE("Missing or non-physical vehicle parameters are refused naming the par
   doc = vehicle_doc();
   doc["inertia_kg_m2"] = {0.01, 0.01, 0.05};
   expect_vehicle_error(doc, "triangle inequality");
+  // Rotor speeds out of order are named as such, before anything derived from them (eighth
+  // campaign U1: blamed on the inertia, a torque of -4.2 N m and a tilt time of -nan s).
+  doc = vehicle_doc();
+  doc["rotor_speed_min_rad_s"] = 1500.0;
+  expect_vehicle_error(doc, "v.json: rotor_speed_min_rad_s: must satisfy 0 <= min < rotor_speed_max_rad_s");
   doc = vehicle_doc();
   doc.erase("motor_time_constant_up_s");
   expect_vehicle_error(doc, "motor_time_constant_up_s: missing required field");

@@ -418,6 +418,24 @@ ReferencePlan build_reference(const Scenario& s) {
   // Plan and repair with the tracking margin added: a reference that grazes the inflated
   // map would be left by any tracking error (the flight checks the vehicle radius alone).
   const double radius = s.vehicle.radius + s.planning_margin;
+  // The body at the ends stays inside the map: an end on a face (a start on the floor) put half
+  // the vehicle outside, and the flight "collided" with no obstacle there (issue 20, eighth
+  // campaign U2); it would now leave the map at once (REQ-FLIGHT-009).
+  for (const auto& [p, name] : {std::pair<Eigen::Vector3d, const char*>{s.start, "start"}, {s.goal, "goal"}}) {
+    const world::Box& b = s.map->bounds();
+    const Eigen::Vector3d inside = (p - b.min).cwiseMin(b.max - p);
+    Eigen::Index axis = 0;
+    if (inside.minCoeff(&axis) < s.vehicle.radius) {
+      const bool low = p[axis] - b.min[axis] <= b.max[axis] - p[axis];
+      std::ostringstream os;
+      os << s.origin << ": " << name << " " << format_point(p) << " is " << short_number(inside[axis])
+         << " m from the map's " << (low ? "min" : "max") << " " << "xyz"[axis] << " = "
+         << short_number(low ? b.min[axis] : b.max[axis]) << ", less than the vehicle radius "
+         << short_number(s.vehicle.radius) << " m: the body would stick out of the map; move the " << name
+         << " inside";
+      throw Error(os.str());
+    }
+  }
   if (s.trajectory_file) {
     r.trajectory = *s.trajectory_file;
     r.source = "file";

@@ -98,6 +98,29 @@ TEST_CASE("Bad scenarios are refused before flight with the fault named", "[REQ-
   doc = default_doc();
   doc["pose"]["rate_hz"] = 60;
   expect_scenario_error(doc, "must divide the N3 loop rate");
+  // Eighth campaign U2: an end closer to a face of the map than the vehicle radius (on the floor,
+  // at the ceiling) put the body outside and the flight "collided" with nothing.
+  const miner::Json indoor = miner::read_json_file(std::string(MINER_SOURCE_DIR) + "/fixtures/maps/indoor-1.json");
+  const miner::Json& bounds = indoor["bounds"];
+  const double top = bounds["max"][2].get<double>();
+  doc = default_doc();
+  doc["start"] = indoor["query"]["start"];
+  doc["goal"] = indoor["query"]["goal"];
+  doc["start"][2] = bounds["min"][2].get<double>();
+  expect_scenario_error(doc, "s.json: start");
+  expect_scenario_error(doc, "m from the map's min z = 0, less than the vehicle radius 0.3 m");
+  doc = default_doc();
+  doc["start"] = indoor["query"]["start"];
+  doc["goal"] = indoor["query"]["goal"];
+  doc["goal"][2] = top - 0.29;
+  expect_scenario_error(doc, "s.json: goal");
+  expect_scenario_error(doc, "from the map's max z = " + std::to_string(static_cast<int>(top)));
+  doc["goal"][2] = top - 0.31;  // the radius fits: no complaint about the bounds
+  try {
+    pipeline::build_reference(pipeline::scenario_from_json(doc, "s.json", kScenarios));
+  } catch (const miner::Error& e) {
+    CHECK_THAT(std::string(e.what()), !Contains("from the map's"));
+  }
   doc = default_doc();
   doc["n3"]["rate_hz"] = 200;
   expect_scenario_error(doc, "n3: rate_hz must be in [400, 10000]");

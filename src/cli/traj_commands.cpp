@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/cli.hpp"
+#include "miner/core/text.hpp"
 #include "miner/core/error.hpp"
 #include "miner/core/json_io.hpp"
 #include "miner/traj/problem_io.hpp"
@@ -24,10 +25,15 @@ void run_solve(const SolveOptions& o, std::ostream& out) {
   const auto request = traj::request_from_json(read_json_file(o.problem), o.problem, o.allocate, o.rho);
   const auto& problem = request.problem;
   Json answer;
+  std::optional<double> solve_ms;  // said on the terminal, never in the file (deterministic bytes)
   try {
-    answer = request.optimise
-                 ? traj::answer_to_json(traj::optimise_allocation(problem, *request.optimise), *request.optimise)
-                 : traj::answer_to_json(traj::solve_minco(problem));
+    if (request.optimise) {
+      const traj::AllocationResult a = traj::optimise_allocation(problem, *request.optimise);
+      solve_ms = a.solve_ms;
+      answer = traj::answer_to_json(a, *request.optimise);
+    } else {
+      answer = traj::answer_to_json(traj::solve_minco(problem));
+    }
   } catch (const Error& e) {
     // The solver names the rule the problem breaks; the message names the problem file too
     // (issue 20, fourth campaign: "allocation: \"optimise\" needs ..." named no file).
@@ -42,7 +48,9 @@ void run_solve(const SolveOptions& o, std::ostream& out) {
       return;
     }
     out << "wrote " << o.out << ": " << answer["durations"].size() << " segments, order "
-        << problem.order << ", cost " << answer["cost"].get<double>() << "\n";
+        << problem.order << ", cost " << answer["cost"].get<double>();
+    if (solve_ms) out << ", allocation solved in " << short_number(*solve_ms) << " ms";
+    out << "\n";
   }
 }
 }  // namespace

@@ -114,8 +114,45 @@ GridPath astar(const Map& map, const VoxelGrid& grid, const Eigen::Vector3d& sta
   cost_to_come[si] = 0.0;
   open.emplace(octile_distance(s, g, 1.0), si);
 
+  // A flood from the goal, one cell per A* expansion: when it runs out first, the goal sits in
+  // a pocket without the start and the answer "unreachable" costs the pocket's size, not the
+  // whole grid's (issue 20, eighth campaign H1: an enclosed goal on a 64 M-cell grid ran past
+  // a minute). Steps are symmetric (the same cells lie between a and b as between b and a),
+  // so the flood's cells are exactly those that reach the goal. It stops once it meets the start.
+  std::vector<std::uint8_t> reaches_goal(n, 0);
+  std::vector<std::uint32_t> flood{static_cast<std::uint32_t>(gi)};  // n <= kMaxGridCells < 2^32
+  std::size_t flood_next = 0;
+  reaches_goal[gi] = 1;
+  bool flood_done = si == gi;
+  const auto flood_step = [&]() {
+    if (flood_next == flood.size()) return;
+    const std::size_t cur = flood[flood_next++];
+    const int cx = static_cast<int>(cur % nx), cy = static_cast<int>((cur / nx) % ny), cz = static_cast<int>(cur / (nx * ny));
+    for (const GridMove& m : moves) {
+      const int x = cx + m.dx, y = cy + m.dy, z = cz + m.dz;
+      if (x < 0 || y < 0 || z < 0 || x >= dims[0] || y >= dims[1] || z >= dims[2]) continue;
+      const std::size_t ni = static_cast<std::size_t>(static_cast<std::ptrdiff_t>(cur) + m.offset);
+      if (reaches_goal[ni] || grid.occupied(ni) || !block_free(grid, cur, m)) continue;
+      reaches_goal[ni] = 1;
+      flood.push_back(static_cast<std::uint32_t>(ni));
+      if (ni == si) flood_done = true;
+    }
+  };
+
   GridPath result;
   while (!open.empty()) {
+    if (!flood_done) {
+      flood_step();
+      if (flood_next == flood.size() && !reaches_goal[si]) {
+        std::ostringstream os;
+        os << "goal " << format_point(goal) << " is unreachable from start " << format_point(start)
+           << " for robot radius " << grid.robot_radius() << " m: the " << flood.size()
+           << " free cells that reach the goal do not include the start (the goal is enclosed)";
+        throw NoSolution(os.str());
+      }
+      if (flood_next == flood.size()) flood_done = true;
+      if (flood_done) std::vector<std::uint32_t>().swap(flood);  // the start reaches the goal: done
+    }
     const std::size_t cur = open.top().second;
     open.pop();
     if (closed[cur]) continue;

@@ -173,5 +173,16 @@ TEST_CASE("An unreachable goal is a NoSolution that says how much was searched",
   } catch (const miner::NoSolution& e) {
     CHECK_THAT(std::string(e.what()), Contains("goal (7.5, 7.5, 7.5) is unreachable from start (1, 1, 1)"));
     CHECK(e.code() == miner::ExitCode::kNoSolution);
+    // The work is the pocket's: the flood from the goal ran out after its one free cell, long
+    // before A* from the start had seen the ~990 outside (issue 20, eighth campaign H1: an
+    // enclosed goal on a 64 M-cell grid searched the whole grid for over a minute).
+    CHECK_THAT(std::string(e.what()), Contains("the 1 free cells that reach the goal do not include the start"));
+  }
+  // The start in the room instead: A* from it runs out first, and says so.
+  try {
+    astar(map, grid, V(7.5, 7.5, 7.5), V(1, 1, 1));
+    FAIL("expected NoSolution");
+  } catch (const miner::NoSolution& e) {
+    CHECK_THAT(std::string(e.what()), Contains("A* exhausted the 1 free cells reachable from the start"));
   }
 }

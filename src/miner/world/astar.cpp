@@ -118,7 +118,8 @@ GridPath astar(const Map& map, const VoxelGrid& grid, const Eigen::Vector3d& sta
   // a pocket without the start and the answer "unreachable" costs the pocket's size, not the
   // whole grid's (issue 20, eighth campaign H1: an enclosed goal on a 64 M-cell grid ran past
   // a minute). Steps are symmetric (the same cells lie between a and b as between b and a),
-  // so the flood's cells are exactly those that reach the goal. It stops once it meets the start.
+  // so the flood's cells are exactly those that reach the goal. It stops once it meets a cell A*
+  // has reached (then the start reaches the goal).
   std::vector<std::uint8_t> reaches_goal(n, 0);
   std::vector<std::uint32_t> flood{static_cast<std::uint32_t>(gi)};  // n <= kMaxGridCells < 2^32
   std::size_t flood_next = 0;
@@ -135,7 +136,8 @@ GridPath astar(const Map& map, const VoxelGrid& grid, const Eigen::Vector3d& sta
       if (reaches_goal[ni] || grid.occupied(ni) || !block_free(grid, cur, m)) continue;
       reaches_goal[ni] = 1;
       flood.push_back(static_cast<std::uint32_t>(ni));
-      if (ni == si) flood_done = true;
+      // A cell A* has reached from the start: start and goal are connected, the flood's job is done.
+      if (ni == si || cost_to_come[ni] < kInf) flood_done = true;
     }
   };
 
@@ -143,7 +145,7 @@ GridPath astar(const Map& map, const VoxelGrid& grid, const Eigen::Vector3d& sta
   while (!open.empty()) {
     if (!flood_done) {
       flood_step();
-      if (flood_next == flood.size() && !reaches_goal[si]) {
+      if (!flood_done && flood_next == flood.size() && !reaches_goal[si]) {
         std::ostringstream os;
         os << "goal " << format_point(goal) << " is unreachable from start " << format_point(start)
            << " for robot radius " << grid.robot_radius() << " m: the " << flood.size()

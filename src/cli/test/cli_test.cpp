@@ -647,6 +647,10 @@ TEST_CASE("Resource bounds: counts, budgets and tolerances outside their range a
       {{"bench", "sim", "--rtol", "1e-300"}, "--rtol"},
       {{"plan", "--map", map, "--iterations", "2000000000"}, "--iterations"},
       {{"plan", "--map", map, "--iterations", "1000001"}, "--iterations"},  // 10^7 ran for minutes
+      // A size alone too large at the family's coarsest resolution (eighth campaign U6: blamed
+      // on --resolution, never given, exit 1).
+      {{"map", "gen", "--preset", "cluttered", "--size", "1000", "1000", "1000", "--out", dir() + "/b.json"},
+       "--size: (1000, 1000, 1000) m at the family's coarsest resolution"},
       {{"bench", "frontend", "--map", map, "--throughput-iterations", "18446744073709551615"}, "--throughput-iterations"},
       {{"map", "gen", "--preset", "cluttered", "--resolution", "nan", "--out", dir() + "/b.json"}, "--resolution"}};
   for (const auto& [args, option] : cases) {

@@ -231,6 +231,20 @@ void check_overrides(const GeneratorPreset& preset, const GeneratorOverrides& ov
   }
   if (overrides.resolution && !(*overrides.resolution >= kMinFamilyResolution && *overrides.resolution <= kMaxFamilyResolution))
     throw Error("resolution: must be between 0.01 and 10 m");
+  // A size alone whose grid at the family's coarsest resolution is too large is the size's
+  // fault, named as such before any drawing (issue 20, eighth campaign U6: it was blamed on a
+  // resolution the user never gave, after the line was accepted).
+  if (overrides.size && !overrides.resolution && drawn != "scan" && is_family(generator_preset(drawn))) {
+    const double resolution = family_resolution(generator_preset(drawn), *overrides.size);
+    const Eigen::Vector3d cells = (*overrides.size / resolution).array().ceil();
+    if (cells.prod() > kMaxGeneratedCells) {
+      std::ostringstream os;
+      os << "size: " << format_point(*overrides.size) << " m at the family's coarsest resolution " << resolution
+         << " m gives " << cells.prod() << " grid cells (at most " << kMaxGeneratedCells
+         << "): give a smaller size or a coarser resolution";
+      throw Error(os.str());
+    }
+  }
   // A grid needs a cell along every axis: a resolution coarser than the smallest extent the map
   // can have is a fault of the overrides, found here, not after drawing (issue 20, fourth
   // campaign: it failed in the map's own check, exit 1).

@@ -11,6 +11,7 @@
 
 #include "miner/core/error.hpp"
 #include "miner/core/rng.hpp"
+#include "miner/core/text.hpp"
 #include "miner/heuristic/grid.hpp"
 #include "miner/heuristic/sgan_kernels.hpp"
 #include "miner/heuristic/tensor_file.hpp"
@@ -403,8 +404,11 @@ void Sgan::Impl::build(const TensorFile& f, Sgan::Kernels which) {
     dims.fail("each must be a multiple of 8 in [8, 256]");
   // E in {0, 1, 2} enters the network as E x scale: a scale outside (0, 1] is no encoding the
   // network was trained on (issue 20: -1e300 was accepted).
-  arch.environment_scale = ar.at("environment_scale").number_in(0.0, 1.0);
-  if (!(arch.environment_scale > 0.0)) ar.at("environment_scale").fail("must be positive");
+  // One range in one message: (0, 1] (issue 20, eighth campaign U5: -1 was told "[0, 1]" and
+  // 0 then "must be positive").
+  arch.environment_scale = ar.at("environment_scale").number();
+  if (!(arch.environment_scale > 0.0 && arch.environment_scale <= 1.0))
+    ar.at("environment_scale").fail("must be in (0, 1], got " + short_number(arch.environment_scale));
   arch.threshold = ar.at("threshold").number();
   if (!(arch.threshold > 0.0 && arch.threshold < 1.0)) ar.at("threshold").fail("must be in (0, 1)");
   // Absent in the files written before the widest rule (REQ-HEUR-016): fixed.

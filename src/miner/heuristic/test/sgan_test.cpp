@@ -434,7 +434,8 @@ TEST_CASE("A missing, truncated, altered or mismatched weights file is refused n
     refuses([](miner::Json& h) { h["tensors"][1]["offset"] = 0; }, "two tensors overlap");
     refuses([](miner::Json& h) { h["tensors"][1]["offset"] = 2593; }, "must be a multiple of 4");
     refuses([](miner::Json& h) { h["tensors"][0]["extra"] = 1; }, "tensors[0].extra: unknown key");
-    refuses([](miner::Json& h) { h["meta"]["architecture"]["environment_scale"] = -1e300; }, "environment_scale: must be in [0, 1]");
+    refuses([](miner::Json& h) { h["meta"]["architecture"]["environment_scale"] = -1e300; }, "environment_scale: must be in (0, 1]");
+    refuses([](miner::Json& h) { h["meta"]["architecture"]["environment_scale"] = 0; }, "environment_scale: must be in (0, 1], got 0");
     refuses([](miner::Json& h) { h["meta"]["architecture"]["scale_channels"] = 0; },
             "meta.architecture.scale_divisor: is given, but scale_channels is 0");
     refuses([](miner::Json& h) { h["meta"]["architecture"]["threshold_rule"] = "widset"; },

@@ -884,7 +884,13 @@ void report(bool json, const Json& doc, const std::string& human, std::ostream& 
 }
 
 int run_cli(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
-  return cli_main(args, out, err, Mode::kRun);
+  // Standard output is text (JSON, tables, "wrote <path>"): a control byte in a path or name
+  // the user gave reaches the terminal as \xNN, as on stderr (issue 20, eighth campaign U4: an
+  // escape sequence in --out was echoed raw). JSON escapes its own control bytes already.
+  std::ostringstream text;
+  const int code = cli_main(args, text, err, Mode::kRun);
+  out << printable_text(text.str());
+  return code;
 }
 
 int check_cli_arguments(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {

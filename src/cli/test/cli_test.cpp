@@ -2007,3 +2007,19 @@ TEST_CASE("fly --seed takes every 64-bit seed and the run folder keeps it: flyin
   REQUIRE(miner_cli({"fly", "--seed", "9223372036854775807", "--out", dir() + "/seed-263-1", "--quiet"}).code == 0);
   CHECK(read(dir() + "/seed-263/flight_log.csv") != read(dir() + "/seed-263-1/flight_log.csv"));
 }
+
+TEST_CASE("Eighth campaign: control bytes never reach stdout raw and a scan's failure names the user's seed",
+          "[REQ-CLI-001][REQ-WORLD-011]") {
+  // U4: a path holding a terminal escape was echoed raw on stdout (stderr escaped it).
+  const std::string odd = dir() + "/r\x1b[31mX.json";
+  const Run gen = miner_cli({"map", "gen", "--preset", "indoor", "--out", odd});
+  REQUIRE(gen.code == 0);
+  CHECK(gen.out.find('\x1b') == std::string::npos);
+  CHECK_THAT(gen.out, Contains("r\\x1b[31mX.json"));
+  CHECK(std::filesystem::exists(odd));  // the file itself has the name given
+  // U3: a scan whose base map cannot be drawn named the internal base seed, not --seed.
+  const Run scan = miner_cli({"map", "gen", "--preset", "scan", "--base", "sim", "--obstacles", "10000", "--seed", "1",
+                              "--out", dir() + "/u3.json"});
+  CHECK(scan.code == 3);
+  CHECK_THAT(scan.err, Contains("preset \"scan\", seed 1: its base map \"sim\" has no solvable draw"));
+}

@@ -112,7 +112,18 @@ ScanMap generate_scan_map(const GeneratorPreset& preset, std::uint64_t seed, con
       base_name = kScanBases[rng.uniform_index(choices)];
     }
     const GeneratorPreset base_preset = generator_preset(base_name);
-    const Map base = generate_map(base_preset, rng.next_u64(), base_overrides);
+    // The base's own failure names the scan's seed, the one the user gave (issue 20, eighth
+    // campaign U3: it named the internal base seed, which the user cannot pass back).
+    const std::uint64_t base_seed = rng.next_u64();
+    Map base = [&] {
+      try {
+        return generate_map(base_preset, base_seed, base_overrides);
+      } catch (const NoSolution&) {
+        throw NoSolution("preset \"scan\", seed " + std::to_string(seed) + ": its base map \"" + base_name +
+                         "\" has no solvable draw with these overrides in " + std::to_string(kMaxGeneratorAttempts) +
+                         " attempts (too many obstacles for its size?)");
+      }
+    }();
     // Every scan is planned for the preset's radius, the smallest of the bases' (so the base
     // map's own query, checked for a radius at least as large, stays solvable in it).
     const Query query{base.query()->start, base.query()->goal, preset.robot_radius};

@@ -19,6 +19,10 @@ constexpr double kDegree = M_PI / 180.0;
 constexpr double kMaxRays = kMaxScanRays;
 /// Most voxels all rays together may cross (OctoMap integrates ~1e7 per second).
 constexpr double kMaxRaySteps = 2e9;
+/// Most voxel tests the body sweep may make (poses every half voxel x the (2n + 1)^3 cube around
+/// each): ~1.4e8 per second here, so about 4 s (issue 20, eighth campaign UB1: --body-radius 10
+/// at 0.1 m took 2e9 tests, 15-60 s, outside the stated bounds).
+constexpr double kMaxSweepTests = 5e8;
 
 void check(bool ok, const std::string& field, const std::string& what) {
   if (!ok) throw Error("scan " + field + ": " + what);
@@ -97,6 +101,17 @@ void validate_scan(const ScanOptions& o, const Map& map, const std::vector<Eigen
        << " m would walk " << steps << " voxels, more than the " << kMaxRaySteps
        << " a scan may; use fewer rays, a shorter range or a coarser resolution";
     throw Error(os.str());
+  }
+  if (o.body_radius > 0.0) {
+    const double side = 2.0 * (std::ceil(o.body_radius / res) + 1.0) + 1.0;
+    const double tests = (std::floor(length / (0.5 * res)) + 2.0) * side * side * side;
+    if (tests > kMaxSweepTests) {
+      std::ostringstream os;
+      os << "scan: the body sweep (body radius " << o.body_radius << " m at " << res << " m voxels over " << length
+         << " m) would test " << tests << " voxels, more than the " << kMaxSweepTests
+         << " a scan may; use a smaller body radius or a coarser resolution";
+      throw Error(os.str());
+    }
   }
   // OctoMap keys are 16 bits: the map must lie within 32768 voxels of the origin.
   const double reach = std::max(map.bounds().min.cwiseAbs().maxCoeff(), map.bounds().max.cwiseAbs().maxCoeff());

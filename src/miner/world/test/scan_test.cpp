@@ -154,6 +154,15 @@ TEST_CASE("Bad scan settings are refused naming the setting", "[REQ-WORLD-016]")
   o.h_rays = 20000;  // 2e6 rays a pose, 4 poses at most (scan_ray_bound): 8e6 rays of up to ~2.5 m at 2 cm
   o.v_rays = 100;
   refuses(o, path, "would walk");
+  // The body sweep counts too (eighth campaign UB1: --body-radius 10 at 0.1 m, 2e9 voxel tests
+  // outside the stated bounds); a body the size of a vehicle is far inside the bound.
+  o = ScanOptions();
+  o.resolution = 0.05;
+  o.body_radius = 10.0;
+  refuses(o, path, "the body sweep (body radius 10 m at 0.05 m voxels");
+  refuses(o, path, "more than the 5e+08 a scan may");
+  o.body_radius = 0.3;
+  CHECK_NOTHROW(validate_scan(o, map, path));
   // A map 400 m from the origin at 1 cm: beyond OctoMap's 16-bit keys.
   const Map far(Box{V(400, 400, 0), V(404, 404, 2)}, 0.05, {});
   o = ScanOptions();

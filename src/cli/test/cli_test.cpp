@@ -650,7 +650,9 @@ TEST_CASE("Resource bounds: counts, budgets and tolerances outside their range a
       // A size alone too large at the family's coarsest resolution (eighth campaign U6: blamed
       // on --resolution, never given, exit 1).
       {{"map", "gen", "--preset", "cluttered", "--size", "1000", "1000", "1000", "--out", dir() + "/b.json"},
-       "--size: (1000, 1000, 1000) m at the family's coarsest resolution"},
+       "--size: (1000, 1000, 1000) m at the cluttered family's coarsest resolution"},
+      {{"map", "gen", "--preset", "scan", "--size", "1000", "1000", "100", "--out", dir() + "/b.json"},
+       "--size: (1000, 1000, 100) m at the "},
       {{"bench", "frontend", "--map", map, "--throughput-iterations", "18446744073709551615"}, "--throughput-iterations"},
       {{"map", "gen", "--preset", "cluttered", "--resolution", "nan", "--out", dir() + "/b.json"}, "--resolution"}};
   for (const auto& [args, option] : cases) {

@@ -234,15 +234,24 @@ void check_overrides(const GeneratorPreset& preset, const GeneratorOverrides& ov
   // A size alone whose grid at the family's coarsest resolution is too large is the size's
   // fault, named as such before any drawing (issue 20, eighth campaign U6: it was blamed on a
   // resolution the user never gave, after the line was accepted).
-  if (overrides.size && !overrides.resolution && drawn != "scan" && is_family(generator_preset(drawn))) {
-    const double resolution = family_resolution(generator_preset(drawn), *overrides.size);
-    const Eigen::Vector3d cells = (*overrides.size / resolution).array().ceil();
-    if (cells.prod() > kMaxGeneratedCells) {
-      std::ostringstream os;
-      os << "size: " << format_point(*overrides.size) << " m at the family's coarsest resolution " << resolution
-         << " m gives " << cells.prod() << " grid cells (at most " << kMaxGeneratedCells
-         << "): give a smaller size or a coarser resolution";
-      throw Error(os.str());
+  if (overrides.size && !overrides.resolution) {
+    // The families the map may be drawn from: the preset, a scan's base, or any family base of a
+    // scan without one (the recheck of U6: `--preset scan --size ...` still failed late).
+    std::vector<std::string> families;
+    if (drawn != "scan") families.push_back(drawn);
+    else
+      for (const std::string& b : scan_base_names()) families.push_back(b);
+    for (const std::string& f : families) {
+      if (!is_family(generator_preset(f))) continue;
+      const double resolution = family_resolution(generator_preset(f), *overrides.size);
+      const Eigen::Vector3d cells = (*overrides.size / resolution).array().ceil();
+      if (cells.prod() > kMaxGeneratedCells) {
+        std::ostringstream os;
+        os << "size: " << format_point(*overrides.size) << " m at the " << f << " family's coarsest resolution "
+           << resolution << " m gives " << cells.prod() << " grid cells (at most " << kMaxGeneratedCells
+           << "): give a smaller size or a coarser resolution";
+        throw Error(os.str());
+      }
     }
   }
   // A grid needs a cell along every axis: a resolution coarser than the smallest extent the map

@@ -115,12 +115,21 @@ TEST_CASE("Bad scenarios are refused before flight with the fault named", "[REQ-
   doc["goal"][2] = top - 0.29;
   expect_scenario_error(doc, "s.json: goal");
   expect_scenario_error(doc, "from the map's max z = " + std::to_string(static_cast<int>(top)));
-  doc["goal"][2] = top - 0.31;  // the radius fits: no complaint about the bounds
+  doc["goal"][2] = top - 0.3;  // exactly the radius inside (to rounding): no complaint about the bounds
   try {
     pipeline::build_reference(pipeline::scenario_from_json(doc, "s.json", kScenarios));
   } catch (const miner::Error& e) {
     CHECK_THAT(std::string(e.what()), !Contains("from the map's"));
   }
+  // A waypoint on a face too (the recheck: it flew out of the map).
+  doc = default_doc();
+  doc["start"] = indoor["query"]["start"];
+  doc["goal"] = indoor["query"]["goal"];
+  doc.erase("planner");
+  doc["waypoints"] = miner::Json::array({indoor["query"]["start"]});
+  doc["waypoints"][0][2] = bounds["min"][2].get<double>();
+  expect_scenario_error(doc, "s.json: waypoints[0]");
+  expect_scenario_error(doc, "m from the map's min z = 0, less than the vehicle radius 0.3 m");
   doc = default_doc();
   doc["n3"]["rate_hz"] = 200;
   expect_scenario_error(doc, "n3: rate_hz must be in [400, 10000]");

@@ -65,7 +65,8 @@ struct FlyCliOptions {
 };
 
 void run_fly(const FlyCliOptions& o, std::ostream& out) {
-  const ScenarioDocument document = read_scenario_document(o.scenario);
+  ScenarioDocument document = read_scenario_document(o.scenario);
+  if (o.ground_truth && document.doc.is_object()) document.doc["controller_reads"] = "ground-truth";
   const pipeline::Scenario s = resolve_scenario(o.scenario, document);
   // The run folder replaces its contents whole: it must hold none of the scenario's inputs,
   // checked before any work (REQ-CLI-003).
@@ -75,7 +76,7 @@ void run_fly(const FlyCliOptions& o, std::ostream& out) {
       throw CLI::ValidationError("--out", run_dir + " holds " + *input + ", which the scenario reads: the run folder would replace it");
   const pipeline::ReferencePlan reference = pipeline::build_reference(s);
   flight::FlyOptions options;
-  options.use_ground_truth = o.ground_truth;
+  options.use_ground_truth = s.controller_reads_truth;
   const auto t0 = std::chrono::steady_clock::now();
   const flight::FlightResult r = pipeline::fly(s, reference, options);
   auto stage_ms = reference.stage_ms;
@@ -95,7 +96,7 @@ void run_fly(const FlyCliOptions& o, std::ostream& out) {
     out << dump_json(summary);
   } else {
     out << "flew " << s.name << " (seed " << s.seed << ", controller on the "
-        << (o.ground_truth ? "GROUND TRUTH (diagnostic)" : "EKF estimate") << "): reference from "
+        << (s.controller_reads_truth ? "GROUND TRUTH (diagnostic)" : "EKF estimate") << "): reference from "
         << reference.source;
     if (reference.region) out << " (MINER RRT* on the " << reference.region->source() << " region)";
     out << ", " << reference.trajectory.segments() << " segments, " << std::fixed << std::setprecision(2)

@@ -2004,6 +2004,15 @@ TEST_CASE("fly --seed takes every 64-bit seed and the run folder keeps it: flyin
   CHECK(miner::read_json_file(run + "/summary.json")["seed"].get<std::uint64_t>() == 18446744073709551615ULL);
   REQUIRE(miner_cli({"fly", "--scenario", run + "/scenario.json", "--out", again, "--quiet"}).code == 0);
   CHECK(read(again + "/flight_log.csv") == read(run + "/flight_log.csv"));
+  // --ground-truth is recorded too: the replay flies on the truth again (recheck of W2).
+  const std::string truth = dir() + "/truth-run", truth_again = dir() + "/truth-again";
+  REQUIRE(miner_cli({"fly", "--ground-truth", "--out", truth, "--quiet"}).code == 0);
+  CHECK(miner::read_json_file(truth + "/scenario.json")["controller_reads"] == "ground-truth");
+  CHECK(miner::read_json_file(truth + "/summary.json")["controller_reads"] == "ground-truth");
+  REQUIRE(miner_cli({"fly", "--scenario", truth + "/scenario.json", "--out", truth_again, "--quiet"}).code == 0);
+  CHECK(miner::read_json_file(truth_again + "/summary.json")["controller_reads"] == "ground-truth");
+  CHECK(read(truth_again + "/flight_log.csv") == read(truth + "/flight_log.csv"));
+  CHECK(read(truth + "/flight_log.csv") != read(run + "/flight_log.csv"));
   // 2^63 and 2^63 - 1 are two seeds, two flights.
   REQUIRE(miner_cli({"fly", "--seed", "9223372036854775808", "--out", dir() + "/seed-263", "--quiet"}).code == 0);
   REQUIRE(miner_cli({"fly", "--seed", "9223372036854775807", "--out", dir() + "/seed-263-1", "--quiet"}).code == 0);

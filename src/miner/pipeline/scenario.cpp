@@ -48,7 +48,7 @@ Scenario scenario_from_json(const Json& doc, const std::string& origin, const st
   root.require_format(kScenarioFormat);
   root.only_keys({"format", "name", "map", "vehicle", "start", "goal", "waypoints", "trajectory", "planner", "seed",
                   "hover_after_s", "goal_tolerance_m", "planning_margin_m", "imu", "pose", "n3", "controller", "ekf",
-                  "command_dropout_s", "wind", "mismatch", "battery", "yaw"});
+                  "command_dropout_s", "wind", "mismatch", "battery", "yaw", "controller_reads"});
   Scenario s;
   s.origin = origin;
   if (root.has("name")) {
@@ -186,6 +186,15 @@ Scenario scenario_from_json(const Json& doc, const std::string& origin, const st
     // 2^64 and beyond parse as a double: the range, not the sign, is what is wrong with them.
     if (!f.value().is_number_unsigned()) f.fail("must be an integer in [0, 2^64 - 1], got " + f.value().dump());
     s.seed = f.value().get<std::uint64_t>();
+  }
+  // The diagnostic `fly --ground-truth` is part of what was flown: a run folder's scenario.json
+  // records it, so its replay flies the same flight (eighth campaign recheck of W2).
+  if (root.has("controller_reads")) {
+    const std::string reads = root.at("controller_reads").string();
+    if (reads != "ekf" && reads != "ground-truth")
+      root.at("controller_reads").fail("must be \"ekf\" (the default) or \"ground-truth\" (a diagnostic), not \"" +
+                                       reads + "\"");
+    s.controller_reads_truth = reads == "ground-truth";
   }
   if (root.has("hover_after_s")) {
     s.hover_after_s = root.at("hover_after_s").positive_number();
@@ -571,7 +580,9 @@ flight::FlightResult fly(const Scenario& scenario, const ReferencePlan& referenc
   const double radius = scenario.vehicle.radius;
   setup.collides = [map, radius](const Eigen::Vector3d& p) { return !map->is_free(p, radius); };
   setup.world = Eigen::AlignedBox3d(map->bounds().min, map->bounds().max);
-  return flight::fly(setup, reference, options);
+  flight::FlyOptions o = options;
+  o.use_ground_truth = o.use_ground_truth || scenario.controller_reads_truth;
+  return flight::fly(setup, reference, o);
 }
 
 }  // namespace miner::pipeline

@@ -13,6 +13,7 @@
 ///                                                           absent: plan with MINER RRT*),
 ///    "trajectory": {"order": 4, "v_max": 0.8, "a_max": 0.5} | {"file": "answer.json"},
 ///    "seed": 1, "hover_after_s": 3, "goal_tolerance_m": 0.3, "planning_margin_m": 0.1,
+///    "controller_reads": "ekf" (or "ground-truth": a diagnostic, fly --ground-truth),
 ///    "imu": {...}, "pose": {...}, "n3": {...}, "controller": {...}, "ekf": {...},
 ///    "command_dropout_s": [t0, t1]                         (optional: the companion
 ///                                                           computer stays silent then)}
@@ -64,6 +65,9 @@ struct Scenario : flight::FlightSetup {
   std::string origin;                       ///< where it was read from (messages)
   std::shared_ptr<const world::Map> map;  ///< never null after loading
   std::optional<Eigen::MatrixX3d> waypoints;  ///< interior waypoints, one per row
+  /// "controller_reads": "ground-truth": the controller reads the true state (a diagnostic,
+  /// `fly --ground-truth`); default "ekf", the estimate.
+  bool controller_reads_truth = false;
   int order = 4;                            ///< s: 3 jerk, 4 snap
   traj::Limits limits{0.8, 0.5};
   /// "trapezoid" or "optimise" (REQ-TRAJ-011: J + rho sum T within the limits, by Ceres).

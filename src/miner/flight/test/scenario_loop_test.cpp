@@ -98,6 +98,9 @@ TEST_CASE("Bad scenarios are refused before flight with the fault named", "[REQ-
   doc = default_doc();
   doc["pose"]["rate_hz"] = 60;
   expect_scenario_error(doc, "must divide the N3 loop rate");
+  doc = default_doc();
+  doc["controller_reads"] = "truth";
+  expect_scenario_error(doc, "s.json: controller_reads: must be \"ekf\" (the default) or \"ground-truth\"");
   // Eighth campaign U2: an end closer to a face of the map than the vehicle radius (on the floor,
   // at the ceiling) put the body outside and the flight "collided" with nothing.
   const miner::Json indoor = miner::read_json_file(std::string(MINER_SOURCE_DIR) + "/fixtures/maps/indoor-1.json");

@@ -69,13 +69,18 @@ void require_figures_folder(const std::filesystem::path& folder) {
     throw Error(problem);
 }
 
-/// The default figures folder of a report: beside it, named after it (docs/results.md ->
-/// docs/results/), so that two reports in one folder never share one figures folder, which
-/// each run replaces whole (issue 20, eighth campaign D1, D2: a second report's run deleted the
-/// first one's box plots). A name that is all suffix (".md") gets "-figures" added.
-std::filesystem::path default_figures_folder(const std::filesystem::path& results) {
+/// The figures folder of a report, checked before the work (require_figures_folder): --figures
+/// when given, else beside the report and named after it (docs/results.md -> docs/results/), so
+/// that two reports in one folder never share one figures folder, which each run replaces whole
+/// (issue 20, eighth campaign D1, D2: a second report's run deleted the first one's box plots).
+/// A name that is all suffix (".md") gets "-figures" added.
+std::filesystem::path figures_folder(const std::filesystem::path& results, const std::string& given) {
   const std::filesystem::path stem = results.stem();
-  return results.parent_path() / (stem == results.filename() ? stem.string() + "-figures" : stem.string());
+  const std::filesystem::path folder =
+      !given.empty() ? std::filesystem::path(given)
+                     : results.parent_path() / (stem == results.filename() ? stem.string() + "-figures" : stem.string());
+  require_figures_folder(folder);
+  return folder;
 }
 
 /// The figures and their manifest figures.json (format, command, files), written as one folder:
@@ -239,7 +244,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   struct PaperOptions {
     bench::PaperBenchOptions bench;
     std::string results = "docs/results.md";
-    std::string figures;  // empty: default_figures_folder(results)
+    std::string figures;  // empty: figures_folder's default
     bool json = false;
     bool quiet = false;
   };
@@ -286,8 +291,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
     const std::string command = command_line(pc, {"--runs", "--seed", "--time-limit", "--heuristic-samples"});
     namespace fs = std::filesystem;
     const fs::path results(p->results);
-    const fs::path figures = p->figures.empty() ? default_figures_folder(results) : fs::path(p->figures);
-    require_figures_folder(figures);  // the default one too, before the work (seventh campaign C6)
+    const fs::path figures = figures_folder(results, p->figures);  // the default one checked too (seventh campaign C6)
     const auto r = bench::run_paper_bench(p->bench, command, p->quiet ? nullptr : terminal_stream());
     const std::string link = fs::relative(fs::absolute(figures), fs::absolute(results).parent_path()).generic_string();
     const auto plots = bench::results_figures(r);
@@ -302,7 +306,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
     bench::SuiteBenchOptions bench;
     std::string suite = "fixtures/bench/suite.json";
     std::string results = "docs/suite.md";
-    std::string figures;  // empty: default_figures_folder(results)
+    std::string figures;  // empty: figures_folder's default
     bool json = false;
     bool quiet = false;
   };
@@ -334,9 +338,8 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
     su->bench.suite = bench::load_suite(su->suite);
     su->bench.suite_file = su->suite;
     const fs::path results(su->results);
-    const fs::path figures = su->figures.empty() ? default_figures_folder(results) : fs::path(su->figures);
     const std::string command = command_line(sc, {"--suite", "--runs", "--seed", "--time-limit", "--iterations"});
-    require_figures_folder(figures);  // the default one too, before the work (seventh campaign C6)
+    const fs::path figures = figures_folder(results, su->figures);  // the default one checked too (seventh campaign C6)
     const auto r = bench::run_suite_bench(su->bench, command, su->quiet ? nullptr : terminal_stream());
     const std::string link = fs::relative(fs::absolute(figures), fs::absolute(results).parent_path()).generic_string();
     const auto plots = bench::suite_figures(r);

@@ -97,14 +97,14 @@ std::filesystem::path nearest_existing(std::filesystem::path p) {
   return p;
 }
 
+/// Links followed when an output's target is named: the kernel's own limit (MAXSYMLINKS).
+constexpr int kMaxLinkHops = 40;
+
 /// What makes an output file path unusable whatever its folder: a name over the file-system
 /// limit (checked before the work, not when the write fails after it), or an existing thing
 /// that is not a regular file (a device, FIFO or socket would be replaced by the write's
 /// rename; issue 20). A symbolic link is judged by what it points to (the write goes through
 /// it). Empty when usable.
-/// Links followed when an output's target is named: the kernel's own limit (MAXSYMLINKS).
-constexpr int kMaxLinkHops = 40;
-
 std::string output_file_problem(const std::string& text) {
   namespace fs = std::filesystem;
   const fs::path p(text);

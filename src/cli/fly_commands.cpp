@@ -53,7 +53,7 @@ ScenarioDocument read_scenario_document(const ScenarioOptions& o) {
   return d;
 }
 
-pipeline::Scenario resolve_scenario(const ScenarioOptions&, const ScenarioDocument& d) {
+pipeline::Scenario resolve_scenario(const ScenarioDocument& d) {
   return pipeline::scenario_from_json(d.doc, d.origin, d.base_dir);
 }
 
@@ -67,7 +67,7 @@ struct FlyCliOptions {
 void run_fly(const FlyCliOptions& o, std::ostream& out) {
   ScenarioDocument document = read_scenario_document(o.scenario);
   if (o.ground_truth && document.doc.is_object()) document.doc["controller_reads"] = "ground-truth";
-  const pipeline::Scenario s = resolve_scenario(o.scenario, document);
+  const pipeline::Scenario s = resolve_scenario(document);
   // The run folder replaces its contents whole: it must hold none of the scenario's inputs,
   // checked before any work (REQ-CLI-003).
   const std::string run_dir = o.out.empty() ? pipeline::default_run_folder(s) : o.out;
@@ -75,10 +75,9 @@ void run_fly(const FlyCliOptions& o, std::ostream& out) {
     if (const auto input = pipeline::run_folder_conflict(run_dir, document.doc, document.base_dir))
       throw CLI::ValidationError("--out", run_dir + " holds " + *input + ", which the scenario reads: the run folder would replace it");
   const pipeline::ReferencePlan reference = pipeline::build_reference(s);
-  flight::FlyOptions options;
-  options.use_ground_truth = s.controller_reads_truth;
+  // pipeline::fly flies on the truth when the scenario says so (--ground-truth, above).
   const auto t0 = std::chrono::steady_clock::now();
-  const flight::FlightResult r = pipeline::fly(s, reference, options);
+  const flight::FlightResult r = pipeline::fly(s, reference);
   auto stage_ms = reference.stage_ms;
   stage_ms.emplace_back("flight", elapsed_ms(t0));
 
@@ -154,7 +153,7 @@ void add_fly_commands(CLI::App& app, std::ostream& out) {
       ->check(finite_in(1e-12, 1e-2));
   add_output_options(sim, b->output);
   sim->callback([b, &out] {
-    const auto r = bench::run_sim_bench(resolve_scenario(b->scenario, read_scenario_document(b->scenario)), b->bench);
+    const auto r = bench::run_sim_bench(resolve_scenario(read_scenario_document(b->scenario)), b->bench);
     std::ostringstream table;
     bench::print_table(r, table);
     emit(b->output, bench::to_json(r), table.str(), out);

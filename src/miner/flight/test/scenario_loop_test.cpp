@@ -1,6 +1,10 @@
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+#include <cmath>
+#include <string>
 #include <tuple>
+#include <vector>
 
 #include <filesystem>
 #include <fstream>
@@ -233,6 +237,98 @@ TEST_CASE("Bad scenarios are refused before flight with the fault named", "[REQ-
   doc["vehicle"] = flight::to_json(flight::VehicleParams{});
   doc["vehicle"]["mass_kgg"] = 2;
   expect_scenario_error(doc, "mass_kgg: unknown key, did you mean \"mass_kg\"?");
+}
+
+namespace {
+/// One row of docs/flight.md's "Value ranges" table: a scenario field and its documented range.
+struct RangeRow {
+  std::string field;            ///< dotted path, e.g. "n3.rate_hz" or "vehicle.mass_kg"
+  double lo = 0.0, hi = 0.0;
+  bool lo_closed = true, hi_closed = true;
+  bool each_axis = false;       ///< a 3-vector: the range holds for every component
+  bool integer = false;         ///< a count: the step past an end is 1
+};
+
+std::vector<RangeRow> documented_ranges() {
+  std::ifstream in(std::string(MINER_SOURCE_DIR) + "/docs/flight.md");
+  std::string line;
+  bool inside = false;
+  std::vector<RangeRow> rows;
+  while (std::getline(in, line)) {
+    if (line.rfind("### Value ranges", 0) == 0) inside = true;
+    else if (inside && line.rfind("#", 0) == 0) break;
+    if (!inside || line.rfind("| `", 0) != 0) continue;
+    // | `field` | [lo, hi] | unit |
+    const std::size_t f0 = line.find('`') + 1, f1 = line.find('`', f0);
+    const std::size_t r0 = line.find_first_of("[(", f1), comma = line.find(',', r0), r1 = line.find_first_of("])", comma);
+    RangeRow r;
+    r.field = line.substr(f0, f1 - f0);
+    r.lo_closed = line[r0] == '[';
+    r.hi_closed = line[r1] == ']';
+    r.lo = std::stod(line.substr(r0 + 1, comma - r0 - 1));
+    r.hi = std::stod(line.substr(comma + 1, r1 - comma - 1));
+    r.each_axis = line.find("each axis", r1) != std::string::npos;
+    r.integer = line.find("an integer", r1) != std::string::npos;
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+/// The scenario refuses `row.field` = `v` for its range: the error names the field's key and
+/// says a range phrase (other rules tying fields together may refuse a value inside the range;
+/// those messages say how the fields relate, not "must be in/positive/below/at most").
+bool refused_for_range(const miner::Json& doc, const RangeRow& row) {
+  const std::string key = row.field.substr(row.field.rfind('.') + 1);
+  try {
+    pipeline::scenario_from_json(doc, "s.json", kScenarios);
+    return false;
+  } catch (const miner::Error& e) {
+    const std::string m = e.what();
+    if (m.find(key) == std::string::npos) return false;
+    for (const char* phrase : {"must be in", "must be positive", "must be below", "must be at most",
+                               "must be a finite number in", "must be finite and in", "gains must be"})
+      if (m.find(phrase) != std::string::npos) return true;
+    return false;
+  }
+}
+
+miner::Json with_value(const RangeRow& row, double v) {
+  miner::Json doc = default_doc();
+  doc["vehicle"] = flight::to_json(flight::VehicleParams{});
+  // Companions: other fields set so that the value under test meets no rule tying it to them.
+  if (row.field == "trajectory.rho") doc["trajectory"]["allocation"] = "optimise";
+  if (row.field == "pose.delay_jitter_s") doc["pose"]["delay_s"] = 0.0;
+  if (row.field == "pose.dropout_rate_hz") doc["pose"]["dropout_mean_s"] = 1.0;
+  if (row.field == "n3.latency_s") doc["n3"]["timeout_s"] = 10.0;
+  miner::Json* at = &doc;
+  std::size_t start = 0;
+  for (std::size_t dot; (dot = row.field.find('.', start)) != std::string::npos; start = dot + 1)
+    at = &(*at)[row.field.substr(start, dot - start)];
+  miner::Json& value = (*at)[row.field.substr(start)];
+  value = row.each_axis ? miner::Json::array({v, v, v}) : miner::Json(v);
+  return doc;
+}
+
+/// A step past (or inside) an end that a changed constant or a flipped comparison would move.
+double step(const RangeRow& row, double bound) { return row.integer ? 1.0 : std::max(std::abs(bound), 1.0) * 1e-9; }
+}  // namespace
+
+TEST_CASE("Every ranged scenario value is refused one step past each end of its documented range and kept at it",
+          "[REQ-FLIGHT-007]") {
+  const auto rows = documented_ranges();
+  REQUIRE(rows.size() >= 60);  // the table is read (a renamed heading would silently test nothing)
+  for (const auto& row : rows) {
+    INFO(row.field << " documented " << (row.lo_closed ? "[" : "(") << row.lo << ", " << row.hi
+                   << (row.hi_closed ? "]" : ")"));
+    // Each end: a closed end is kept and a step past it refused; an open end is refused and a
+    // step inside it kept. A kept value may still meet another rule, never its own range.
+    CHECK(refused_for_range(with_value(row, row.lo - step(row, row.lo)), row));
+    CHECK(refused_for_range(with_value(row, row.hi + step(row, row.hi)), row));
+    CHECK(refused_for_range(with_value(row, row.lo), row) == !row.lo_closed);
+    CHECK(refused_for_range(with_value(row, row.hi), row) == !row.hi_closed);
+    if (!row.lo_closed) CHECK_FALSE(refused_for_range(with_value(row, row.lo + step(row, row.lo)), row));
+    if (!row.hi_closed) CHECK_FALSE(refused_for_range(with_value(row, row.hi - step(row, row.hi)), row));
+  }
 }
 
 TEST_CASE("A scenario's trajectory.allocation optimise gives a lower J + rho T within the limits", "[REQ-TRAJ-011][REQ-FLIGHT-007]") {

@@ -173,3 +173,43 @@ TEST_CASE("require_free names the point and the obstacle", "[REQ-WORLD-010]") {
   CHECK_THROWS_WITH(map.require_free(V(5, NAN, 1), 0.0, "start"), Contains("start[1]: must be a finite"));
   CHECK_NOTHROW(map.require_free(V(1, 1, 1), 0.5, "start"));
 }
+
+TEST_CASE("A map's metric range holds at its ends: each end kept, a step past it refused", "[REQ-WORLD-002]") {
+  // REQ-WORLD-002's closed ranges: resolution [0.001, 100] m, corners within 10^6 m of the
+  // origin, query radius [0, 10] m, start and goal inside the bounds (a face included).
+  constexpr double kStep = 1e-9;  // relative: far above rounding, far below any real change
+  const auto map_doc = [](V lo, V hi, double resolution) {
+    Json d = valid_doc();
+    d["bounds"] = {{"min", {lo.x(), lo.y(), lo.z()}}, {"max", {hi.x(), hi.y(), hi.z()}}};
+    d["resolution"] = resolution;
+    d["obstacles"] = Json::array();
+    return d;
+  };
+  // Resolution: 0.001 m on a 0.4 m cube (400^3 = 6.4e7 cells, inside the 2^26 cell bound),
+  // 100 m on a 100 m cube.
+  CHECK(error_of(map_doc(V::Zero(), V::Constant(0.4), 0.001)) == "(no error)");
+  CHECK_THAT(error_of(map_doc(V::Zero(), V::Constant(0.4), 0.001 * (1 - kStep))), Contains("resolution:") && Contains("is outside the resolutions"));
+  CHECK(error_of(map_doc(V::Zero(), V::Constant(100), 100.0)) == "(no error)");
+  CHECK_THAT(error_of(map_doc(V::Zero(), V::Constant(100), 100.0 * (1 + kStep))), Contains("is outside the resolutions"));
+  // Corners: at 10^6 m kept, past it refused, on each side of the origin.
+  CHECK(error_of(map_doc(V::Constant(1e6 - 100), V::Constant(1e6), 1.0)) == "(no error)");
+  CHECK_THAT(error_of(map_doc(V::Constant(1e6 - 100), V(1e6, 1e6 * (1 + kStep), 1e6), 1.0)),
+             Contains("bounds.max:") && Contains("lies farther than 1e+06 m"));
+  CHECK(error_of(map_doc(V::Constant(-1e6), V::Constant(-1e6 + 100), 1.0)) == "(no error)");
+  CHECK_THAT(error_of(map_doc(V(-1e6, -1e6, -1e6 * (1 + kStep)), V::Constant(-1e6 + 100), 1.0)),
+             Contains("bounds.min:") && Contains("lies farther than 1e+06 m"));
+  // Query radius and ends: radius 0 and 10 m kept, a step outside refused; ends on the faces kept.
+  const auto query_doc = [&](V start, V goal, double radius) {
+    Json d = map_doc(V::Zero(), V::Constant(100), 0.5);
+    d["query"] = {{"start", {start.x(), start.y(), start.z()}}, {"goal", {goal.x(), goal.y(), goal.z()}}, {"robot_radius", radius}};
+    return d;
+  };
+  const V a(50, 50, 50), b(60, 60, 60);
+  CHECK(error_of(query_doc(a, b, 0.0)) == "(no error)");
+  CHECK(error_of(query_doc(a, b, 10.0)) == "(no error)");
+  CHECK_THAT(error_of(query_doc(a, b, -1e-12)), Contains("query.robot_radius:") && Contains("is outside [0, 10] m"));
+  CHECK_THAT(error_of(query_doc(a, b, 10.0 * (1 + kStep))), Contains("query.robot_radius:") && Contains("is outside [0, 10] m"));
+  CHECK(error_of(query_doc(V::Zero(), V::Constant(100), 1.0)) == "(no error)");
+  CHECK_THAT(error_of(query_doc(V(0, 0, -1e-9), b, 1.0)), Contains("query.start:") && Contains("lies outside the map bounds"));
+  CHECK_THAT(error_of(query_doc(a, V(100, 100 + 1e-7, 100), 1.0)), Contains("query.goal:") && Contains("lies outside the map bounds"));
+}

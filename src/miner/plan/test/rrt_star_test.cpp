@@ -1,5 +1,6 @@
 #include <catch2/catch.hpp>
 
+#include <tuple>
 #include <type_traits>
 #include <utility>
 
@@ -236,6 +237,67 @@ TEST_CASE("Invalid planner options and a missing or mismatched region are refuse
   CHECK(miner::plan::planner_from_name("guided") == PlannerKind::kGuided);
   PlanningProblem no_map;
   CHECK_THROWS_WITH(miner::plan::plan(no_map, PlannerOptions{}), Contains("no map"));
+}
+
+TEST_CASE("Each planner option's range holds at its ends: a closed end kept, a step past it refused", "[REQ-PLAN-008]") {
+  // The ranges REQ-PLAN-008 names: goal_bias, mu_1, mu_2 in [0, 1); guided_local_fraction in
+  // [0, 1]; rewire_factor >= 1; steer_step 0 (the default) or >= a tenth of the resolution;
+  // safeguard_iterations >= 1; max_iterations <= kMaxIterations.
+  const auto map = miner::testing::wall_with_door_map();
+  const auto problem = PlanningProblem::make(map, V(1, 1, 0.5), V(9, 1, 0.5), 0.1);
+  const HeuristicRegion region = astar_region(problem);
+  constexpr double kStep = 1e-12;
+  const auto options = [] {
+    PlannerOptions o;
+    o.planner = PlannerKind::kMiner;
+    o.max_iterations = 200;
+    return o;
+  };
+  const auto kept = [&](const PlannerOptions& o) {
+    try {
+      miner::plan::plan(problem, o, &region);
+      return true;
+    } catch (const miner::Error&) {
+      return false;
+    }
+  };
+  using Field = double PlannerOptions::*;
+  for (const auto& [field, name, closed_one] :
+       {std::tuple<Field, const char*, bool>{&PlannerOptions::goal_bias, "goal_bias", false},
+        {&PlannerOptions::mu_1, "mu_1", false},
+        {&PlannerOptions::mu_2, "mu_2", false},
+        {&PlannerOptions::guided_local_fraction, "guided_local_fraction", true}}) {
+    INFO(name);
+    PlannerOptions o = options();
+    o.*field = 0.0;
+    CHECK(kept(o));
+    o.*field = -kStep;
+    CHECK_THROWS_WITH(miner::plan::plan(problem, o, &region), Contains(name));
+    o.*field = 1.0 - kStep;
+    CHECK(kept(o));
+    o.*field = closed_one ? 1.0 : 1.0 + kStep;
+    CHECK(kept(o) == closed_one);
+    o.*field = 1.0 + kStep;
+    CHECK_FALSE(kept(o));
+  }
+  PlannerOptions o = options();
+  o.rewire_factor = 1.0;
+  CHECK(kept(o));
+  o.rewire_factor = 1.0 - kStep;
+  CHECK_THROWS_WITH(miner::plan::plan(problem, o, &region), Contains("rewire_factor"));
+  o = options();
+  o.steer_step = 0.1 * map.resolution();
+  CHECK(kept(o));
+  o.steer_step = 0.1 * map.resolution() * (1 - 1e-9);
+  CHECK_THROWS_WITH(miner::plan::plan(problem, o, &region), Contains("steer_step"));
+  o = options();
+  o.safeguard_iterations = 1;
+  CHECK(kept(o));
+  // The largest budget is accepted (the run stops at its first solution, not after 10^6).
+  o = options();
+  o.max_iterations = miner::plan::kMaxIterations;
+  o.stop_at_first = true;
+  CHECK(kept(o));
 }
 
 TEST_CASE("A start inside the goal region is solved at once", "[REQ-PLAN-001]") {

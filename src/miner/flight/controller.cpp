@@ -80,6 +80,12 @@ YawParams yaw_params_from_json(const JsonField& f) {
     if (!(y.rate_limit > 0.0)) f.at("rate_limit_deg_s").fail("must be positive");
   }
   if (f.has("min_speed_m_s")) y.min_speed = f.at("min_speed_m_s").number_in(0.0, 100.0, "m/s");
+  // A key the chosen mode never reads is refused, not flown without effect (issue 20, ninth
+  // campaign C5: fixed_deg 0 and 90 in velocity mode gave the same log bytes).
+  if (y.mode == YawParams::Mode::kVelocity && f.has("fixed_deg"))
+    f.at("fixed_deg").fail("unused: yaw.mode is \"velocity\" (the heading follows the velocity); drop it or use \"fixed\"");
+  if (y.mode == YawParams::Mode::kFixed && f.has("min_speed_m_s"))
+    f.at("min_speed_m_s").fail("unused: yaw.mode is \"fixed\" (min_speed_m_s applies to \"velocity\" only)");
   return y;
 }
 

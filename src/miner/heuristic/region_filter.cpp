@@ -8,6 +8,8 @@
 #include "miner/core/error.hpp"
 #include "miner/core/rng.hpp"
 #include "miner/core/stopwatch.hpp"
+#include "miner/core/text.hpp"
+#include "miner/core/units.hpp"
 #include "miner/heuristic/grid.hpp"
 #include "miner/heuristic/sgan.hpp"
 #include "miner/heuristic/strict_bridge.hpp"
@@ -233,6 +235,13 @@ FilteredRegion filter_region(const std::vector<float>& p, const std::vector<std:
 HeuristicQuery query_region(const Sgan& sgan, const world::Map& map, const Eigen::Vector3d& start,
                             const Eigen::Vector3d& goal, double robot_radius, std::uint64_t seed, bool filter,
                             bool strict) {
+  // The query is one a planner would take (issue 20, ninth campaign P2, P3: a NaN start crashed
+  // the cell lookup, a start inside an obstacle or outside the map got a region).
+  require_finite(robot_radius, "robot_radius");
+  if (!(robot_radius >= 0.0 && robot_radius <= kMaxRobotRadius))
+    throw Error("robot_radius: " + short_number(robot_radius) + " m is outside [0, " + short_number(kMaxRobotRadius) + "] m");
+  map.require_free(start, robot_radius, "start");
+  map.require_free(goal, robot_radius, "goal");
   const SganArchitecture& arch = sgan.architecture();
   const world::Box& b = map.bounds();
   const Eigen::Vector3i dims = arch.dims;

@@ -103,7 +103,9 @@ struct HeuristicQuery {
 /// Encodes E (obstacles grown by robot_radius) and S on the network's grid over the map
 /// bounds, runs the generator with noise from Rng(seed, stream 0x5347414e) and filters
 /// (or, with filter = false, only thresholds) the output; step 5 runs only with strict = true
-/// (opt-in: it costs 0.2-5 ms a query, docs/heuristic.md).
+/// (opt-in: it costs 0.2-5 ms a query, docs/heuristic.md). Throws miner::Error unless the
+/// query is a planner's: start and goal finite, in the bounds and free at robot_radius, the
+/// radius in [0, kMaxRobotRadius].
 HeuristicQuery query_region(const Sgan& sgan, const world::Map& map, const Eigen::Vector3d& start,
                             const Eigen::Vector3d& goal, double robot_radius, std::uint64_t seed, bool filter = true,
                             bool strict = false);

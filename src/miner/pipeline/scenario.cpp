@@ -257,6 +257,13 @@ Scenario scenario_from_json(const Json& doc, const std::string& origin, const st
   s.n3.max_vertical_speed = std::min(s.n3.max_vertical_speed, speed_limit);
   if (s.controller.max_tilt_deg > s.n3.max_tilt_deg)
     root.fail("controller.max_tilt_deg exceeds the N3's max_tilt_deg");
+  // A controller capped below the reference's speed falls behind it and cuts corners into
+  // obstacles (issue 20, ninth campaign C4: 0.1 m/s under a 0.8 m/s v_max collided twice).
+  if (s.controller.max_speed < s.limits.v_max)
+    root.at("controller").at("max_speed_m_s").fail(
+        short_number(s.controller.max_speed) + " m/s is below trajectory.v_max " + short_number(s.limits.v_max) +
+        " m/s: the controller could not keep up with the reference (leave it out for " +
+        short_number(kSpeedLimitHeadroom) + " v_max, or lower trajectory.v_max)");
   ticks_per(root.has("controller") ? root.at("controller") : root, s.n3.rate_hz, s.controller.rate_hz, "controller rate");
   ticks_per(root.has("pose") ? root.at("pose") : root, s.n3.rate_hz, s.pose.rate_hz, "pose rate");
   // The N3 drops API control when no command arrived for timeout_s: a timeout shorter than the
@@ -388,6 +395,18 @@ void require_flight_length(const Scenario& s, const traj::PolynomialTrajectory& 
                 short_number(t.total_duration()) + " s + hover " + short_number(s.hover_after_s) + " s), more than the " +
                 std::to_string(static_cast<int>(kMaxFlightSeconds)) + " s a simulated flight may; " + advice);
   }
+}
+
+/// The reference runs from the scenario's start to its goal, at rest at both ends.
+void check_reference_ends(const Scenario& s, const traj::PolynomialTrajectory& t) {
+  const double T = t.total_duration();
+  if ((t.evaluate(0.0) - s.start).norm() > kEndpointTolerance || (t.evaluate(T) - s.goal).norm() > kEndpointTolerance)
+    throw Error(s.origin + ": the reference trajectory must start at start " + format_point(s.start) +
+                " and end at goal " + format_point(s.goal) + "; it runs from " + format_point(t.evaluate(0.0)) +
+                " to " + format_point(t.evaluate(T)));
+  for (int k = 1; k <= 2; ++k)
+    if (t.evaluate(0.0, k).norm() > kEndpointTolerance || t.evaluate(T, k).norm() > kEndpointTolerance)
+      throw Error(s.origin + ": the reference trajectory must start and end at rest (the vehicle starts hovering)");
 }
 
 void check_envelope(const Scenario& s, const traj::PolynomialTrajectory& t) {
@@ -558,15 +577,7 @@ ReferencePlan build_reference(const Scenario& s) {
     }
     r.stage_ms.emplace_back("trajectory", elapsed_ms(t_traj));
   }
-  const double T = r.trajectory.total_duration();
-  if ((r.trajectory.evaluate(0.0) - s.start).norm() > kEndpointTolerance ||
-      (r.trajectory.evaluate(T) - s.goal).norm() > kEndpointTolerance)
-    throw Error(s.origin + ": the reference trajectory must start at start " + format_point(s.start) +
-                " and end at goal " + format_point(s.goal) + "; it runs from " +
-                format_point(r.trajectory.evaluate(0.0)) + " to " + format_point(r.trajectory.evaluate(T)));
-  for (int k = 1; k <= 2; ++k)
-    if (r.trajectory.evaluate(0.0, k).norm() > kEndpointTolerance || r.trajectory.evaluate(T, k).norm() > kEndpointTolerance)
-      throw Error(s.origin + ": the reference trajectory must start and end at rest (the vehicle starts hovering)");
+  check_reference_ends(s, r.trajectory);
   check_envelope(s, r.trajectory);
   const auto [v, a] = traj::trajectory_extremes(r.trajectory, kLimitSampleStep);
   r.max_speed = v;
@@ -574,7 +585,39 @@ ReferencePlan build_reference(const Scenario& s) {
   return r;
 }
 
+void check_reference(const Scenario& s, const ReferencePlan& reference) {
+  // A reference is flown only in the scenario it was built for (issue 20, ninth campaign P8:
+  // from Python a reference of another scenario flew from another start, through walls, or
+  // at 7x the scenario's v_max, and came back as an ordinary flight).
+  const traj::PolynomialTrajectory& t = reference.trajectory;
+  check_reference_ends(s, t);
+  require_flight_length(s, t, reference.source == "file");
+  const auto [v, a] = traj::trajectory_extremes(t, kLimitSampleStep);
+  if (v > s.limits.v_max * (1 + kLimitSlack) || a > s.limits.a_max * (1 + kLimitSlack))
+    throw Error(s.origin + ": the reference's maximum speed " + short_number(v) + " m/s and acceleration " +
+                short_number(a) + " m/s^2 exceed the scenario's trajectory.v_max " + short_number(s.limits.v_max) +
+                " m/s, a_max " + short_number(s.limits.a_max) + " m/s^2: build the reference from this scenario");
+  check_envelope(s, t);
+  const auto colliding = traj::colliding_segments(t, *s.map, s.vehicle.radius, 0.0);
+  if (!colliding.empty())
+    throw Error(s.origin + ": the reference's segment " + std::to_string(colliding.front()) +
+                " comes within the vehicle radius " + short_number(s.vehicle.radius) +
+                " m of an obstacle of the scenario's map: build the reference from this scenario");
+  // A disturbance window that opens after the flight ends would never act (ninth campaign C5).
+  const double end = t.total_duration() + s.hover_after_s;
+  if (s.command_dropout && s.command_dropout->first >= end)
+    throw Error(s.origin + ": command_dropout_s: starts at " + short_number(s.command_dropout->first) +
+                " s, after the flight ends at " + short_number(end) + " s (reference " +
+                short_number(t.total_duration()) + " s + hover " + short_number(s.hover_after_s) +
+                " s): it would never happen");
+  for (std::size_t i = 0; i < s.wind.gusts.size(); ++i)
+    if (s.wind.gusts[i].start_s >= end)
+      throw Error(s.origin + ": wind.gusts[" + std::to_string(i) + "].start_s: " + short_number(s.wind.gusts[i].start_s) +
+                  " s is after the flight ends at " + short_number(end) + " s: the gust would never blow");
+}
+
 flight::FlightResult fly(const Scenario& scenario, const ReferencePlan& reference, const flight::FlyOptions& options) {
+  check_reference(scenario, reference);
   flight::FlightSetup setup = scenario;
   const std::shared_ptr<const world::Map> map = scenario.map;
   const double radius = scenario.vehicle.radius;

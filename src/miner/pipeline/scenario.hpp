@@ -134,8 +134,15 @@ struct ReferencePlan : flight::ReferenceTrajectory {
 /// tilt or thrust than the vehicle's envelope allows.
 ReferencePlan build_reference(const Scenario& s);
 
+/// Throws miner::Error naming the scenario unless `reference` is one of its own: from its
+/// start to its goal at rest, no longer than a flight may last, within its trajectory limits
+/// and the vehicle's envelope, clear of its map by the vehicle radius, and no disturbance
+/// window (command dropout, gust) opening after the flight ends. fly() calls it.
+void check_reference(const Scenario& s, const ReferencePlan& reference);
+
 /// Flies the reference with the scenario's flight setup, a collision being the vehicle's
-/// radius touching the scenario's map (flight::fly with FlightSetup::collides from the map).
+/// radius touching the scenario's map (flight::fly with FlightSetup::collides from the map),
+/// after check_reference.
 flight::FlightResult fly(const Scenario& scenario, const ReferencePlan& reference, const flight::FlyOptions& options = {});
 
 }  // namespace miner::pipeline

@@ -43,6 +43,10 @@ Eigen::Vector3d PolynomialTrajectory::evaluate_segment(int i, double tau, int k)
 
 Eigen::Vector3d PolynomialTrajectory::evaluate(double t, int k) const {
   if (durations_.empty()) throw Error("trajectory: has no segments");
+  // A negative order read coefficients before the segment's own, a NaN time answered the start
+  // (issue 20, ninth campaign P1, P12: from Python, garbage, NaN and a segmentation fault).
+  if (k < 0) throw Error("k: the derivative order must be >= 0, got " + std::to_string(k));
+  if (std::isnan(t)) throw Error("t: must be a time in s, got nan");
   int i = 0;
   const int last = segments() - 1;
   t = std::max(0.0, t);

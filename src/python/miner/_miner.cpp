@@ -4,7 +4,9 @@
 //
 // Errors: miner::Error (bad input, naming the field) becomes miner.Error, a ValueError;
 // miner::NoSolution becomes miner.NoSolution. Long calls (planning, flight) release the GIL.
+#include <cmath>
 #include <cstdint>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
@@ -16,6 +18,9 @@
 #include <pybind11/stl.h>
 
 #include "miner/core/error.hpp"
+#include "miner/core/json_io.hpp"
+#include "miner/core/text.hpp"
+#include "miner/core/units.hpp"
 #include "miner/flight/closed_loop.hpp"
 #include "miner/pipeline/scenario.hpp"
 #include "miner/heuristic/region_filter.hpp"
@@ -35,10 +40,160 @@ using V3 = Eigen::Vector3d;
 
 namespace {
 
-/// (n, 3) rows of points as an Eigen matrix (numpy in).
-Eigen::MatrixX3d rows(const Eigen::Ref<const Eigen::MatrixXd>& a, const char* what) {
-  if (a.cols() != 3) throw miner::Error(std::string(what) + ": expected an (n, 3) array, got " + std::to_string(a.rows()) + " x " + std::to_string(a.cols()));
-  return a;
+// ---------------------------------------------------------------- argument checks
+// Every argument is taken as a Python object and converted here, so a wrong type or value is a
+// miner.Error naming the argument (REQ-LIB-002), never pybind11's "incompatible function
+// arguments" with the whole signature, a wrapped integer or a silent NaN (issue 20, ninth
+// campaign P4, P9, P11, P14, P15). Ranges are the CLI's and the file formats'.
+
+std::string type_name(py::handle o) { return py::str(py::type::of(o).attr("__name__")); }
+
+py::module_ numpy() { return py::module_::import("numpy"); }
+
+bool is_bool(py::handle o) {
+  return py::isinstance<py::bool_>(o) || py::isinstance(o, numpy().attr("bool_"));
+}
+
+/// An int or a numpy integer (never a bool, a float or a string).
+bool is_integer(py::handle o) {
+  return !is_bool(o) && (PyLong_Check(o.ptr()) || py::isinstance(o, numpy().attr("integer")));
+}
+
+/// A real number: an int, a float or a numpy integer/floating (never a bool, complex or string).
+double number(py::handle o, const std::string& field) {
+  if (is_bool(o) || !(is_integer(o) || PyFloat_Check(o.ptr()) || py::isinstance(o, numpy().attr("floating"))))
+    throw miner::Error(field + ": expected a number, got " + (o.is_none() ? std::string("None") : type_name(o)));
+  const double v = PyFloat_AsDouble(o.ptr());
+  if (PyErr_Occurred()) {
+    PyErr_Clear();
+    throw miner::Error(field + ": " + std::string(py::str(o)) + " is beyond the largest double");
+  }
+  return v;
+}
+
+double finite_number(py::handle o, const std::string& field) {
+  const double v = number(o, field);
+  if (!std::isfinite(v)) throw miner::Error(field + ": must be a finite number, got " + miner::short_number(v));
+  return v;
+}
+
+double number_in(py::handle o, const std::string& field, double lo, double hi, const std::string& unit = "") {
+  const double v = finite_number(o, field);
+  if (v < lo || v > hi)
+    throw miner::Error(field + ": must be in [" + miner::short_number(lo) + ", " + miner::short_number(hi) + "]" +
+                       (unit.empty() ? "" : " " + unit) + ", got " + miner::short_number(v));
+  return v;
+}
+
+/// An integer in [lo, hi], checked on Python's own (unbounded) integer before any C++ cast.
+long long integer_in(py::handle o, const std::string& field, long long lo, long long hi) {
+  if (!is_integer(o))
+    throw miner::Error(field + ": expected an integer, got " + (o.is_none() ? std::string("None") : type_name(o)) +
+                       (PyFloat_Check(o.ptr()) ? " " + std::string(py::str(o)) : std::string()));
+  const py::int_ v = py::reinterpret_steal<py::int_>(PyNumber_Index(o.ptr()));
+  if (v < py::int_(lo) || v > py::int_(hi))
+    throw miner::Error(field + ": must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " +
+                       std::string(py::str(py::handle(v))));
+  return v.cast<long long>();
+}
+
+std::uint64_t seed_of(py::handle o, const std::string& field = "seed") {
+  if (!is_integer(o)) throw miner::Error(field + ": expected an integer in [0, 2^64 - 1], got " + type_name(o));
+  const py::int_ v = py::reinterpret_steal<py::int_>(PyNumber_Index(o.ptr()));
+  if (v < py::int_(0) || v > py::int_(py::reinterpret_steal<py::object>(PyLong_FromUnsignedLongLong(~0ULL))))
+    throw miner::Error(field + ": must be an integer in [0, 2^64 - 1], got " + std::string(py::str(py::handle(v))));
+  return v.cast<std::uint64_t>();
+}
+
+bool flag(py::handle o, const std::string& field) {
+  if (!is_bool(o)) throw miner::Error(field + ": expected True or False, got " + type_name(o));
+  return PyObject_IsTrue(o.ptr()) == 1;
+}
+
+/// A real array: a numpy array or a (nested) sequence of ints and floats; not bool, complex,
+/// object or string data.
+py::array_t<double> real_array(py::handle o, const std::string& field) {
+  py::object a;
+  try {
+    a = numpy().attr("asarray")(o);
+  } catch (const py::error_already_set&) {
+    throw miner::Error(field + ": expected an array of numbers, got " + type_name(o));
+  }
+  const std::string kind = py::str(a.attr("dtype").attr("kind"));
+  if (kind != "i" && kind != "u" && kind != "f")
+    throw miner::Error(field + ": expected an array of numbers, got " + type_name(o) + " of dtype " +
+                       std::string(py::str(a.attr("dtype"))));
+  return py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a);
+}
+
+/// (n, 3) rows of finite points.
+Eigen::MatrixX3d points_of(py::handle o, const std::string& field) {
+  const py::array_t<double> a = real_array(o, field);
+  if (a.ndim() != 2 || a.shape(1) != 3)
+    throw miner::Error(field + ": expected an (n, 3) array, got shape " + std::string(py::str(py::object(a.attr("shape")))));
+  Eigen::MatrixX3d m(a.shape(0), 3);
+  const auto r = a.unchecked<2>();
+  for (py::ssize_t i = 0; i < a.shape(0); ++i)
+    for (py::ssize_t k = 0; k < 3; ++k) {
+      m(i, k) = r(i, k);
+      if (!std::isfinite(m(i, k)))
+        throw miner::Error(field + "[" + std::to_string(i) + "]: must be finite, got " + miner::short_number(m(i, k)));
+    }
+  return m;
+}
+
+V3 point_of(py::handle o, const std::string& field) {
+  const py::array_t<double> a = real_array(o, field);
+  if (a.ndim() != 1 || a.shape(0) != 3)
+    throw miner::Error(field + ": expected 3 coordinates, got shape " + std::string(py::str(py::object(a.attr("shape")))));
+  const V3 p(a.at(0), a.at(1), a.at(2));
+  miner::require_finite(p, field);
+  return p;
+}
+
+std::optional<V3> optional_point(py::handle o, const std::string& field) {
+  if (o.is_none()) return std::nullopt;
+  return point_of(o, field);
+}
+
+/// A 1-D array of numbers (NaN left to the caller, which names its index).
+std::vector<double> vector_of(py::handle o, const std::string& field) {
+  const py::array_t<double> a = real_array(o, field);
+  if (a.ndim() != 1) throw miner::Error(field + ": expected a 1-D array, got " + std::to_string(a.ndim()) + " dimensions");
+  return std::vector<double>(a.data(), a.data() + a.shape(0));
+}
+
+/// A file path: a str or an os.PathLike, non-UTF-8 names as os.fsencode gives them; not empty.
+std::string path_of(py::handle o, const std::string& field) {
+  py::object p;
+  try {
+    p = py::module_::import("os").attr("fsencode")(o);
+  } catch (const py::error_already_set&) {
+    throw miner::Error(field + ": expected a path (str or os.PathLike), got " + type_name(o));
+  }
+  std::string s = py::cast<std::string>(py::bytes(p));
+  if (s.empty()) throw miner::Error(field + ": empty: name a file");
+  miner::require_path_without_nul(s, field);
+  return s;
+}
+
+std::string text_of(py::handle o, const std::string& field) {
+  if (!py::isinstance<py::str>(o)) throw miner::Error(field + ": expected a str, got " + type_name(o));
+  return py::cast<std::string>(o);
+}
+
+template <class T>
+const T& object_of(py::handle o, const std::string& field, const char* python_name) {
+  try {
+    return o.cast<const T&>();
+  } catch (const py::cast_error&) {
+    throw miner::Error(field + ": expected a miner." + python_name + ", got " +
+                       (o.is_none() ? std::string("None") : type_name(o)));
+  }
+}
+
+bool ends_with(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
 Eigen::MatrixX3d path_matrix(const std::vector<V3>& path) {
@@ -60,12 +215,17 @@ struct Query {
   V3 start, goal;
   double radius;
 };
-Query resolve(const miner::world::Map& map, const std::optional<V3>& start, const std::optional<V3>& goal,
-              std::optional<double> radius) {
+Query resolve(const miner::world::Map& map, py::handle start, py::handle goal, py::handle radius) {
   const auto& q = map.query();
-  if ((!start || !goal) && !q) throw miner::Error("the map has no stored query: give start and goal");
-  return {start ? *start : q->start, goal ? *goal : q->goal, radius ? *radius : (q ? q->robot_radius : 0.0)};
+  const std::optional<V3> s = optional_point(start, "start"), g = optional_point(goal, "goal");
+  if ((!s || !g) && !q) throw miner::Error("the map has no stored query: give start and goal");
+  const double r = radius.is_none() ? (q ? q->robot_radius : 0.0)
+                                    : number_in(radius, "radius", 0.0, miner::kMaxRobotRadius, "m");
+  return {s ? *s : q->start, g ? *g : q->goal, r};
 }
+
+/// A trajectory's k (derivative order): the library refuses k < 0; the bound keeps the int.
+int derivative_of(py::handle k) { return static_cast<int>(integer_in(k, "k", 0, 1 << 30)); }
 
 }  // namespace
 
@@ -84,30 +244,47 @@ PYBIND11_MODULE(_miner, m) {
   });
 
   // ------------------------------------------------------------------------- maps
-  py::class_<miner::world::Map, std::shared_ptr<miner::world::Map>>(m, "Map",
+  using miner::world::Map;
+  py::class_<Map, std::shared_ptr<Map>>(m, "Map",
       "A bounded 3D workspace of box obstacles and/or voxels (miner-map-v1 JSON, OctoMap .bt/.ot).")
-      .def_static("load", [](const std::string& path) { return std::make_shared<miner::world::Map>(miner::world::Map::load(path)); },
+      .def_static("load", [](py::object path) { return std::make_shared<Map>(Map::load(path_of(path, "path"))); },
                   py::arg("path"), "Loads a .json map or an OctoMap .bt/.ot file.")
-      .def_static("from_json", [](const std::string& text) {
-            return std::make_shared<miner::world::Map>(miner::world::Map::from_json(miner::parse_json(text, "<string>"), "<string>"));
+      .def_static("from_json", [](py::object text) {
+            return std::make_shared<Map>(Map::from_json(miner::parse_json(text_of(text, "text"), "<string>"), "<string>"));
           }, py::arg("text"), "A map from its miner-map-v1 JSON text.")
-      .def_static("generate", [](const std::string& preset, std::uint64_t seed) {
-            return std::make_shared<miner::world::Map>(miner::world::generate_map(miner::world::generator_preset(preset), seed));
+      .def_static("generate", [](py::object preset, py::object seed) {
+            return std::make_shared<Map>(
+                miner::world::generate_map(miner::world::generator_preset(text_of(preset, "preset")), seed_of(seed)));
           }, py::arg("preset") = "sim", py::arg("seed") = 1,
           "A seeded map of a preset: sim, indoor, cluttered, rooms, forest, multilevel, mixed, scan.")
-      .def("save", &miner::world::Map::save, py::arg("path"))
-      .def("to_json", [](const miner::world::Map& map) { return map.to_json().dump(2); })
-      .def_property_readonly("bounds", [](const miner::world::Map& map) {
+      .def("save", [](const Map& map, py::object path_arg, py::object drop_query_arg) {
+            // The CLI's rules for a map output (REQ-CLI-003, REQ-WORLD-003; ninth campaign P5-P7):
+            // .json or .bt exactly, and an OctoMap, which holds voxels only, takes no query unless
+            // asked to drop it.
+            const std::string path = path_of(path_arg, "path");
+            const bool drop_query = flag(drop_query_arg, "drop_query");
+            const bool octomap = ends_with(path, ".bt");
+            if (!octomap && !ends_with(path, ".json"))
+              throw miner::Error("path: " + path + ": a map is written as .json or .bt (exactly, lower case)");
+            if (octomap && map.query() && !drop_query)
+              throw miner::Error("path: " + path + " is an OctoMap, which holds voxels only, so the map's query (start, "
+                                 "goal, robot radius) would be lost; pass drop_query=True, or write .json");
+            if (drop_query && !octomap) throw miner::Error("drop_query: only for a .bt path (a .json map keeps its query)");
+            map.save(path);
+          }, py::arg("path"), py::arg("drop_query") = false,
+          "Writes the map as miner-map-v1 JSON (.json) or an OctoMap (.bt, which holds no query: drop_query=True).")
+      .def("to_json", [](const Map& map) { return map.to_json().dump(2); })
+      .def_property_readonly("bounds", [](const Map& map) {
             return py::make_tuple(V3(map.bounds().min), V3(map.bounds().max));
           }, "(min, max) corners in m")
-      .def_property_readonly("resolution", &miner::world::Map::resolution)
-      .def_property_readonly("obstacles", [](const miner::world::Map& map) {
+      .def_property_readonly("resolution", &Map::resolution)
+      .def_property_readonly("obstacles", [](const Map& map) {
             Eigen::MatrixXd boxes(static_cast<Eigen::Index>(map.obstacles().size()), 6);
             for (std::size_t i = 0; i < map.obstacles().size(); ++i)
               boxes.row(static_cast<Eigen::Index>(i)) << map.obstacles()[i].min.transpose(), map.obstacles()[i].max.transpose();
             return boxes;
           }, "(n, 6) array of box obstacles: min x y z, max x y z")
-      .def_property_readonly("query", [](const miner::world::Map& map) -> py::object {
+      .def_property_readonly("query", [](const Map& map) -> py::object {
             if (!map.query()) return py::none();
             py::dict d;
             d["start"] = map.query()->start;
@@ -115,37 +292,61 @@ PYBIND11_MODULE(_miner, m) {
             d["robot_radius"] = map.query()->robot_radius;
             return std::move(d);
           }, "the stored start, goal and robot radius, or None")
-      .def("is_free", &miner::world::Map::is_free, py::arg("p"), py::arg("radius") = 0.0)
-      .def("segment_free", &miner::world::Map::segment_free, py::arg("a"), py::arg("b"), py::arg("radius") = 0.0)
-      .def("clearance", &miner::world::Map::clearance, py::arg("p"));
+      .def("is_free", [](const Map& map, py::object p, py::object radius) {
+            return map.is_free(point_of(p, "p"), number_in(radius, "radius", 0.0, miner::kMaxRobotRadius, "m"));
+          }, py::arg("p"), py::arg("radius") = 0.0, "inside the bounds and no obstacle within radius of p")
+      .def("segment_free", [](const Map& map, py::object a, py::object b, py::object radius) {
+            return map.segment_free(point_of(a, "a"), point_of(b, "b"),
+                                    number_in(radius, "radius", 0.0, miner::kMaxRobotRadius, "m"));
+          }, py::arg("a"), py::arg("b"), py::arg("radius") = 0.0, "the segment a-b is free at radius")
+      .def("clearance", [](const Map& map, py::object p) { return map.clearance(point_of(p, "p")); }, py::arg("p"),
+           "distance from p to the nearest obstacle (m)");
 
   // ---------------------------------------------------------------------- regions
-  py::class_<miner::plan::HeuristicRegion>(m, "Region", "A heuristic region H on a grid over the map bounds.")
-      .def_static("load", &miner::plan::HeuristicRegion::load, py::arg("path"))
-      .def("save", &miner::plan::HeuristicRegion::save, py::arg("path"))
-      .def_property_readonly("dims", [](const miner::plan::HeuristicRegion& r) { return Eigen::Vector3i(r.dims()); })
-      .def_property_readonly("cell_count", [](const miner::plan::HeuristicRegion& r) { return r.cells().size(); })
-      .def_property_readonly("source", &miner::plan::HeuristicRegion::source)
-      .def_property_readonly("threshold", &miner::plan::HeuristicRegion::threshold)
+  using miner::plan::HeuristicRegion;
+  py::class_<HeuristicRegion>(m, "Region", "A heuristic region H on a grid over the map bounds.")
+      .def_static("load", [](py::object path) { return HeuristicRegion::load(path_of(path, "path")); }, py::arg("path"))
+      .def("save", [](const HeuristicRegion& r, py::object path_arg) {
+            const std::string path = path_of(path_arg, "path");
+            if (!ends_with(path, ".json"))
+              throw miner::Error("path: " + path + ": a region is written as miner-region-v1 JSON: name it .json");
+            r.save(path);
+          }, py::arg("path"))
+      .def_property_readonly("dims", [](const HeuristicRegion& r) { return Eigen::Vector3i(r.dims()); })
+      .def_property_readonly("cell_count", [](const HeuristicRegion& r) { return r.cells().size(); })
+      .def_property_readonly("source", &HeuristicRegion::source)
+      .def_property_readonly("threshold", &HeuristicRegion::threshold)
       .def_property_readonly("probabilities", &region_grid, "(nz, ny, nx) array of cell probabilities");
 
-  m.def("sgan_region", [](const miner::world::Map& map, std::optional<V3> start, std::optional<V3> goal,
-                          std::optional<double> radius, std::uint64_t seed, const std::string& weights, bool filter) {
+  m.def("sgan_region", [](py::object map_arg, py::object start, py::object goal, py::object radius, py::object seed_arg,
+                          py::object weights_arg, py::object filter_arg) {
+        const Map& map = object_of<Map>(map_arg, "map", "Map");
         const Query q = resolve(map, start, goal, radius);
+        const std::uint64_t seed = seed_of(seed_arg);
+        const bool filter = flag(filter_arg, "filter");
+        const std::string weights = weights_arg.is_none() ? std::string() : path_of(weights_arg, "weights");
         const miner::heuristic::Sgan sgan = miner::heuristic::Sgan::load_or_builtin(weights);
         py::gil_scoped_release unlocked;
         return miner::heuristic::query_region(sgan, map, q.start, q.goal, q.radius, seed, filter).region;
       }, py::arg("map"), py::arg("start") = py::none(), py::arg("goal") = py::none(), py::arg("radius") = py::none(),
-      py::arg("seed") = 1, py::arg("weights") = "", py::arg("filter") = true,
+      py::arg("seed") = 1, py::arg("weights") = py::none(), py::arg("filter") = true,
       "The sGAN's region for a query (Alg. 1 lines 2-3): the shipped network unless `weights` names a file; "
       "filtered (safe, connected when A* is) unless filter=False.");
-  m.def("astar_region", [](const miner::world::Map& map, std::optional<V3> start, std::optional<V3> goal,
-                           std::optional<double> radius, const Eigen::Vector3i& dims, int dilation) {
+  m.def("astar_region", [](py::object map_arg, py::object start, py::object goal, py::object radius, py::object dims_arg,
+                           py::object dilation_arg) {
+        const Map& map = object_of<Map>(map_arg, "map", "Map");
         const Query q = resolve(map, start, goal, radius);
+        const std::vector<double> d = vector_of(dims_arg, "dims");
+        if (d.size() != 3) throw miner::Error("dims: expected 3 integers nx ny nz, got " + std::to_string(d.size()));
+        Eigen::Vector3i dims;
+        for (int k = 0; k < 3; ++k)
+          dims[k] = static_cast<int>(integer_in(py::reinterpret_borrow<py::object>(py::list(dims_arg)[k]),
+                                                "dims[" + std::to_string(k) + "]", 1, 4096));
+        const int dilation = static_cast<int>(integer_in(dilation_arg, "dilation", 0, 4));
         const auto problem = miner::plan::PlanningProblem::make(map, q.start, q.goal, q.radius);
         return miner::plan::astar_dilated_region(problem, miner::plan::astar_reference(problem), dims, dilation);
       }, py::arg("map"), py::arg("start") = py::none(), py::arg("goal") = py::none(), py::arg("radius") = py::none(),
-      py::arg("dims") = miner::plan::HeuristicRegion::default_dims(), py::arg("dilation") = 1,
+      py::arg("dims") = py::make_tuple(32, 32, 32), py::arg("dilation") = 1,
       "The A*-dilated region (the oracle the network is trained toward).");
 
   // --------------------------------------------------------------------- planning
@@ -163,72 +364,125 @@ PYBIND11_MODULE(_miner, m) {
       .def_property_readonly("target_iteration", [](const miner::plan::PlanResult& r) -> py::object {
             return r.target ? py::cast(r.target->iteration) : py::none();
           });
-  m.def("plan", [](const miner::world::Map& map, std::optional<V3> start, std::optional<V3> goal,
-                   std::optional<double> radius, const std::string& planner, const miner::plan::HeuristicRegion* region,
-                   std::uint64_t seed, std::size_t iterations, std::optional<double> target_cost, bool first,
-                   bool safeguard) {
+  m.def("plan", [](py::object map_arg, py::object start, py::object goal, py::object radius, py::object planner,
+                   py::object region_arg, py::object seed, py::object iterations, py::object target_cost,
+                   py::object first, py::object safeguard) {
+        const Map& map = object_of<Map>(map_arg, "map", "Map");
         const Query q = resolve(map, start, goal, radius);
         const auto problem = miner::plan::PlanningProblem::make(map, q.start, q.goal, q.radius);
         miner::plan::PlannerOptions o;
-        o.planner = miner::plan::planner_from_name(planner);
-        o.seed = seed;
-        o.max_iterations = iterations;
-        o.target_cost = target_cost;
-        o.stop_at_first = first;
-        o.safeguard = safeguard;
+        o.planner = miner::plan::planner_from_name(text_of(planner, "planner"));
+        o.seed = seed_of(seed);
+        o.max_iterations = static_cast<std::size_t>(
+            integer_in(iterations, "iterations", 1, static_cast<long long>(miner::plan::kMaxIterations)));
+        // The CLI's --target-cost range (m): a cost <= 0 is below any path.
+        if (!target_cost.is_none()) o.target_cost = number_in(target_cost, "target_cost", 1e-9, 1e9, "m");
+        o.stop_at_first = flag(first, "first");
+        o.safeguard = flag(safeguard, "safeguard");
+        const HeuristicRegion* region = region_arg.is_none() ? nullptr : &object_of<HeuristicRegion>(region_arg, "region", "Region");
         if (o.planner == miner::plan::PlannerKind::kMiner && region == nullptr)
           throw miner::Error("planner \"miner\" needs a region (miner.sgan_region or miner.astar_region)");
-        py::gil_scoped_release unlocked;
-        return miner::plan::plan(problem, o, region);
+        miner::plan::PlanResult r;
+        {
+          py::gil_scoped_release unlocked;
+          r = miner::plan::plan(problem, o, region);
+        }
+        // An unsolved run is miner.NoSolution, as the CLI's exit 3 (ninth campaign P10: it
+        // came back with cost 0.0, the best cost there is).
+        if (!r.solved) throw miner::NoSolution(r.reason);
+        return r;
       }, py::arg("map"), py::arg("start") = py::none(), py::arg("goal") = py::none(), py::arg("radius") = py::none(),
-      py::arg("planner") = "miner", py::arg("region") = nullptr, py::arg("seed") = 1, py::arg("iterations") = 20000,
+      py::arg("planner") = "miner", py::arg("region") = py::none(), py::arg("seed") = 1, py::arg("iterations") = 20000,
       py::arg("target_cost") = py::none(), py::arg("first") = false, py::arg("safeguard") = true,
-      "One run of rrtstar, informed, guided or miner (which samples `region`); the same seed gives the same path.");
+      "One run of rrtstar, informed, guided or miner (which samples `region`); the same seed gives the same path. "
+      "Raises miner.NoSolution when the budget ends without a path.");
 
   // ------------------------------------------------------------------ trajectories
-  py::class_<miner::traj::PolynomialTrajectory>(m, "Trajectory", "A piecewise polynomial of order s (MINCO's answer).")
-      .def_property_readonly("order", &miner::traj::PolynomialTrajectory::order)
-      .def_property_readonly("durations", &miner::traj::PolynomialTrajectory::durations)
-      .def_property_readonly("total_duration", &miner::traj::PolynomialTrajectory::total_duration)
-      .def_property_readonly("coefficients", &miner::traj::PolynomialTrajectory::coefficients,
+  using miner::traj::PolynomialTrajectory;
+  py::class_<PolynomialTrajectory>(m, "Trajectory", "A piecewise polynomial of order s (MINCO's answer).")
+      .def_property_readonly("order", &PolynomialTrajectory::order)
+      .def_property_readonly("durations", &PolynomialTrajectory::durations)
+      .def_property_readonly("total_duration", &PolynomialTrajectory::total_duration)
+      .def_property_readonly("coefficients", &PolynomialTrajectory::coefficients,
                              "(2 s M, 3) stacked monomial coefficients, segment by segment")
-      .def_property_readonly("cost", &miner::traj::PolynomialTrajectory::cost, "J = integral of |d^s p / dt^s|^2")
-      .def("evaluate", &miner::traj::PolynomialTrajectory::evaluate, py::arg("t"), py::arg("k") = 0,
-           "the k-th derivative at time t (clamped to the trajectory)")
-      .def("sample", [](const miner::traj::PolynomialTrajectory& t, const Eigen::VectorXd& times, int k) {
-            Eigen::MatrixX3d out(times.size(), 3);
-            for (Eigen::Index i = 0; i < times.size(); ++i) out.row(i) = t.evaluate(times[i], k);
+      .def_property_readonly("cost", &PolynomialTrajectory::cost, "J = integral of |d^s p / dt^s|^2")
+      .def("evaluate", [](const PolynomialTrajectory& t, py::object time, py::object k) {
+            return t.evaluate(number(time, "t"), derivative_of(k));
+          }, py::arg("t"), py::arg("k") = 0, "the k-th derivative (k >= 0) at time t (clamped to the trajectory)")
+      .def("sample", [](const PolynomialTrajectory& t, py::object times_arg, py::object k_arg) {
+            const std::vector<double> times = vector_of(times_arg, "times");
+            const int k = derivative_of(k_arg);
+            Eigen::MatrixX3d out(static_cast<Eigen::Index>(times.size()), 3);
+            for (std::size_t i = 0; i < times.size(); ++i) {
+              if (std::isnan(times[i])) throw miner::Error("times[" + std::to_string(i) + "]: must be a time in s, got nan");
+              out.row(static_cast<Eigen::Index>(i)) = t.evaluate(times[i], k);
+            }
             return out;
           }, py::arg("times"), py::arg("k") = 0, "(n, 3) k-th derivatives at the given times");
-  m.def("minco", [](const Eigen::Ref<const Eigen::MatrixXd>& points, std::optional<std::vector<double>> durations,
-                    int order, double v_max, double a_max) {
-        const Eigen::MatrixX3d p = rows(points, "points");
-        std::vector<double> T = durations ? *durations : miner::traj::trapezoidal_allocation(p, miner::traj::Limits{v_max, a_max});
+  m.def("minco", [](py::object points_arg, py::object durations_arg, py::object order_arg, py::object v_max_arg,
+                    py::object a_max_arg) {
+        const Eigen::MatrixX3d p = points_of(points_arg, "points");
+        const int order = static_cast<int>(integer_in(order_arg, "order", 3, 4));
+        std::vector<double> T;
+        if (!durations_arg.is_none()) {
+          // Given durations fix the timing: limits beside them would not be applied (as
+          // `miner traj solve` refuses them; ninth campaign P14).
+          for (const auto& [arg, name] : {std::pair{&v_max_arg, "v_max"}, std::pair{&a_max_arg, "a_max"}})
+            if (!arg->is_none())
+              throw miner::Error(std::string(name) + ": unused: durations are given (give one of them)");
+          T = vector_of(durations_arg, "durations");
+        } else {
+          // The traj problem file's range (m/s, m/s^2).
+          const miner::traj::Limits limits{
+              v_max_arg.is_none() ? 2.0 : number_in(v_max_arg, "v_max", 1e-6, 1e6, "m/s"),
+              a_max_arg.is_none() ? 1.0 : number_in(a_max_arg, "a_max", 1e-6, 1e6, "m/s^2")};
+          T = miner::traj::trapezoidal_allocation(p, limits);
+          // A segment too short or too long for doubles has no duration: named by its points,
+          // not as a durations[i] the caller never gave (ninth campaign P13).
+          for (std::size_t i = 0; i < T.size(); ++i)
+            if (!std::isfinite(T[i]) || !(T[i] > 0.0))
+              throw miner::Error("points[" + std::to_string(i) + "] and points[" + std::to_string(i + 1) + "]: a segment of " +
+                                 miner::short_number((p.row(static_cast<Eigen::Index>(i) + 1) - p.row(static_cast<Eigen::Index>(i))).norm()) +
+                                 " m has no trapezoidal duration (" + miner::short_number(T[i]) +
+                                 " s at v_max, a_max): too short or too long for double precision");
+        }
         return miner::traj::solve_minco(miner::traj::rest_to_rest(order, p, std::move(T)));
-      }, py::arg("points"), py::arg("durations") = py::none(), py::arg("order") = 4, py::arg("v_max") = 2.0,
-      py::arg("a_max") = 1.0,
+      }, py::arg("points"), py::arg("durations") = py::none(), py::arg("order") = 4, py::arg("v_max") = py::none(),
+      py::arg("a_max") = py::none(),
       "The minimum-jerk (order 3) or minimum-snap (order 4) trajectory through (n, 3) points, at rest at both "
-      "ends; durations given, or from the trapezoidal profile of v_max and a_max. Every answer is checked.");
+      "ends; durations given, or from the trapezoidal profile of v_max (default 2 m/s) and a_max (default 1 m/s^2), "
+      "which the curve may exceed between waypoints (docs/traj.md). Every answer is checked.");
 
   // ----------------------------------------------------------------------- flight
-  py::class_<miner::pipeline::Scenario>(m, "Scenario", "A miner-scenario-v1 flight: map, vehicle, query, sensors, controller.")
-      .def_static("load", &miner::pipeline::load_scenario, py::arg("path"))
+  using miner::pipeline::Scenario;
+  py::class_<Scenario>(m, "Scenario", "A miner-scenario-v1 flight: map, vehicle, query, sensors, controller.")
+      .def_static("load", [](py::object path) { return miner::pipeline::load_scenario(path_of(path, "path")); },
+                  py::arg("path"))
       .def_static("default", &miner::pipeline::default_scenario, "the built-in indoor-1 scenario")
-      .def_static("from_json", [](const std::string& text, const std::string& base_dir) {
-            return miner::pipeline::scenario_from_json(miner::parse_json(text, "<string>"), "<string>", base_dir);
+      .def_static("from_json", [](py::object text, py::object base_dir_arg) {
+            // Relative paths in the text resolve from base_dir, which must be a folder: a lexical
+            // "nodir/../maps" picked up files through a folder that is not there (ninth campaign P16).
+            const std::string base_dir = path_of(base_dir_arg, "base_dir");
+            std::error_code ec;
+            if (!std::filesystem::is_directory(base_dir, ec))
+              throw miner::Error("base_dir: " + base_dir + " is not a folder");
+            return miner::pipeline::scenario_from_json(miner::parse_json(text_of(text, "text"), "<string>"), "<string>",
+                                                       base_dir);
           }, py::arg("text"), py::arg("base_dir") = ".")
-      .def_readonly("name", &miner::pipeline::Scenario::name)
-      .def_readonly("seed", &miner::pipeline::Scenario::seed)
-      .def_property_readonly("start", [](const miner::pipeline::Scenario& s) { return V3(s.start); })
-      .def_property_readonly("goal", [](const miner::pipeline::Scenario& s) { return V3(s.goal); })
-      .def_property_readonly("map", [](const miner::pipeline::Scenario& s) { return std::make_shared<miner::world::Map>(*s.map); });
-  py::class_<miner::pipeline::ReferencePlan>(m, "Reference", "The trajectory a flight follows and where it came from.")
-      .def_readonly("trajectory", &miner::pipeline::ReferencePlan::trajectory)
-      .def_readonly("path", &miner::pipeline::ReferencePlan::path)
-      .def_readonly("source", &miner::pipeline::ReferencePlan::source)
-      .def_readonly("max_speed", &miner::pipeline::ReferencePlan::max_speed)
-      .def_readonly("max_acceleration", &miner::pipeline::ReferencePlan::max_acceleration);
-  m.def("build_reference", [](const miner::pipeline::Scenario& s) {
+      .def_readonly("name", &Scenario::name)
+      .def_readonly("seed", &Scenario::seed)
+      .def_property_readonly("start", [](const Scenario& s) { return V3(s.start); })
+      .def_property_readonly("goal", [](const Scenario& s) { return V3(s.goal); })
+      .def_property_readonly("map", [](const Scenario& s) { return std::make_shared<Map>(*s.map); });
+  using miner::pipeline::ReferencePlan;
+  py::class_<ReferencePlan>(m, "Reference", "The trajectory a flight follows and where it came from.")
+      .def_readonly("trajectory", &ReferencePlan::trajectory)
+      .def_readonly("path", &ReferencePlan::path)
+      .def_readonly("source", &ReferencePlan::source)
+      .def_readonly("max_speed", &ReferencePlan::max_speed)
+      .def_readonly("max_acceleration", &ReferencePlan::max_acceleration);
+  m.def("build_reference", [](py::object scenario) {
+        const Scenario& s = object_of<Scenario>(scenario, "scenario", "Scenario");
         py::gil_scoped_release unlocked;
         return miner::pipeline::build_reference(s);
       }, py::arg("scenario"), "Plan (MINER RRT* on the sGAN region unless the scenario says otherwise), repair and smooth.");
@@ -251,11 +505,14 @@ PYBIND11_MODULE(_miner, m) {
             for (const auto& row : r.log) out = std::copy(row.begin(), row.end(), out);
             return a;
           }, "(ticks, columns) array; names in log_columns");
-  m.def("fly", [](const miner::pipeline::Scenario& s, const miner::pipeline::ReferencePlan& reference, bool log) {
+  m.def("fly", [](py::object scenario, py::object reference_arg, py::object log) {
+        const Scenario& s = object_of<Scenario>(scenario, "scenario", "Scenario");
+        const ReferencePlan& reference = object_of<ReferencePlan>(reference_arg, "reference", "Reference");
         miner::flight::FlyOptions o;
-        o.record_log = log;
+        o.record_log = flag(log, "log");
         py::gil_scoped_release unlocked;
         return miner::pipeline::fly(s, reference, o);
       }, py::arg("scenario"), py::arg("reference"), py::arg("log") = true,
-      "Flies the reference with the scenario's vehicle, sensors, N3, EKF and controller (same seed, same bytes).");
+      "Flies the reference with the scenario's vehicle, sensors, N3, EKF and controller (same seed, same bytes); "
+      "the reference must be this scenario's (miner.build_reference(scenario)).");
 }

@@ -89,3 +89,128 @@ def test_the_default_scenario_flies_to_its_goal():
     assert flight.log.shape == (len(flight.log), len(flight.log_columns))
     assert flight.position_rmse < 0.1
     assert json.loads(flight.summary)["goal_reached"] is True
+
+
+# ---- issue 20, ninth campaign: the Python layer checks what the CLI checks (REQ-LIB-002) ----
+WALL = json.dumps({"format": "miner-map-v1", "bounds": {"min": [0, 0, 0], "max": [10, 10, 2]}, "resolution": 0.5,
+                   "obstacles": [{"type": "box", "min": [4.5, 0, 0], "max": [5.5, 7, 2]},
+                                 {"type": "box", "min": [4.5, 9, 0], "max": [5.5, 10, 2]}],
+                   "query": {"start": [2, 3, 1], "goal": [8, 3, 1], "robot_radius": 0.1}})
+SEALED = json.dumps({"format": "miner-map-v1", "bounds": {"min": [0, 0, 0], "max": [10, 10, 10]}, "resolution": 0.5,
+                     "obstacles": [{"type": "box", "min": [7, 7, 7], "max": [10, 10, 7.5]},
+                                   {"type": "box", "min": [7, 7, 7.5], "max": [7.5, 10, 10]},
+                                   {"type": "box", "min": [7.5, 7, 7.5], "max": [10, 7.5, 10]}],
+                     "query": {"start": [1, 1, 1], "goal": [8.75, 8.75, 8.75], "robot_radius": 0.1}})
+
+
+def test_trajectory_derivative_order_and_time_are_checked():
+    t = miner.minco([[0, 0, 0], [1, 0, 0], [2, 1, 0]])
+    for k in (-1, -100, -2**31, -10**6):  # read outside the coefficients, or crashed (P1)
+        with pytest.raises(miner.Error, match="k: "):
+            t.evaluate(1.0, k=k)
+        with pytest.raises(miner.Error, match="k: "):
+            t.sample(np.linspace(0, 1, 5), k=k)
+    with pytest.raises(miner.Error, match="k: "):
+        t.evaluate(1.0, k=2**40)
+    with pytest.raises(miner.Error, match="t: must be a time"):  # NaN answered the start (P12)
+        t.evaluate(float("nan"))
+    with pytest.raises(miner.Error, match=r"times\[0\]"):
+        t.sample(np.array([float("nan"), 1.0]))
+    assert np.allclose(t.evaluate(1e9), t.evaluate(t.total_duration))  # finite times clamp, as documented
+    assert np.allclose(t.evaluate(1.0, k=20), 0.0)
+
+
+def test_region_queries_are_planner_queries():
+    m = miner.Map.from_json(WALL)
+    for start in ([float("nan"), 3, 1], [5, 3, 1], [-500, 3, 1], [float("inf"), 3, 1]):  # P2 crash, P3
+        with pytest.raises(miner.Error, match="start"):
+            miner.sgan_region(m, start=start)
+    with pytest.raises(miner.Error, match="goal"):
+        miner.sgan_region(m, goal=[float("nan"), 3, 1], filter=False)
+    with pytest.raises(miner.Error, match="radius"):
+        miner.sgan_region(m, radius=5)  # the start is within 5 m of the wall
+    with pytest.raises(miner.Error, match="radius"):
+        miner.sgan_region(m, radius=1e300)
+    for dims, field in (([2**32 + 8, 8, 8], "dims"), ([8.9, 8, 8], "dims"), ([True, 8, 8], "dims"),
+                        ([4097, 8, 8], "dims"), ([0, 8, 8], "dims")):  # wrapped, truncated (P4)
+        with pytest.raises(miner.Error, match=field):
+            miner.astar_region(m, dims=dims)
+    assert list(miner.astar_region(m, dims=[8, 8, 4]).dims) == [8, 8, 4]
+    with pytest.raises(miner.Error, match="dilation"):
+        miner.astar_region(m, dilation=5)
+
+
+def test_map_save_keeps_the_cli_rules(tmp_path):
+    m = miner.Map.from_json(WALL)
+    with pytest.raises(miner.Error, match="query"):  # a .bt holds no query (P5)
+        m.save(str(tmp_path / "q.bt"))
+    m.save(str(tmp_path / "q.bt"), drop_query=True)
+    assert miner.Map.load(str(tmp_path / "q.bt")).query is None
+    for name in ("x.BT", "x.txt"):  # JSON under another suffix (P6)
+        with pytest.raises(miner.Error, match=".json or .bt"):
+            m.save(str(tmp_path / name))
+    with pytest.raises(miner.Error, match="path: empty"):  # "cannot replace file: Success" (P7)
+        m.save("")
+    m.save(tmp_path / "pathlike.json")  # an os.PathLike is a path
+    assert miner.Map.load(tmp_path / "pathlike.json").query is not None
+    with pytest.raises(miner.Error, match="name it .json"):
+        miner.astar_region(m).save(str(tmp_path / "r.bt"))
+
+
+def test_collision_queries_refuse_nan_negative_and_non_numbers():
+    m = miner.Map.from_json(WALL)
+    for radius in (float("nan"), -1.0, float("inf"), 1e300):  # NaN called a wall free (P9)
+        with pytest.raises(miner.Error, match="radius"):
+            m.is_free([5, 3, 1], radius=radius)
+        with pytest.raises(miner.Error, match="radius"):
+            m.segment_free([2, 3, 1], [8, 3, 1], radius=radius)
+    with pytest.raises(miner.Error, match="p"):
+        m.clearance([float("nan")] * 3)
+    for p in (["1", "1", "1"], [1 + 1j, 1, 1], [True, True, True], [1, 1], None):
+        with pytest.raises(miner.Error, match="p"):
+            m.is_free(p)
+    assert not m.is_free([5, 3, 1]) and m.is_free([2, 3, 1], radius=0.4)
+
+
+def test_plan_ranges_and_an_unsolved_run():
+    m = miner.Map.from_json(WALL)
+    for kwargs, field in (({"iterations": 0}, "iterations"), ({"iterations": True}, "iterations"),
+                          ({"iterations": 10**6 + 1}, "iterations"), ({"target_cost": -1.0}, "target_cost"),
+                          ({"target_cost": 0.0}, "target_cost"), ({"radius": 10.5}, "radius"),
+                          ({"first": 2}, "first"), ({"seed": -1}, "seed"), ({"seed": 2**64}, "seed"),
+                          ({"seed": True}, "seed"), ({"planner": 3}, "planner")):  # P11, P15
+        with pytest.raises(miner.Error, match=field):
+            miner.plan(m, planner=kwargs.pop("planner", "rrtstar"), **kwargs)
+    with pytest.raises(miner.Error, match="map"):
+        miner.plan("sim-1.json", planner="rrtstar")
+    assert miner.plan(m, planner="rrtstar", seed=2**64 - 1, iterations=3000).solved
+    sealed = miner.Map.from_json(SEALED)
+    with pytest.raises(miner.NoSolution, match="no path"):  # came back with cost 0.0 (P10)
+        miner.plan(sealed, planner="rrtstar", iterations=500)
+
+
+def test_minco_names_what_the_caller_gave():
+    with pytest.raises(miner.Error, match=r"points\[0\] and points\[1\]"):  # not durations[0] (P13)
+        miner.minco([[0, 0, 0], [1e-300, 0, 0], [1, 0, 0]])
+    with pytest.raises(miner.Error, match="v_max: unused"):  # P14
+        miner.minco([[0, 0, 0], [1, 0, 0], [2, 1, 0]], durations=[1.0, 1.0], v_max=-5)
+    with pytest.raises(miner.Error, match="v_max"):
+        miner.minco([[0, 0, 0], [1, 0, 0]], v_max=-5)
+    with pytest.raises(miner.Error, match="points"):
+        miner.minco(np.array([[0, 0, 0], [1, 0, 0]], dtype=bool))
+    with pytest.raises(miner.Error, match="order"):
+        miner.minco([[0, 0, 0], [1, 0, 0]], order=5)
+
+
+def test_a_reference_flies_only_in_its_own_scenario(tmp_path):
+    s = miner.Scenario.default()
+    doc = json.loads((SOURCE / "fixtures" / "scenarios" / "default.json").read_text())
+    doc["trajectory"]["v_max"], doc["trajectory"]["a_max"] = 0.1, 0.05
+    slow = miner.Scenario.from_json(json.dumps(doc), base_dir=str(SOURCE / "fixtures" / "scenarios"))
+    with pytest.raises(miner.Error, match="exceed the scenario's trajectory.v_max"):  # P8
+        miner.fly(slow, miner.build_reference(s))
+    with pytest.raises(miner.Error, match="reference"):
+        miner.fly(s, "not a reference")
+    for base_dir in (str(tmp_path / "nodir"), str(SOURCE / "README.md")):  # P16
+        with pytest.raises(miner.Error, match="base_dir"):
+            miner.Scenario.from_json(json.dumps(doc), base_dir=base_dir)

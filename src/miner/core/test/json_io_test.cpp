@@ -5,6 +5,9 @@
 #include <limits>
 #include <fstream>
 #include <sstream>
+#include <string>
+
+#include <unistd.h>
 
 #include "miner/core/error.hpp"
 #include "miner/core/json_io.hpp"
@@ -75,6 +78,23 @@ TEST_CASE("A key named twice in one object is refused, naming it", "[REQ-CORE-00
   CHECK_THROWS_WITH(miner::parse_json(R"({"a": [[{"k": 1, "k": 2}]]})", "n.json"), Contains("n.json: a[][].k: the key"));
   // The same key in different objects, or in objects of an array, is fine.
   CHECK_NOTHROW(miner::parse_json(R"({"a": {"k": 1}, "b": {"k": 2}, "l": [{"k": 1}, {"k": 2}], "k": 3})", "ok.json"));
+}
+
+TEST_CASE("A file of another format given as JSON is named by its format", "[REQ-CORE-003]") {
+  // Issue 20, ninth campaign C7: an OctoMap given as a region, problem or scenario got
+  // "malformed JSON at byte 140: a NUL byte".
+  const std::string dir = std::filesystem::temp_directory_path() / ("miner_json_formats_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const auto file = [&](const std::string& name, const std::string& bytes) {
+    std::ofstream(dir + "/" + name, std::ios::binary) << bytes;
+    return dir + "/" + name;
+  };
+  CHECK_THROWS_WITH(miner::read_json_file(file("r.bt", std::string("# Octomap OcTree binary file\nid OcTree\n\0\1", 43))),
+                    Contains("r.bt: is an OctoMap file (voxels), not a JSON document"));
+  CHECK_THROWS_WITH(miner::read_json_file(file("c.json", "ply\nformat ascii 1.0\n")), Contains("c.json: is a point cloud"));
+  CHECK_THROWS_WITH(miner::read_json_file(file("d.json", "# .PCD v0.7\n")), Contains("is a point cloud"));
+  CHECK(miner::read_json_file(file("ok.json", "{\"ply\": 1}"))["ply"] == 1);
+  std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("A number the JSON library would not read as written is refused, naming it", "[REQ-CORE-003]") {

@@ -233,6 +233,20 @@ TEST_CASE("Bad scenarios are refused before flight with the fault named", "[REQ-
   doc["planner"]["region"] = "astar";
   doc["planner"]["weights"] = "w.bin";
   expect_scenario_error(doc, "s.json: planner.weights: applies to \"region\": \"sgan\" only");
+  // Ninth campaign C4: a controller capped below the reference's speed fell behind and cut
+  // corners into pillars; C5: keys the chosen yaw mode never reads flew without effect.
+  doc = default_doc();
+  doc["controller"]["max_speed_m_s"] = 0.1;
+  expect_scenario_error(doc, "controller.max_speed_m_s: 0.1 m/s is below trajectory.v_max");
+  doc["controller"]["max_speed_m_s"] = doc["trajectory"]["v_max"];
+  CHECK_NOTHROW(pipeline::scenario_from_json(doc, "s.json", kScenarios));
+  doc = default_doc();
+  doc["yaw"] = {{"mode", "velocity"}, {"fixed_deg", 90}};
+  expect_scenario_error(doc, "yaw.fixed_deg: unused: yaw.mode is \"velocity\"");
+  doc["yaw"] = {{"mode", "fixed"}, {"min_speed_m_s", 1}};
+  expect_scenario_error(doc, "yaw.min_speed_m_s: unused: yaw.mode is \"fixed\"");
+  doc["yaw"] = {{"min_speed_m_s", 1}};  // fixed is the default mode
+  expect_scenario_error(doc, "yaw.min_speed_m_s: unused");
   doc = default_doc();
   doc["vehicle"] = flight::to_json(flight::VehicleParams{});
   doc["vehicle"]["mass_kgg"] = 2;
@@ -300,6 +314,8 @@ miner::Json with_value(const RangeRow& row, double v) {
   if (row.field == "pose.delay_jitter_s") doc["pose"]["delay_s"] = 0.0;
   if (row.field == "pose.dropout_rate_hz") doc["pose"]["dropout_mean_s"] = 1.0;
   if (row.field == "n3.latency_s") doc["n3"]["timeout_s"] = 10.0;
+  if (row.field == "yaw.min_speed_m_s") doc["yaw"]["mode"] = "velocity";
+  if (row.field == "controller.max_speed_m_s") doc["trajectory"]["v_max"] = 0.01;
   miner::Json* at = &doc;
   std::size_t start = 0;
   for (std::size_t dot; (dot = row.field.find('.', start)) != std::string::npos; start = dot + 1)
@@ -439,6 +455,39 @@ TEST_CASE("The pipeline owns the run folder: its files in order, the summary nam
   CHECK_FALSE(pipeline::run_folder_conflict("/data/runs/a", doc, "/data").has_value());
 }
 
+TEST_CASE("A reference flies only in the scenario it was built for", "[REQ-FLIGHT-007]") {
+  // Issue 20, ninth campaign P8 (from Python): a reference of another scenario flew from
+  // another start, through walls or past the limits, and came back as an ordinary flight; C5:
+  // a dropout or gust after the flight's end never acted, without a word.
+  Eigen::MatrixX3d points(3, 3);
+  points << 5, 5, 3, 8, 7, 4, 11, 6, 3;
+  const auto s = miner::testing::open_room_scenario(points, 1.0, 1.0, 9);
+  const auto ref = pipeline::build_reference(s);
+  CHECK_NOTHROW(pipeline::check_reference(s, ref));
+  auto moved = s;
+  moved.start += Eigen::Vector3d(0.5, 0, 0);
+  CHECK_THROWS_WITH(pipeline::fly(moved, ref), Contains("must start at start"));
+  auto slow = s;
+  slow.limits.v_max = 0.5 * ref.max_speed;
+  CHECK_THROWS_WITH(pipeline::fly(slow, ref), Contains("exceed the scenario's trajectory.v_max"));
+  auto walled = s;  // the same room with a pillar on the reference's way
+  auto obstacles = s.map->obstacles();
+  const Eigen::Vector3d mid = ref.trajectory.evaluate(0.5 * ref.trajectory.total_duration());
+  obstacles.push_back(miner::world::Box{mid - Eigen::Vector3d::Constant(0.2), mid + Eigen::Vector3d::Constant(0.2)});
+  walled.map = std::make_shared<const miner::world::Map>(s.map->bounds(), s.map->resolution(), obstacles);
+  CHECK_THROWS_WITH(pipeline::fly(walled, ref), Contains("of an obstacle of the scenario's map"));
+  const double end = ref.trajectory.total_duration() + s.hover_after_s;
+  auto late = s;
+  late.command_dropout = std::make_pair(end, end + 1.0);
+  CHECK_THROWS_WITH(pipeline::fly(late, ref), Contains("command_dropout_s: starts at") && Contains("never happen"));
+  late.command_dropout = std::make_pair(end - 0.5, end + 1.0);  // it opens before the end: flown
+  CHECK_NOTHROW(pipeline::check_reference(late, ref));
+  auto gusty = s;
+  gusty.wind.enabled = true;
+  gusty.wind.gusts.push_back({end, 1.0, Eigen::Vector3d(1, 0, 0)});
+  CHECK_THROWS_WITH(pipeline::fly(gusty, ref), Contains("wind.gusts[0].start_s") && Contains("never blow"));
+}
+
 TEST_CASE("A flight stops the first tick the vehicle is outside its world and says where", "[REQ-FLIGHT-009]") {
   // Issue 20, seventh campaign: a vehicle that could not hold its reference flew on hundreds of
   // metres off its 10 x 10 x 5 m map, the flight simulated to its end.
@@ -474,11 +523,20 @@ TEST_CASE("A flight stops the first tick the vehicle is outside its world and sa
   CHECK(r.summary["left_map"]["time_s"].get<double>() == r.left_world_time_s);
   CHECK(r.summary["left_map"]["position"][0].get<double>() == r.left_world_position.x());
 
-  // pipeline::fly bounds the flight by the scenario's map.
+  // pipeline::fly flies only the scenario's own reference: one that leaves its map is refused
+  // before the flight (issue 20, ninth campaign P8) ...
   auto small = s;
   small.map = std::make_shared<const miner::world::Map>(miner::world::Box{{0, 0, 0}, {kWallX, 20, 10}}, 0.5,
                                                         std::vector<miner::world::Box>{});
-  const flight::FlightResult p = pipeline::fly(small, ref);
-  CHECK(p.left_world);
-  CHECK(p.left_world_time_s == r.left_world_time_s);
+  CHECK_THROWS_WITH(pipeline::fly(small, ref), Contains("build the reference from this scenario"));
+  // ... and bounds the flight by the scenario's map: a wind the vehicle cannot hold against
+  // blows it out, and the flight stops there.
+  auto windy = s;
+  windy.wind.enabled = true;
+  windy.wind.mean = Eigen::Vector3d(30.0, 0.0, 0.0);
+  windy.vehicle.linear_drag = Eigen::Vector3d::Constant(5.0);  // 150 N at 30 m/s: far past its thrust
+  const flight::FlightResult p = pipeline::fly(windy, pipeline::build_reference(windy));
+  REQUIRE(p.left_world);
+  CHECK(p.left_world_position.x() > s.map->bounds().max.x());
+  CHECK(p.flight_time == Approx(p.left_world_time_s));
 }

@@ -293,6 +293,16 @@ TEST_CASE("Each planner option's range holds at its ends: a closed end kept, a s
   o = options();
   o.safeguard_iterations = 1;
   CHECK(kept(o));
+  // On a 0.1 m map the least step is 0.01 m, which 0.1 x 0.1 rounds past in doubles (ninth
+  // campaign C6: the documented minimum was refused).
+  const miner::world::Map fine(miner::world::Box{{0, 0, 0}, {4, 4, 2}}, 0.1, {});
+  const auto open = PlanningProblem::make(fine, V(0.5, 0.5, 1), V(3.5, 3.5, 1), 0.1);
+  o = options();
+  o.planner = PlannerKind::kRrtStar;
+  o.steer_step = 0.01;
+  CHECK_NOTHROW(miner::plan::plan(open, o));
+  o.steer_step = 0.0099;
+  CHECK_THROWS_WITH(miner::plan::plan(open, o), Contains("is below a tenth of the map's resolution"));
   // The largest budget is accepted (the run stops at its first solution, not after 10^6).
   o = options();
   o.max_iterations = miner::plan::kMaxIterations;

@@ -233,6 +233,13 @@ TEST_CASE("Bad scenarios are refused before flight with the fault named", "[REQ-
   doc["planner"]["region"] = "astar";
   doc["planner"]["weights"] = "w.bin";
   expect_scenario_error(doc, "s.json: planner.weights: applies to \"region\": \"sgan\" only");
+  // The tilt-time rule reads the larger of the roll and pitch inertias (held-out audit 7,
+  // h7-flight-06 read roll only and flew [0.029, 5, 5] out of the map).
+  for (const Eigen::Vector3d& inertia : {Eigen::Vector3d(0.029, 5, 5), Eigen::Vector3d(5, 0.029, 5)}) {
+    flight::VehicleParams v;
+    v.inertia = inertia;
+    CHECK_THROWS_WITH(flight::validate(v), Contains("inertia_kg_m2") && Contains("tilt limit"));
+  }
   // Ninth campaign C4: a controller capped below the reference's speed fell behind and cut
   // corners into pillars; C5: keys the chosen yaw mode never reads flew without effect.
   doc = default_doc();

@@ -449,6 +449,11 @@ TEST_CASE("A dataset folder that contradicts itself is refused naming the file a
         edit_json(q0 + "/train-index.json", [](miner::Json& d) { d[0]["start"][0] = 1e6; });
       },
       "start: lies outside the sample's bounds");
+  refused(  // the goal is checked by itself, not through the start (held-out audit 7, h7-heuristic-04)
+      [&](const std::string& q0, const std::string&) {
+        edit_json(q0 + "/train-index.json", [](miner::Json& d) { d[0]["goal"][1] = -1e6; });
+      },
+      "goal: lies outside the sample's bounds");
   // Shard bytes outside their levels, or a sample with no start and goal cells, with the SHA-256
   // in dataset.json recomputed to match (issue 20, sixth campaign: they were read silently).
   const auto edit_shard = [&](const std::string& q0, const std::function<void(std::string&)>& change) {
@@ -485,6 +490,16 @@ TEST_CASE("Bad dataset options are refused naming the option", "[REQ-HEUR-003]")
   o = small_options();
   o.dims = Eigen::Vector3i(2, 32, 32);
   CHECK_THROWS_WITH(heuristic::validate(o), Contains("--dims"));
+  // Both ends of --dims [4, 256] are kept, a cell past each refused (held-out audit 7,
+  // h7-heuristic-02 refused 4).
+  for (const int n : {4, 256}) {
+    o.dims = Eigen::Vector3i(n, n, 4);
+    CHECK_NOTHROW(heuristic::validate(o));
+  }
+  for (const int n : {3, 257}) {
+    o.dims = Eigen::Vector3i(8, 8, n);
+    CHECK_THROWS_WITH(heuristic::validate(o), Contains("--dims"));
+  }
   o = small_options();
   o.preset = "swamp";
   CHECK_THROWS_WITH(heuristic::validate(o), Contains("swamp"));

@@ -436,6 +436,12 @@ TEST_CASE("A missing, truncated, altered or mismatched weights file is refused n
     refuses([](miner::Json& h) { h["tensors"][0]["extra"] = 1; }, "tensors[0].extra: unknown key");
     refuses([](miner::Json& h) { h["meta"]["architecture"]["environment_scale"] = -1e300; }, "environment_scale: must be in (0, 1]");
     refuses([](miner::Json& h) { h["meta"]["architecture"]["environment_scale"] = 0; }, "environment_scale: must be in (0, 1], got 0");
+    refuses([](miner::Json& h) { h["meta"]["architecture"]["environment_scale"] = 1.0 + 1e-12; }, "environment_scale: must be in (0, 1]");
+    {  // the closed end is kept (held-out audit 7, h7-heuristic-05 refused 1)
+      miner::Json one = header;
+      one["meta"]["architecture"]["environment_scale"] = 1.0;
+      CHECK_NOTHROW(heuristic::Sgan::from_bytes(rewritten(one), "one.bin"));
+    }
     refuses([](miner::Json& h) { h["meta"]["architecture"]["scale_channels"] = 0; },
             "meta.architecture.scale_divisor: is given, but scale_channels is 0");
     refuses([](miner::Json& h) { h["meta"]["architecture"]["threshold_rule"] = "widset"; },

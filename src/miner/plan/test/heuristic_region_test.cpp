@@ -92,6 +92,9 @@ TEST_CASE("A region round-trips through miner-region-v1 and bad files name the f
   CHECK_THROWS_WITH(HeuristicRegion::cell_count(I(big, big, big)), Contains("more than the limit"));
   CHECK_THROWS_WITH(HeuristicRegion::cell_count(I(1 << 22, 1 << 21, 1 << 21)), Contains("more than the limit"));
   CHECK(HeuristicRegion::cell_count(I(32, 32, 32)) == 32768);
+  // The limit itself is kept, one cell past it refused (held-out audit 7, h7-plan-06).
+  CHECK(HeuristicRegion::cell_count(I(256, 256, 256)) == HeuristicRegion::kMaxCells);
+  CHECK_THROWS_WITH(HeuristicRegion::cell_count(I(256, 256, 257)), Contains("more than the limit"));
   doc = r.to_json();
   doc["dims"] = {big, big, big};
   CHECK_THROWS_WITH(HeuristicRegion::from_json(doc, "r.json"), Contains("more than the limit"));

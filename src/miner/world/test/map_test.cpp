@@ -191,6 +191,9 @@ TEST_CASE("A map's metric range holds at its ends: each end kept, a step past it
   CHECK_THAT(error_of(map_doc(V::Zero(), V::Constant(0.4), 0.001 * (1 - kStep))), Contains("resolution:") && Contains("is outside the resolutions"));
   CHECK(error_of(map_doc(V::Zero(), V::Constant(100), 100.0)) == "(no error)");
   CHECK_THAT(error_of(map_doc(V::Zero(), V::Constant(100), 100.0 * (1 + kStep))), Contains("is outside the resolutions"));
+  // The grid bound: exactly 2^26 cells kept, one row more refused (held-out audit 7, h7-world-02).
+  CHECK(error_of(map_doc(V::Zero(), V(1024, 256, 256), 1.0)) == "(no error)");
+  CHECK_THAT(error_of(map_doc(V::Zero(), V(1025, 256, 256), 1.0)), Contains("more than the 6.71089e+07 a map may have"));
   // Corners: at 10^6 m kept, past it refused, on each side of the origin.
   CHECK(error_of(map_doc(V::Constant(1e6 - 100), V::Constant(1e6), 1.0)) == "(no error)");
   CHECK_THAT(error_of(map_doc(V::Constant(1e6 - 100), V(1e6, 1e6 * (1 + kStep), 1e6), 1.0)),

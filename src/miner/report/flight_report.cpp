@@ -436,13 +436,18 @@ std::string render_flight_report(const FlightReportInput& in) {
   h += "<h2>Events</h2>\n<div class=\"plots\">\n" + timeline(f) + "</div>\n";
   h += "<h2>Over time</h2>\n<p>Every plot against time (s); the black line marks the playback slider's time.</p>\n" +
        plots(f);
-  h += "<h2>Stage timing</h2>\n<table><tr><th>stage</th><th>wall clock (ms)</th></tr>\n";
-  double total = 0.0;
-  for (const auto& [name, ms] : in.stage_ms) {
-    h += "<tr><td>" + html_escape(name) + "</td><td>" + fixed(ms, 2) + "</td></tr>\n";
-    total += ms;
+  if (in.stage_ms.empty()) {
+    h += "<h2>Stage timing</h2>\n<p>Not recorded: wall-clock times would make the page differ between two runs "
+         "of the same scenario and seed (<code>miner fly --timing</code> records them).</p>\n";
+  } else {
+    h += "<h2>Stage timing</h2>\n<table><tr><th>stage</th><th>wall clock (ms)</th></tr>\n";
+    double total = 0.0;
+    for (const auto& [name, ms] : in.stage_ms) {
+      h += "<tr><td>" + html_escape(name) + "</td><td>" + fixed(ms, 2) + "</td></tr>\n";
+      total += ms;
+    }
+    h += "<tr><th>total</th><th>" + fixed(total, 2) + "</th></tr></table>\n";
   }
-  h += "<tr><th>total</th><th>" + fixed(total, 2) + "</th></tr></table>\n";
   if (r.planner_iterations > 0)
     h += "<p>Planner: " + std::to_string(r.planner_iterations) + " iterations, tree of " +
          std::to_string(r.tree_vertices.size()) + " vertices.</p>\n";

@@ -337,6 +337,29 @@ TEST_CASE("A pack too small for the flight is depleted: it gives what it stored,
   CHECK(full.battery_used_wh < 60.0);
 }
 
+TEST_CASE("VIO yaw drift turns the world about the start: a vehicle resting at its start is measured there",
+          "[REQ-FLIGHT-015]") {
+  // Held-out audit 7, h7-flight-03 turned it about the map's origin: a vehicle at (30, -20, 2)
+  // was measured tens of centimetres off before it moved.
+  flight::PoseParams p;
+  p.outlier_probability = 0.0;
+  p.position_sigma = 1e-6;
+  p.attitude_sigma = 1e-6;
+  p.yaw_drift_random_walk = 0.5;  // rad/sqrt(s): radians within seconds
+  const Eigen::Vector3d start(30, -20, 2);
+  miner::Rng noise(7, miner::streams::kPoseNoise), vio(7, miner::streams::kPoseVio);
+  flight::PoseSource src(p, 0.02, start, noise, vio);
+  for (int k = 0; k < 200; ++k) {
+    const auto d = src.measure(k * 0.02, start, Eigen::Quaterniond::Identity());
+    REQUIRE(d);
+    CHECK((d->measurement.p - start).norm() < 1e-4);
+  }
+  // ... while a point 10 m away is turned with the drifted frame.
+  const auto away = src.measure(4.0, start + Eigen::Vector3d(10, 0, 0), Eigen::Quaterniond::Identity());
+  REQUIRE(away);
+  CHECK((away->measurement.p - start - Eigen::Vector3d(10, 0, 0)).norm() > 0.01);
+}
+
 TEST_CASE("The VIO pose stream drifts as a random walk, loses tracking at its rate and jitters within bounds", "[REQ-FLIGHT-015]") {
   flight::PoseParams p;
   p.outlier_probability = 0.0;

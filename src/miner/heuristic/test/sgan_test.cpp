@@ -341,6 +341,12 @@ TEST_CASE("The network is told its cells' metric size: sigma = log2(cell / radiu
   CHECK(sigma[1] == 0.25f);
   CHECK(sigma[2] == -0.25f);
   CHECK_THROWS_WITH(heuristic::scale_input(box, Eigen::Vector3i(32, 32, 32), -0.1, 4.0), Contains("radius"));
+  // Each axis by its own cell count (held-out audit 7, h7-heuristic-03 divided every extent by
+  // nx): the same box on a 64 x 32 x 16 grid has cells of 1, 1 and 0.5 m, i.e. 2, 2 and 1 radii.
+  const std::vector<float> uneven = heuristic::scale_input(box, Eigen::Vector3i(64, 32, 16), 0.5, 4.0);
+  CHECK(uneven[0] == 0.25f);
+  CHECK(uneven[1] == 0.25f);
+  CHECK(uneven[2] == 0.0f);
   // A point robot, and cells of 2^12 radii, get the limit instead of infinity or 3.
   for (double r : {0.0, 2.0 / 4096.0}) CHECK(heuristic::scale_input(box, Eigen::Vector3i(32, 32, 32), r, 4.0)[0] == 2.0f);
   // ... and a robot far wider than the cells (cells of 2^-12 radii: sigma -3) gets -2, the

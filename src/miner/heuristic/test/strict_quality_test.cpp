@@ -123,6 +123,12 @@ TEST_CASE("Strict safety is the share of H's volume within the robot radius of a
   CHECK(with_wall.unsafe_fraction == Approx(222.0 / 1200.0));
   CHECK_FALSE(with_wall.safe);
   CHECK(strict_quality(map, grid, region_where(map, [](int i, int, int) { return i <= 3; }), kStart, kGoal).unsafe_fraction == 0.0);
+  // The robot radius counts (held-out audit 7, h7-heuristic-06 tested the centres alone): at
+  // 0.3 m the left side's last slab (centres at x = 3.75, 0.25 m from the wall) is unsafe but
+  // for the door's 3 x 3 centres (0.35 m from the wall's edges): 111 of its 960 voxels.
+  const miner::world::VoxelGrid wide(map, 0.3);
+  CHECK(strict_quality(map, wide, region_where(map, [](int i, int, int) { return i <= 3; }), kStart, kGoal).unsafe_fraction ==
+        Approx(111.0 / 960.0));
   // An empty region is neither.
   const auto none = strict_quality(map, grid, region_where(map, [](int, int, int) { return false; }), kStart, kGoal);
   CHECK(none.voxels == 0);

@@ -1,5 +1,6 @@
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <limits>
 
 #include <fstream>
@@ -163,4 +164,10 @@ TEST_CASE("Hops through H and a path's share in H are measured on the region's c
   CHECK(r.length_fraction_inside({V(0, 1.5, 0.5), V(6, 1.5, 0.5)}) == 0.0);
   CHECK(r.length_fraction_inside({V(0, 1.5, 0.5), V(6, 1.5, 0.5), V(6, 0.5, 0.5), V(6.5, 1.5, 0.5)}) > 0.0);
   CHECK(r.length_fraction_inside({V(1, 1, 1)}) == 0.0);
+  // Each step counts by its midpoint, so one crossing of H's boundary errs by at most half a
+  // step: from x = 6.1 (outside) to 0, 25 steps of 0.244 m, exactly 6 / 6.1 inside (held-out
+  // audit 7, h7-plan-05 counted a step by its start: 0.96, off by a whole step).
+  const double exact = 6.0 / 6.1, half_step = 0.5 * (6.1 / 25.0) / 6.1;
+  CHECK(std::abs(r.length_fraction_inside({V(6.1, 0.5, 0.5), V(0, 0.5, 0.5)}) - exact) <= half_step + 1e-12);
+  CHECK(std::abs(r.length_fraction_inside({V(0, 0.5, 0.5), V(6.1, 0.5, 0.5)}) - exact) <= half_step + 1e-12);
 }

@@ -308,6 +308,20 @@ TEST_CASE("A drained battery under a heavy plant saturates the thrust: the fligh
   CHECK(drained.summary["events"]["saturation_time_s"].get<double>() == drained.saturation_time_s);
 }
 
+TEST_CASE("Thrust capped by the battery alone is reported as saturation", "[REQ-FLIGHT-014][REQ-FLIGHT-018]") {
+  // A 1.9x heavier plant on a pack at 5 %: the controller's own commands stay in range, the
+  // pack's voltage caps the rotors, and the flight says so (held-out audit 7, h7-flight-02
+  // counted only the controller's saturation: 0 s of 0.77).
+  pipeline::Scenario s = pipeline::default_scenario();
+  s.mismatch.mass = 1.9;
+  s.battery.enabled = true;
+  s.battery.initial_charge = 0.05;
+  const auto r = pipeline::fly(s, pipeline::build_reference(s));
+  INFO("saturated " << r.saturation_time_s << " s of " << r.flight_time << " s");
+  CHECK(r.saturation_time_s > 0.25 * r.flight_time);
+  CHECK(r.summary["events"]["saturation_time_s"].get<double>() == r.saturation_time_s);
+}
+
 TEST_CASE("A pack too small for the flight is depleted: it gives what it stored, no more, and the flight fails",
           "[REQ-FLIGHT-014]") {
   // Issue 20, eighth campaign W3: 0.5 Wh stored gave 2.67 Wh and the flight reached its goal.

@@ -399,6 +399,11 @@ TEST_CASE("Before a solution the trust falls once no vertex comes strictly fewer
   const double stalled = static_cast<double>(o.safeguard_iterations) / r.region_trust;
   CHECK(stalled == Approx(std::round(stalled)).margin(1e-6));
   CHECK(stalled >= static_cast<double>(o.safeguard_iterations));
+  // ... and t_p is the last progress, not the run's start: the tree's first steps into the tube
+  // (at iteration >= 1) were progress, so the stall is shorter than the run (held-out audit 7,
+  // h7-plan-01 used t, decaying the trust even while the tree advanced through H).
+  INFO("stalled " << stalled << " of " << r.iterations << " iterations");
+  CHECK(stalled < static_cast<double>(r.iterations));
   // The last strict progress (reaching the tube's last cell before the wall) came in the first
   // half of the run: the trust at the end is at most k_0 / 2000.
   CHECK(r.region_trust <= static_cast<double>(o.safeguard_iterations) / 2000.0);

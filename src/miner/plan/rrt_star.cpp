@@ -257,6 +257,8 @@ void RrtStar::update_best(std::size_t iteration, Clock::time_point t0) {
       g += (path[i] - path[i - 1]).norm();
       beacons_.emplace_back(path[i], g);
     }
+    result_.guided_beacons.clear();
+    for (const auto& beacon : beacons_) result_.guided_beacons.push_back(beacon.first);
   }
 }
 

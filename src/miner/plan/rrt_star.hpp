@@ -142,6 +142,9 @@ struct PlanResult {
   std::size_t region_samples = 0;
   /// guided: samples drawn from a beacon's local subsets (REQ-PLAN-003).
   std::size_t guided_local_samples = 0;
+  /// guided: the beacons of the last improvement, the interior vertices of that solution (never
+  /// x_init or the vertex in the goal region), in path order.
+  std::vector<Eigen::Vector3d> guided_beacons;
   double region_trust = 1.0;
   double steer_step = 0.0;   ///< the eta and r actually used (defaults resolved)
   double goal_radius = 0.0;

@@ -111,6 +111,16 @@ TEST_CASE("Informed and guided RRT* sample like RRT* until the first solution", 
     CHECK(r->cost < rrt.cost);  // focused sampling after the first solution pays off
   }
   CHECK(informed.cost != guided.cost);  // and the two focus differently
+  // Guided's beacons are the last solution's interior vertices, never x_init or x_goal
+  // (held-out audit 7, h7-plan-02 made x_goal a beacon, whose "local subsets" are the whole
+  // informed set and nothing).
+  REQUIRE_FALSE(guided.guided_beacons.empty());
+  for (const V& b : guided.guided_beacons) {
+    INFO(miner::format_point(b));
+    CHECK(b != problem.start);
+    CHECK(b != problem.goal);
+  }
+  CHECK(informed.guided_beacons.empty());
 }
 
 TEST_CASE("Planning is deterministic for a seed and stream and differs across streams", "[REQ-PLAN-007]") {

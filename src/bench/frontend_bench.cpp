@@ -387,6 +387,15 @@ void check_run_record(const JsonField& r, double lower_bound) {
       st.at("nodes").fail(st.at("nodes").value().dump() + " vertices at iteration " + st.at("iteration").value().dump() +
                           ": a tree of " + r.at("planner").string() + " holds its root and at most one vertex per iteration");
   }
+  // The target is reached at or after the first solution: never at an earlier iteration, with
+  // fewer vertices or sooner (ninth campaign recheck of C1: such records were merged).
+  const JsonField first = r.at("first"), target = r.at("target");
+  if (!first.value().is_null() && !target.value().is_null())
+    for (const char* k : {"iteration", "nodes", "time_ms"})  // (OMPL's stages have no iteration count: null)
+      if (target.at(k).value().is_number() && first.at(k).value().is_number() &&
+          target.at(k).number() < first.at(k).number())
+        target.at(k).fail(target.at(k).value().dump() + " is before the first solution's " + first.at(k).value().dump() +
+                          " (the target is reached at or after the first solution)");
 }
 
 RunRecord run_from(const nlohmann::json& j) {
@@ -509,6 +518,12 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
       // A target stage is a solution at or below the campaign's target cost, no better than the
       // run's final cost and no worse than its first (ninth campaign C1: a target of 99 above a
       // 13.74 target and above the run's costs was merged and counted as reached).
+      // A run that ended at or below the target cost reached it: a null target there is a lie.
+      if (r.has("target") && r.at("target").value().is_null() && r.has("cost") && r.at("cost").value().is_number() &&
+          r.at("cost").number() < target * (1.0 - kRoundoff))
+        r.at("target").fail("null, but the run's cost " + r.at("cost").value().dump() +
+                            " is below the campaign's target_cost " + root.at("target_cost").value().dump() +
+                            ": the target was reached");
       if (r.has("target") && r.at("target").value().is_object() && r.at("target").has("cost")) {
         const JsonField t = r.at("target").at("cost");
         const double reached = t.number();

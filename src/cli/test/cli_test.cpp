@@ -1453,6 +1453,24 @@ TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[RE
     // A target stage above the campaign's target cost (ninth campaign C1: merged, counted reached).
     doctor([](miner::Json& d) { d["run_records"][0]["target"] = {{"cost", 1e6}, {"iteration", 1}}; },
            "target.cost: 1000000.0 is above the campaign's target_cost");
+    // A reached target not recorded, or recorded before the first solution (the recheck of C1).
+    doctor([](miner::Json& d) {
+             for (auto& rec : d["run_records"])
+               if (rec["solved"].get<bool>()) {
+                 rec["cost"] = d["target_cost"].get<double>() * 0.999;
+                 rec["target"] = nullptr;
+                 break;
+               }
+           },
+           "is below the campaign's target_cost");
+    doctor([](miner::Json& d) {
+             for (auto& rec : d["run_records"])
+               if (!rec["target"].is_null() && !rec["first"].is_null() && rec["first"]["nodes"].get<std::uint64_t>() > 1) {
+                 rec["target"]["nodes"] = rec["first"]["nodes"].get<std::uint64_t>() - 1;
+                 break;
+               }
+           },
+           "is before the first solution's");
     // Impossible values (issue 20, second audit): a cost below the straight line, above the run's
     // own first solution, more iterations than the budget; the top level is strict too, and a
     // changed setting is named with both values.

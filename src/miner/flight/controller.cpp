@@ -49,6 +49,9 @@ ControllerParams controller_params_from_json(const JsonField& f) {
   if (f.has("yaw_gain")) {
     c.yaw_gain = f.at("yaw_gain").number_in(0.0, kMaxGain, "1/s");
     if (!(c.yaw_gain > 0.0)) f.at("yaw_gain").fail("must be positive");
+    // Read by the rate mode only (ninth campaign recheck of C5: flown without effect).
+    if (c.yaw_mode != ControllerParams::YawMode::kRate)
+      f.at("yaw_gain").fail("unused: yaw_mode is \"angle\" (the default); yaw_gain applies to \"rate\" only");
   }
   return c;
 }

@@ -126,6 +126,8 @@ PoseParams pose_params_from_json(const JsonField& f) {
   p.dropout_mean_s = f.number_in_or("dropout_mean_s", 0.0, 0.0, 100.0, "s");
   if (p.dropout_rate_hz > 0.0 && !(p.dropout_mean_s > 0.0))
     f.at("dropout_rate_hz").fail("needs a positive dropout_mean_s (how long a loss lasts)");
+  if (f.has("dropout_mean_s") && !(p.dropout_rate_hz > 0.0))
+    f.at("dropout_mean_s").fail("unused: no tracking loss starts without a positive dropout_rate_hz");
   if (p.delay_s + p.delay_jitter_s > 1.0) f.at("delay_jitter_s").fail("delay_s + delay_jitter_s must be at most 1 s");
   if (!(p.position_sigma > 0.0) || !(p.attitude_sigma > 0.0))
     f.fail("position_sigma and attitude_sigma must be positive (the EKF divides by them)");

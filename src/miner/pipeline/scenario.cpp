@@ -28,7 +28,10 @@ namespace {
 std::string resolve(const std::string& base_dir, const std::string& path) {
   const std::filesystem::path p(path);
   if (p.is_absolute() || base_dir.empty()) return path;
-  return (std::filesystem::path(base_dir) / p).lexically_normal().string();
+  // Not lexically normalised: the system resolves "..", so a path through a folder that is not
+  // there (or through a file) is refused, as a shell would (ninth campaign recheck of P16:
+  // "nodir/../../maps/indoor-1.json" loaded the map).
+  return (std::filesystem::path(base_dir) / p).string();
 }
 
 /// A rate that must be an integer fraction of the N3 loop rate; returns the ratio.

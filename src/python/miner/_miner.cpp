@@ -85,8 +85,23 @@ double number_in(py::handle o, const std::string& field, double lo, double hi, c
   return v;
 }
 
-/// An integer in [lo, hi], checked on Python's own (unbounded) integer before any C++ cast.
+/// A float holding a whole number (8.0, numpy's float64(8)), read as that integer.
+bool is_whole_float(py::handle o) {
+  if (is_bool(o) || !(PyFloat_Check(o.ptr()) || py::isinstance(o, numpy().attr("floating")))) return false;
+  const double v = PyFloat_AsDouble(o.ptr());
+  return std::isfinite(v) && std::floor(v) == v && std::fabs(v) < 9007199254740992.0;  // 2^53: exact
+}
+
+/// An integer in [lo, hi], checked on Python's own (unbounded) integer before any C++ cast; a
+/// whole float (dims computed with numpy) is that integer, a fractional one is refused.
 long long integer_in(py::handle o, const std::string& field, long long lo, long long hi) {
+  if (is_whole_float(o)) {
+    const double v = PyFloat_AsDouble(o.ptr());
+    if (v < static_cast<double>(lo) || v > static_cast<double>(hi))
+      throw miner::Error(field + ": must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                         "], got " + miner::short_number(v));
+    return static_cast<long long>(v);
+  }
   if (!is_integer(o))
     throw miner::Error(field + ": expected an integer, got " + (o.is_none() ? std::string("None") : type_name(o)) +
                        (PyFloat_Check(o.ptr()) ? " " + std::string(py::str(o)) : std::string()));
@@ -184,6 +199,7 @@ std::string text_of(py::handle o, const std::string& field) {
 
 template <class T>
 const T& object_of(py::handle o, const std::string& field, const char* python_name) {
+  if (o.is_none()) throw miner::Error(field + ": expected a miner." + python_name + ", got None");
   try {
     return o.cast<const T&>();
   } catch (const py::cast_error&) {

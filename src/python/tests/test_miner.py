@@ -214,3 +214,17 @@ def test_a_reference_flies_only_in_its_own_scenario(tmp_path):
     for base_dir in (str(tmp_path / "nodir"), str(SOURCE / "README.md")):  # P16
         with pytest.raises(miner.Error, match="base_dir"):
             miner.Scenario.from_json(json.dumps(doc), base_dir=base_dir)
+
+
+def test_none_for_an_object_and_whole_floats_for_integers():
+    m = miner.Map.from_json(WALL)
+    with pytest.raises(miner.Error, match="map: expected a miner.Map, got None"):  # recheck of P15
+        miner.plan(None, planner="rrtstar")
+    with pytest.raises(miner.Error, match="scenario: expected a miner.Scenario, got None"):
+        miner.build_reference(None)
+    with pytest.raises(miner.Error, match="reference: expected a miner.Reference, got None"):
+        miner.fly(miner.Scenario.default(), None)
+    # A whole float is that integer (dims from numpy arithmetic); a fractional one is refused.
+    assert list(miner.astar_region(m, dims=np.array([8.0, 8.0, 4.0])).dims) == [8, 8, 4]
+    with pytest.raises(miner.Error, match=r"dims\[0\]"):
+        miner.astar_region(m, dims=[8.5, 8, 4])

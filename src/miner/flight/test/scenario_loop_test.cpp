@@ -254,6 +254,19 @@ TEST_CASE("Bad scenarios are refused before flight with the fault named", "[REQ-
   expect_scenario_error(doc, "yaw.min_speed_m_s: unused: yaw.mode is \"fixed\"");
   doc["yaw"] = {{"min_speed_m_s", 1}};  // fixed is the default mode
   expect_scenario_error(doc, "yaw.min_speed_m_s: unused");
+  doc = default_doc();  // the recheck: two more keys their mode never reads
+  doc["controller"]["yaw_gain"] = 2.0;
+  expect_scenario_error(doc, "controller.yaw_gain: unused: yaw_mode is \"angle\"");
+  doc["controller"]["yaw_mode"] = "rate";
+  CHECK_NOTHROW(pipeline::scenario_from_json(doc, "s.json", kScenarios));
+  doc = default_doc();
+  doc["pose"]["dropout_mean_s"] = 0.5;
+  expect_scenario_error(doc, "pose.dropout_mean_s: unused: no tracking loss starts");
+  // A relative path resolves through the system, not lexically (the recheck of P16): a folder
+  // that is not there is not skipped by "..".
+  doc = default_doc();
+  doc["map"] = "nodir/../../maps/indoor-1.json";
+  expect_scenario_error(doc, "nodir/../../maps/indoor-1.json");
   doc = default_doc();
   doc["vehicle"] = flight::to_json(flight::VehicleParams{});
   doc["vehicle"]["mass_kgg"] = 2;
@@ -322,6 +335,8 @@ miner::Json with_value(const RangeRow& row, double v) {
   if (row.field == "pose.dropout_rate_hz") doc["pose"]["dropout_mean_s"] = 1.0;
   if (row.field == "n3.latency_s") doc["n3"]["timeout_s"] = 10.0;
   if (row.field == "yaw.min_speed_m_s") doc["yaw"]["mode"] = "velocity";
+  if (row.field == "controller.yaw_gain") doc["controller"]["yaw_mode"] = "rate";
+  if (row.field == "pose.dropout_mean_s") doc["pose"]["dropout_rate_hz"] = 1.0;
   if (row.field == "controller.max_speed_m_s") doc["trajectory"]["v_max"] = 0.01;
   miner::Json* at = &doc;
   std::size_t start = 0;

@@ -50,16 +50,7 @@ void require_json_file_size(const std::string& path) {
 Json read_json_file(const std::string& path) {
   require_path_without_nul(path, "file");
   require_json_file_size(path);
-  const std::string bytes = read_file_bytes(path);
-  // The binary and text formats MINER reads elsewhere are named by their first bytes, not
-  // reported as malformed JSON (issue 20, ninth campaign C7: an OctoMap given as a region,
-  // problem or scenario got "malformed JSON at byte 140: a NUL byte").
-  const auto starts_with = [&](const std::string& magic) { return bytes.compare(0, magic.size(), magic) == 0; };
-  if (starts_with("# Octomap OcTree"))
-    throw Error(path + ": is an OctoMap file (voxels), not a JSON document: give it where a map is read (--map)");
-  if (starts_with("ply\n") || starts_with("ply\r\n") || starts_with("# .PCD"))
-    throw Error(path + ": is a point cloud (PLY or PCD), not a JSON document: `miner map import --cloud` reads it");
-  return parse_json(bytes, path);
+  return parse_json(read_file_bytes(path), path);
 }
 
 std::string json_error_text(const std::exception& e) {
@@ -135,6 +126,15 @@ Json parse_json(const std::string& text, const std::string& origin) {
   // Nesting deeper than any MINER document needs is refused before parsing: the JSON library
   // frees and prints nested values recursively, so 10^6 brackets would overflow the stack.
   constexpr int kMaxJsonDepth = 256;
+  // The binary and text formats MINER reads elsewhere are named by their first bytes, not
+  // reported as malformed JSON (issue 20, ninth campaign C7: an OctoMap given as a region,
+  // problem or scenario, from a file or as Python text, got "malformed JSON ... a NUL byte").
+  const auto starts_with = [&](const std::string& magic) { return text.compare(0, magic.size(), magic) == 0; };
+  if (starts_with("# Octomap OcTree"))
+    throw Error(origin + ": is an OctoMap file (voxels), not a JSON document: give it where a map is read "
+                         "(`--map`, miner.Map.load)");
+  if (starts_with("ply\n") || starts_with("ply\r\n") || starts_with("# .PCD"))
+    throw Error(origin + ": is a point cloud (PLY or PCD), not a JSON document: `miner map import --cloud` reads it");
   int depth = 0;
   bool in_string = false;
   // The first number the JSON library would misread, kept until the parser has said whether the

@@ -25,7 +25,7 @@ struct RepairOptions {
   int max_iterations = 10;   ///< re-solves after the first
   /// Collision sampling: consecutive samples at most this far apart (m); the chords
   /// between samples are checked exactly. 0 means half the map resolution, and at most the
-  /// robot radius (the curve then keeps at least half the radius between samples).
+  /// robot radius (the curve then keeps at least three quarters of it between samples).
   double sample_step = 0.0;
   /// Durations by optimise_allocation (REQ-TRAJ-011; its limits are `limits`) instead of the
   /// trapezoid, in every round, so the optimised curve is the one repaired.

@@ -458,7 +458,7 @@ PYBIND11_MODULE(_miner, m) {
           for (std::size_t i = 0; i < T.size(); ++i)
             if (!std::isfinite(T[i]) || !(T[i] > 0.0))
               throw miner::Error("points[" + std::to_string(i) + "] and points[" + std::to_string(i + 1) + "]: a segment of " +
-                                 miner::short_number((p.row(static_cast<Eigen::Index>(i) + 1) - p.row(static_cast<Eigen::Index>(i))).norm()) +
+                                 miner::short_number((p.row(static_cast<Eigen::Index>(i) + 1) - p.row(static_cast<Eigen::Index>(i))).stableNorm()) +
                                  " m has no trapezoidal duration (" + miner::short_number(T[i]) +
                                  " s at v_max, a_max): too short or too long for double precision");
         }

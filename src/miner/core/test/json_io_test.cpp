@@ -89,11 +89,14 @@ TEST_CASE("A file of another format given as JSON is named by its format", "[REQ
     std::ofstream(dir + "/" + name, std::ios::binary) << bytes;
     return dir + "/" + name;
   };
-  CHECK_THROWS_WITH(miner::read_json_file(file("r.bt", std::string("# Octomap OcTree binary file\nid OcTree\n\0\1", 43))),
+  static const char kOctoMap[] = "# Octomap OcTree binary file\nid OcTree\n\0\1";
+  CHECK_THROWS_WITH(miner::read_json_file(file("r.bt", std::string(kOctoMap, sizeof kOctoMap - 1))),
                     Contains("r.bt: is an OctoMap file (voxels), not a JSON document"));
   CHECK_THROWS_WITH(miner::read_json_file(file("c.json", "ply\nformat ascii 1.0\n")), Contains("c.json: is a point cloud"));
   CHECK_THROWS_WITH(miner::read_json_file(file("d.json", "# .PCD v0.7\n")), Contains("is a point cloud"));
   CHECK(miner::read_json_file(file("ok.json", "{\"ply\": 1}"))["ply"] == 1);
+  // Text given directly (Python's from_json) is named the same way.
+  CHECK_THROWS_WITH(miner::parse_json("# Octomap OcTree binary file\n", "<string>"), Contains("<string>: is an OctoMap file"));
   std::filesystem::remove_all(dir);
 }
 

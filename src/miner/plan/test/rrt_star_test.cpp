@@ -249,8 +249,8 @@ TEST_CASE("Invalid planner options and a missing or mismatched region are refuse
   CHECK_THROWS_WITH(miner::plan::plan(no_map, PlannerOptions{}), Contains("no map"));
 }
 
-TEST_CASE("Each planner option's range holds at its ends: a closed end kept, a step past it refused", "[REQ-PLAN-008]") {
-  // The ranges REQ-PLAN-008 names: goal_bias, mu_1, mu_2 in [0, 1); guided_local_fraction in
+TEST_CASE("Each planner option's range holds at its ends: a closed end kept, a step past it refused", "[REQ-PLAN-007]") {
+  // The ranges REQ-PLAN-007 names: goal_bias, mu_1, mu_2 in [0, 1); guided_local_fraction in
   // [0, 1]; rewire_factor >= 1; steer_step 0 (the default) or >= a tenth of the resolution;
   // safeguard_iterations >= 1; max_iterations <= kMaxIterations.
   const auto map = miner::testing::wall_with_door_map();

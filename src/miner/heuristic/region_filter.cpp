@@ -8,8 +8,6 @@
 #include "miner/core/error.hpp"
 #include "miner/core/rng.hpp"
 #include "miner/core/stopwatch.hpp"
-#include "miner/core/text.hpp"
-#include "miner/core/units.hpp"
 #include "miner/heuristic/grid.hpp"
 #include "miner/heuristic/sgan.hpp"
 #include "miner/heuristic/strict_bridge.hpp"
@@ -237,9 +235,7 @@ HeuristicQuery query_region(const Sgan& sgan, const world::Map& map, const Eigen
                             bool strict) {
   // The query is one a planner would take (issue 20, ninth campaign P2, P3: a NaN start crashed
   // the cell lookup, a start inside an obstacle or outside the map got a region).
-  require_finite(robot_radius, "robot_radius");
-  if (!(robot_radius >= 0.0 && robot_radius <= kMaxRobotRadius))
-    throw Error("robot_radius: " + short_number(robot_radius) + " m is outside [0, " + short_number(kMaxRobotRadius) + "] m");
+  world::check_robot_radius(robot_radius, "robot_radius");
   map.require_free(start, robot_radius, "start");
   map.require_free(goal, robot_radius, "goal");
   const SganArchitecture& arch = sgan.architecture();

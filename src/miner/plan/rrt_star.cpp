@@ -9,8 +9,6 @@
 #include "miner/core/error.hpp"
 #include "miner/core/rng.hpp"
 #include "miner/core/stopwatch.hpp"
-#include "miner/core/text.hpp"
-#include "miner/core/units.hpp"
 #include "miner/plan/heuristic_region.hpp"
 #include "miner/plan/informed_set.hpp"
 #include "miner/plan/kd_tree.hpp"
@@ -407,12 +405,9 @@ PlanningProblem PlanningProblem::make(const world::Map& map, const Eigen::Vector
                                       const Eigen::Vector3d& goal, double robot_radius) {
   require_finite(start, "start");
   require_finite(goal, "goal");
-  require_finite(robot_radius, "robot_radius");
   // The map format's range (REQ-WORLD-002): a radius above it is no quadrotor (issue 20,
   // ninth campaign P11: Python's plan took 10.5 m, which the CLI and every file refuse).
-  if (robot_radius < 0.0 || robot_radius > kMaxRobotRadius)
-    throw Error("robot_radius: " + short_number(robot_radius) + " m is outside [0, " + short_number(kMaxRobotRadius) +
-                "] m");
+  world::check_robot_radius(robot_radius, "robot_radius");
   map.require_free(start, robot_radius, "start");
   map.require_free(goal, robot_radius, "goal");
   PlanningProblem p;

@@ -58,6 +58,12 @@ void check_resolution(double resolution, const std::string& field) {
   }
 }
 
+void check_robot_radius(double radius, const std::string& field) {
+  require_finite(radius, field);
+  if (radius < 0.0 || radius > kMaxRobotRadius)
+    throw Error(field + ": " + short_number(radius) + " m is outside [0, " + short_number(kMaxRobotRadius) + "] m");
+}
+
 Eigen::Vector3i grid_dims(const Box& bounds, double resolution) {
   // Snaps in the cell count: a face within this many cells of a whole number is on it.
   constexpr double kGridSnapTolerance = 1e-9;
@@ -106,12 +112,7 @@ Map::Map(Box bounds, double resolution, std::vector<Box> obstacles, std::optiona
   if (query_) {
     require_finite(query_->start, "query.start");
     require_finite(query_->goal, "query.goal");
-    require_finite(query_->robot_radius, "query.robot_radius");
-    if (query_->robot_radius < 0.0 || query_->robot_radius > kMaxRobotRadius) {
-      std::ostringstream os;
-      os << "query.robot_radius: " << query_->robot_radius << " m is outside [0, " << kMaxRobotRadius << "] m";
-      throw Error(os.str());
-    }
+    check_robot_radius(query_->robot_radius, "query.robot_radius");
     for (const auto& [p, name] : {std::pair{&query_->start, "query.start"}, std::pair{&query_->goal, "query.goal"}})
       if (!in_bounds(*p)) throw Error(std::string(name) + ": " + format_point(*p) + " lies outside the map bounds");
   }

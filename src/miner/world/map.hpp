@@ -57,6 +57,9 @@ using miner::kMaxRobotRadius;
 /// Throws miner::Error "<field>: ..." unless `resolution` is finite and in [kMinResolution,
 /// kMaxResolution].
 void check_resolution(double resolution, const std::string& field);
+/// Throws miner::Error naming `field` unless the robot radius is finite and in
+/// [0, kMaxRobotRadius] m: the range every reader and every query shares (REQ-WORLD-002).
+void check_robot_radius(double radius, const std::string& field);
 
 /// A start/goal pair stored with a map (optional extension of miner-map-v1), so a map
 /// generated for a benchmark carries the query it was checked against.

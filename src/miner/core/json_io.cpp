@@ -384,6 +384,14 @@ void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& 
   const auto discard = [&] {
     for (const auto& [tmp, target] : moves) fs::remove(tmp, ec);
   };
+  // An empty name and one file given twice are refused before anything is written (tenth
+  // campaign L18: both failed at the rename with "cannot replace file: Success").
+  std::set<std::string> distinct;
+  for (const auto& file : files) {
+    if (file.first.empty()) throw Error("output file: empty name");
+    if (!distinct.insert(fs::path(file.first).lexically_normal().string()).second)
+      throw Error(file.first + ": given twice in one atomic write");
+  }
   for (const auto& [path, content] : files) {
     require_path_without_nul(path, "output file");
     const fs::path target(path);
@@ -468,6 +476,13 @@ void write_folder_atomic(const std::string& path, const std::vector<std::pair<st
   std::error_code ec;
   fs::create_directories(parent, ec);
   if (ec || !fs::is_directory(parent)) throw Error(path + ": cannot create parent folder " + parent.string());
+  // Every file is a plain name inside the folder (tenth campaign L20: "../x" and absolute names
+  // were written outside it, past the replace-only-earlier-output rule).
+  for (const auto& f : files) {
+    const fs::path name(f.first);
+    if (f.first.empty() || name.has_parent_path() || name.is_absolute() || f.first == "." || f.first == "..")
+      throw Error(path + ": file name \"" + f.first + "\" is not a plain name inside the folder");
+  }
   if (fs::exists(target, ec) && !fs::is_directory(target, ec))
     throw Error(path + ": exists and is not a folder; refusing to replace it");
   // Only an earlier output of the same kind is replaced (issue 20: `--out victim` deleted a

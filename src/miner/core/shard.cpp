@@ -27,6 +27,14 @@ void require_shard(int index, int count) {
 void require_complete_parts(const std::vector<Json>& tags, const std::vector<std::string>& names,
                             const std::string& job) {
   if (tags.empty()) throw Error(job + ": no parts given");
+  // One name per tag, integer fields (tenth campaign L19: fewer names read past the end; L18: a
+  // string "count" escaped as the JSON library's type_error).
+  if (names.size() != tags.size())
+    throw Error(job + ": " + std::to_string(tags.size()) + " part tags but " + std::to_string(names.size()) + " names");
+  for (std::size_t p = 0; p < tags.size(); ++p)
+    for (const char* key : {"index", "count"})
+      if (!tags[p].is_object() || !tags[p].contains(key) || !tags[p].at(key).is_number_integer())
+        throw Error(names[p] + ": its part tag needs an integer \"" + key + "\"");
   const int n = tags.front().at("count").get<int>();
   if (static_cast<int>(tags.size()) != n)
     throw Error(job + " has " + std::to_string(n) + " parts, got " + std::to_string(tags.size()));

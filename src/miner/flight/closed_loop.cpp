@@ -11,6 +11,7 @@
 
 #include "miner/core/error.hpp"
 #include "miner/core/rng.hpp"
+#include "miner/core/text.hpp"
 #include "miner/flight/controller.hpp"
 #include "miner/flight/ekf.hpp"
 #include "miner/flight/flatness.hpp"
@@ -97,6 +98,12 @@ FlightResult fly(const FlightSetup& s, const ReferenceTrajectory& reference, con
   const double control_dt = control_every * dt;
   const auto& trajectory = reference.trajectory;
   const double t_traj = trajectory.total_duration();
+  if (!(std::isfinite(s.hover_after_s) && s.hover_after_s >= 0.0 && t_traj + s.hover_after_s <= kMaxFlightSeconds))
+    throw Error("flight: the reference (" + short_number(t_traj) + " s) and hover_after_s (" + short_number(s.hover_after_s) +
+                " s) must add up to at most " + short_number(kMaxFlightSeconds) + " s of simulated flight");
+  if (!(s.n3.rate_hz > 0.0 && s.controller.rate_hz > 0.0 && s.pose.rate_hz > 0.0) ||
+      !std::isfinite(s.n3.rate_hz + s.controller.rate_hz + s.pose.rate_hz))
+    throw Error("flight: the N3, controller and pose rates must be positive finite rates in Hz");
   const long total_ticks = static_cast<long>(std::ceil((t_traj + s.hover_after_s) / dt));
 
   Rng imu_rng(s.seed, streams::kImuNoise), pose_rng(s.seed, streams::kPoseNoise),

@@ -127,6 +127,11 @@ struct FlightResult {
   Json summary;
 };
 
+/// Longest simulated flight (reference + hover, s): bounds the work and the log of one
+/// flight (~4 x 10^5 N3 ticks, a ~100 MB log at most). fly() refuses more, whoever calls it
+/// (REQ-FLIGHT-007; tenth campaign L12b: a library caller's 10^7 s hover ran unbounded).
+inline constexpr double kMaxFlightSeconds = 1000.0;
+
 /// Flies `reference` from setup.start in closed loop until it ends plus the hover; the same
 /// setup (seed included) gives the same bytes.
 FlightResult fly(const FlightSetup& setup, const ReferenceTrajectory& reference, const FlyOptions& options = {});

@@ -34,10 +34,19 @@ void for_neighbours(const Eigen::Vector3i& dims, const Eigen::Vector3i& c, F&& f
 
 /// Throws unless R, E and (when given) P each hold one value per cell of the grid.
 void require_one_grid(const std::vector<float>& p, const std::vector<std::uint8_t>& env,
-                      const std::vector<std::uint8_t>& passability, const Eigen::Vector3i& dims) {
-  const auto n = static_cast<std::size_t>(dims.prod());
+                      const std::vector<std::uint8_t>& passability, const Eigen::Vector3i& dims,
+                      const Eigen::Vector3i& start_cell, const Eigen::Vector3i& goal_cell) {
+  if ((dims.array() < 1).any()) throw Error("region filter: every grid dimension must be at least 1");
+  const auto n = static_cast<std::size_t>(dims.x()) * static_cast<std::size_t>(dims.y()) * static_cast<std::size_t>(dims.z());
   if (p.size() != n || env.size() != n || (!passability.empty() && passability.size() != n))
     throw Error("region filter: grids of different sizes");
+  // Tenth campaign L4: a cell outside the grid corrupted the heap (filter_region) or read
+  // outside it (widest_threshold).
+  for (const auto& [c, name] : {std::pair{&start_cell, "start cell"}, std::pair{&goal_cell, "goal cell"}})
+    if ((c->array() < 0).any() || (c->array() >= dims.array()).any())
+      throw Error(std::string("region filter: the ") + name + " (" + std::to_string(c->x()) + ", " +
+                  std::to_string(c->y()) + ", " + std::to_string(c->z()) + ") lies outside the " +
+                  std::to_string(dims.x()) + " x " + std::to_string(dims.y()) + " x " + std::to_string(dims.z()) + " grid");
 }
 
 /// A chain's step from cell u to its neighbour v: v not solid and, with channel P, every axis
@@ -80,7 +89,7 @@ bool chain_at(const std::vector<float>& p, const std::vector<std::uint8_t>& env,
 std::optional<float> widest_threshold(const std::vector<float>& p, const std::vector<std::uint8_t>& env,
                                       const Eigen::Vector3i& dims, const Eigen::Vector3i& start_cell,
                                       const Eigen::Vector3i& goal_cell, const std::vector<std::uint8_t>& passability) {
-  require_one_grid(p, env, passability, dims);
+  require_one_grid(p, env, passability, dims, start_cell, goal_cell);
   const auto n = static_cast<std::size_t>(dims.prod());
   const std::size_t is = cell_index(dims, start_cell.x(), start_cell.y(), start_cell.z());
   const std::size_t ig = cell_index(dims, goal_cell.x(), goal_cell.y(), goal_cell.z());
@@ -117,7 +126,7 @@ double region_threshold(const std::vector<float>& p, const std::vector<std::uint
                         const Eigen::Vector3i& start_cell, const Eigen::Vector3i& goal_cell, double threshold,
                         bool widest, const std::vector<std::uint8_t>& passability) {
   if (!widest) return threshold;
-  require_one_grid(p, env, passability, dims);
+  require_one_grid(p, env, passability, dims, start_cell, goal_cell);
   const std::size_t is = cell_index(dims, start_cell.x(), start_cell.y(), start_cell.z());
   const std::size_t ig = cell_index(dims, goal_cell.x(), goal_cell.y(), goal_cell.z());
   // Most queries: the fixed threshold's cells already hold a chain (a search of those alone).
@@ -136,7 +145,8 @@ double region_threshold(const std::vector<float>& p, const std::vector<std::uint
 FilteredRegion filter_region(const std::vector<float>& p, const std::vector<std::uint8_t>& env,
                              const Eigen::Vector3i& dims, const Eigen::Vector3i& start_cell,
                              const Eigen::Vector3i& goal_cell, double threshold) {
-  require_one_grid(p, env, {}, dims);
+  require_one_grid(p, env, {}, dims, start_cell, goal_cell);
+  if (std::isnan(threshold)) throw Error("region filter: threshold must be a number, got nan");
   const auto n = static_cast<std::size_t>(dims.prod());
   FilteredRegion out;
   FilterReport& r = out.report;

@@ -624,6 +624,11 @@ void Sgan::Impl::shift_sum_plane(int z, const std::array<const float*, 3>& plane
 }
 
 Sgan::Sgan(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+
+Sgan::Impl& Sgan::live() const {
+  if (!impl_) throw Error("Sgan: used after being moved from");  // tenth campaign L21
+  return *impl_;
+}
 Sgan::~Sgan() = default;
 Sgan::Sgan(Sgan&&) noexcept = default;
 Sgan& Sgan::operator=(Sgan&&) noexcept = default;
@@ -651,15 +656,15 @@ Sgan Sgan::builtin() {
                     "builtin fixtures/sgan/sgan.bin");
 }
 
-const SganArchitecture& Sgan::architecture() const { return impl_->arch; }
-const Json& Sgan::meta() const { return impl_->meta; }
-const std::string& Sgan::path() const { return impl_->path; }
-bool Sgan::own_kernels() const { return impl_->own_kernels; }
+const SganArchitecture& Sgan::architecture() const { return live().arch; }
+const Json& Sgan::meta() const { return live().meta; }
+const std::string& Sgan::path() const { return live().path; }
+bool Sgan::own_kernels() const { return live().own_kernels; }
 
 std::vector<float> Sgan::forward(const std::vector<float>& env, const std::vector<float>& state,
                                  const std::vector<float>& noise, const std::vector<float>& scale,
                                  const std::vector<float>& passability) const {
-  Impl& g = *impl_;
+  Impl& g = live();
   const std::size_t n = g.cond1.voxels();
   if (env.size() != n || state.size() != n || noise.size() != n)
     throw Error("sgan: inputs must have " + std::to_string(n) + " cells each (the weights' grid)");
@@ -776,7 +781,7 @@ std::vector<float> checked_probabilities(const std::string& path, std::vector<fl
 std::vector<float> Sgan::predict(const std::vector<std::uint8_t>& environment, const std::vector<std::uint8_t>& state,
                                  const std::vector<std::uint8_t>& passability, const world::Box& bounds,
                                  double robot_radius, Rng& rng) const {
-  Impl& g = *impl_;
+  Impl& g = live();
   const std::size_t n = g.cond1.voxels();
   if (environment.size() != n || state.size() != n)
     throw Error("sgan: E and S must have " + std::to_string(n) + " cells each (the weights' grid)");

@@ -109,6 +109,8 @@ class Sgan {
   struct Impl;
   explicit Sgan(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
+  /// *impl_, or miner::Error when the network was moved from.
+  Impl& live() const;
 };
 
 /// |sigma| is clamped here: the shipped network saw sigma in [-0.27, 1.14] (cells of 1/2 to 23

@@ -24,15 +24,6 @@ std::string shape_text(const std::vector<int>& s) {
 
 }  // namespace
 
-std::uint64_t fnv1a64(const std::uint8_t* data, std::size_t size) {
-  std::uint64_t h = 0xcbf29ce484222325ULL;
-  for (std::size_t i = 0; i < size; ++i) {
-    h ^= data[i];
-    h *= 0x100000001b3ULL;
-  }
-  return h;
-}
-
 const Tensor& TensorFile::at(const std::string& name, const std::vector<int>& shape) const {
   const auto it = tensors.find(name);
   if (it == tensors.end()) throw Error(path + ": no tensor '" + name + "'");

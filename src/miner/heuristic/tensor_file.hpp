@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "miner/core/json_io.hpp"
+#include "miner/core/sha256.hpp"
 
 namespace miner::heuristic {
 
@@ -37,8 +38,8 @@ struct TensorFile {
   const Tensor& at(const std::string& name, const std::vector<int>& shape) const;
 };
 
-/// FNV-1a, 64 bit.
-std::uint64_t fnv1a64(const std::uint8_t* data, std::size_t size);
+/// FNV-1a, 64 bit (miner::fnv1a64).
+using miner::fnv1a64;
 
 /// Reads and checks `path`; `kind` is the expected "kind" (e.g. "sgan-weights").
 /// Throws miner::Error naming the file and what is wrong with it.

@@ -487,7 +487,10 @@ ReferencePlan build_reference(const Scenario& s) {
       throw Error(s.origin + ": trajectory file: maximum speed " + std::to_string(v) + " m/s and acceleration " +
                   std::to_string(a) + " m/s^2 exceed the limits v_max " + std::to_string(s.limits.v_max) +
                   ", a_max " + std::to_string(s.limits.a_max));
-    const auto colliding = traj::colliding_segments(r.trajectory, *s.map, radius, 0.0);
+    // Chords collision_sample_step apart (a step of 0 here once cast infinity to int and
+    // checked two chords per segment; tenth campaign, found beside L10).
+    const auto colliding =
+        traj::colliding_segments(r.trajectory, *s.map, radius, traj::collision_sample_step(*s.map, radius));
     if (!colliding.empty())
       throw Error(s.origin + ": trajectory file: segment " + std::to_string(colliding.front()) +
                   " comes within the vehicle radius + planning margin (" + std::to_string(radius) +
@@ -601,7 +604,8 @@ void check_reference(const Scenario& s, const ReferencePlan& reference) {
                 short_number(a) + " m/s^2 exceed the scenario's trajectory.v_max " + short_number(s.limits.v_max) +
                 " m/s, a_max " + short_number(s.limits.a_max) + " m/s^2: build the reference from this scenario");
   check_envelope(s, t);
-  const auto colliding = traj::colliding_segments(t, *s.map, s.vehicle.radius, 0.0);
+  const auto colliding =
+      traj::colliding_segments(t, *s.map, s.vehicle.radius, traj::collision_sample_step(*s.map, s.vehicle.radius));
   if (!colliding.empty())
     throw Error(s.origin + ": the reference's segment " + std::to_string(colliding.front()) +
                 " comes within the vehicle radius " + short_number(s.vehicle.radius) +

@@ -43,7 +43,7 @@ inline constexpr const char* kScenarioFormat = "miner-scenario-v1";
 /// `miner fly` (~4 x 10^5 N3 ticks, a ~100 MB log at most). A scenario asking for more (a
 /// long hover, or limits so low that the reference lasts hours) is refused before any
 /// sampling or simulation (REQ-FLIGHT-007).
-inline constexpr double kMaxFlightSeconds = 1000.0;
+using flight::kMaxFlightSeconds;
 /// Ranges of a scenario's values (REQ-FLIGHT-007; issue 20: a goal tolerance of 1e9 m made any
 /// flight "reach" its goal, v_max 1e308 was accepted). Speed and acceleration limits: from
 /// 1 cm/s (below it the reference outlasts kMaxFlightSeconds on any map) to what a racing

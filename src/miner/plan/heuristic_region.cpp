@@ -130,6 +130,9 @@ HeuristicRegion HeuristicRegion::from_path(const world::Box& bounds, const Eigen
   if (dilation < 0 || dilation > kMaxDilation)
     throw Error("region dilation: must be in [0, " + std::to_string(kMaxDilation) + "], got " + std::to_string(dilation));
   if (path.empty()) throw Error("region from path: the path has no points");
+  // Every point before any is used (tenth campaign L5: a NaN second point was cast to a cell
+  // while the first was being walked).
+  for (std::size_t s = 0; s < path.size(); ++s) require_finite(path[s], "region path point " + std::to_string(s));
   HeuristicRegion region(bounds, dims,
                          std::vector<double>(cell_count(dims), 0.0),
                          1.0, std::move(source));

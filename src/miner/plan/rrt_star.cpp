@@ -9,6 +9,7 @@
 #include "miner/core/error.hpp"
 #include "miner/core/rng.hpp"
 #include "miner/core/stopwatch.hpp"
+#include "miner/core/text.hpp"
 #include "miner/plan/heuristic_region.hpp"
 #include "miner/plan/informed_set.hpp"
 #include "miner/plan/kd_tree.hpp"
@@ -401,26 +402,37 @@ std::vector<PlannerKind> all_planners() {
   return {PlannerKind::kRrtStar, PlannerKind::kInformed, PlannerKind::kGuided, PlannerKind::kMiner};
 }
 
-PlanningProblem PlanningProblem::make(const world::Map& map, const Eigen::Vector3d& start,
-                                      const Eigen::Vector3d& goal, double robot_radius) {
-  require_finite(start, "start");
-  require_finite(goal, "goal");
+void validate(const PlanningProblem& p) {
+  if (p.map == nullptr) throw Error("plan: the problem has no map");
+  require_finite(p.start, "start");
+  require_finite(p.goal, "goal");
   // The map format's range (REQ-WORLD-002): a radius above it is no quadrotor (issue 20,
   // ninth campaign P11: Python's plan took 10.5 m, which the CLI and every file refuse).
-  world::check_robot_radius(robot_radius, "robot_radius");
-  map.require_free(start, robot_radius, "start");
-  map.require_free(goal, robot_radius, "goal");
+  world::check_robot_radius(p.robot_radius, "robot_radius");
+  p.map->require_free(p.start, p.robot_radius, "start");
+  p.map->require_free(p.goal, p.robot_radius, "goal");
+  // Lemma 2's radius uses the sampled volume: it must be a volume (tenth campaign L11: 0 and
+  // NaN planned with a rewiring radius of 0 and NaN).
+  if (!(std::isfinite(p.sampled_volume) && p.sampled_volume > 0.0))
+    throw Error("sampled_volume: must be a positive finite volume in m^3, got " + short_number(p.sampled_volume));
+}
+
+PlanningProblem PlanningProblem::make(const world::Map& map, const Eigen::Vector3d& start,
+                                      const Eigen::Vector3d& goal, double robot_radius) {
   PlanningProblem p;
   p.map = &map;
   p.start = start;
   p.goal = goal;
   p.robot_radius = robot_radius;
   p.sampled_volume = map.bounds().volume();
+  validate(p);
   return p;
 }
 
 PlanResult plan(const PlanningProblem& problem, const PlannerOptions& options, const HeuristicRegion* region) {
-  if (problem.map == nullptr) throw Error("plan: the problem has no map");
+  // The problem's fields are public: one filled by hand is checked like make()'s (tenth
+  // campaign L11: a NaN radius "solved" with a vacuous collision check).
+  validate(problem);
   require_probability(options.goal_bias, "goal_bias", true);
   require_probability(options.mu_1, "mu_1", true);
   require_probability(options.mu_2, "mu_2", true);

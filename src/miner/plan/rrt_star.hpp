@@ -117,6 +117,11 @@ struct PlanningProblem {
                               double robot_radius) = delete;
 };
 
+/// The checks of PlanningProblem::make on a problem however it was filled (plan() calls it):
+/// a map, finite ends free at a robot radius in range, a positive finite sampled volume.
+/// Throws miner::Error naming the field.
+void validate(const PlanningProblem& problem);
+
 /// When a stage (first solution, target cost) was reached.
 struct StageRecord {
   std::size_t iteration = 0;  ///< 1-based iteration that reached it

@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "miner/core/error.hpp"
+#include "miner/core/text.hpp"
 
 namespace miner::report {
 
@@ -108,6 +109,11 @@ std::vector<double> nice_ticks(double lo, double hi, int target) {
   if (!(hi > lo) || !std::isfinite(lo) || !std::isfinite(hi) || target < 1)
     throw Error("nice_ticks: needs a finite range lo < hi and target >= 1");
   const double raw = (hi - lo) / target;
+  // Tenth campaign L6: a finite range whose width overflows (-1e308 .. 1e308) or is a denormal
+  // (0 .. 5e-324) gave an infinite or zero step and a crash; such data cannot be drawn.
+  if (!std::isfinite(raw) || !(raw >= 1e-300))
+    throw Error("nice_ticks: the range [" + short_number(lo) + ", " + short_number(hi) +
+                "] is too wide or too narrow for a double's ticks");
   const double mag = std::pow(10.0, std::floor(std::log10(raw)));
   double step = mag;
   for (double m : {1.0, 2.0, 5.0, 10.0})

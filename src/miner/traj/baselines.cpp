@@ -27,6 +27,7 @@ Eigen::MatrixX3d solve_dense_lu(const MincoProblem& p) {
 }
 
 Eigen::MatrixX3d solve_closed_form(const MincoProblem& p) {
+  validate_dense(p);
   const int s = p.order, n = 2 * s, M = static_cast<int>(p.durations.size());
   // A maps coefficients to the end derivatives of every segment (block diagonal).
   Eigen::MatrixXd A = Eigen::MatrixXd::Zero(n * M, n * M);
@@ -69,6 +70,7 @@ Eigen::MatrixX3d solve_closed_form(const MincoProblem& p) {
 }
 
 Eigen::MatrixX3d solve_kkt_qp(const MincoProblem& p) {
+  validate_dense(p);
   const int s = p.order, n = 2 * s, M = static_cast<int>(p.durations.size());
   const int vars = n * M, rows = s + (M - 1) * (1 + s) + s;
   Eigen::MatrixXd Aeq = Eigen::MatrixXd::Zero(rows, vars);

@@ -14,9 +14,12 @@
 #include <Eigen/Core>
 
 #include "miner/traj/minco.hpp"
+#include "miner/traj/optimality_system.hpp"
 
 namespace miner::traj {
 
+/// Each validates its problem (validate_dense: tenth campaign L16, a NaN duration gave NaN
+/// coefficients, order 7 a 56-row answer).
 Eigen::MatrixX3d solve_dense_lu(const MincoProblem& problem);
 Eigen::MatrixX3d solve_closed_form(const MincoProblem& problem);
 Eigen::MatrixX3d solve_kkt_qp(const MincoProblem& problem);

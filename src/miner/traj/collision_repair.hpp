@@ -40,8 +40,15 @@ struct RepairResult {
   std::optional<AllocationResult> allocation;  ///< the last round's, with `optimise`
 };
 
+/// The chord spacing the repair and the pipeline's checks use: min(res / 2, robot radius)
+/// (res / 2 for a point robot), so the curve between two chords keeps >= 3/4 of the radius.
+double collision_sample_step(const world::Map& map, double robot_radius);
+
 /// Index of the first trajectory segment whose sampled chords come within the robot
-/// radius of an obstacle, for every colliding segment (empty when free).
+/// radius of an obstacle, for every colliding segment (empty when free); consecutive samples
+/// at most `sample_step` of arc apart. Throws miner::Error for a radius outside the robot
+/// radius range, a step that is not positive and finite, or one that would need more than
+/// 10^8 samples on a segment.
 std::vector<int> colliding_segments(const PolynomialTrajectory& trajectory, const world::Map& map,
                                     double robot_radius, double sample_step);
 

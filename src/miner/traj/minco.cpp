@@ -475,6 +475,7 @@ std::string row_text(const Eigen::MatrixX3d& m, Eigen::Index r) {
 }  // namespace
 
 void MincoSolver::solve(const MincoProblem& p, PolynomialTrajectory& out) {
+  if (!ws_) throw Error("MincoSolver: used after being moved from");  // tenth campaign L21
   out.set_order(p.order);
   if (p.order == 3) {
     solve_jerk(p, ws_->jerk, out);
@@ -486,6 +487,7 @@ void MincoSolver::solve(const MincoProblem& p, PolynomialTrajectory& out) {
 }
 
 double MincoSolver::cost_and_gradients(const MincoProblem& p, MincoGradients* gradients) const {
+  if (!ws_) throw Error("MincoSolver: used after being moved from");
   const int solved = p.order == 3 ? ws_->jerk.solved : ws_->snap.solved;
   if (solved != static_cast<int>(p.durations.size())) throw Error("MincoSolver: cost_and_gradients needs a solve() first");
   return p.order == 3 ? cost_order<3>(p, ws_->jerk, gradients) : cost_order<4>(p, ws_->snap, gradients);

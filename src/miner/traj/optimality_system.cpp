@@ -2,12 +2,21 @@
 
 #include <cmath>
 
+#include "miner/core/error.hpp"
 #include "miner/traj/polynomial_trajectory.hpp"
 
 namespace miner::traj {
 
 
+void validate_dense(const MincoProblem& p) {
+  validate(p);
+  if (p.durations.size() > static_cast<std::size_t>(kMaxDenseSegments))
+    throw Error("durations: " + std::to_string(p.durations.size()) + " segments, more than the " +
+                std::to_string(kMaxDenseSegments) + " a dense solver takes ((2s M)^2 doubles); MINCO takes any number");
+}
+
 LinearSystem optimality_system(const MincoProblem& p) {
+  validate_dense(p);
   const int s = p.order, n = 2 * s;
   const int M = static_cast<int>(p.durations.size());
   LinearSystem sys{Eigen::MatrixXd::Zero(n * M, n * M), Eigen::MatrixX3d::Zero(n * M, 3)};
@@ -33,6 +42,9 @@ LinearSystem optimality_system(const MincoProblem& p) {
 }
 
 double relative_residual(const LinearSystem& sys, const Eigen::MatrixX3d& c) {
+  if (c.rows() != sys.A.cols())
+    throw Error("relative_residual: " + std::to_string(c.rows()) + " coefficient rows for a system of " +
+                std::to_string(sys.A.cols()) + " unknowns");
   return (sys.A * c - sys.b).norm() / (sys.A.norm() * c.norm() + sys.b.norm());
 }
 

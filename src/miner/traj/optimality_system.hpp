@@ -20,9 +20,18 @@ struct LinearSystem {
   Eigen::MatrixX3d b;
 };
 
+/// The most segments a dense baseline or optimality_system() takes: their matrices hold
+/// (2s M)^2 doubles (500 segments of snap: 128 MB; 5000 asked 12.8 GB and ended in bad_alloc,
+/// issue 20, tenth campaign L16b). MINCO itself takes any M in O(M).
+inline constexpr int kMaxDenseSegments = 500;
+/// validate(problem), then at most kMaxDenseSegments segments; throws miner::Error.
+void validate_dense(const MincoProblem& problem);
+
+/// Validates the problem (validate_dense) and writes the system.
 LinearSystem optimality_system(const MincoProblem& problem);
 
-/// ||A c - b||_F / (||A||_F ||c||_F + ||b||_F): the normwise relative residual.
+/// ||A c - b||_F / (||A||_F ||c||_F + ||b||_F): the normwise relative residual. Throws
+/// miner::Error when c's rows are not the system's unknowns.
 double relative_residual(const LinearSystem& system, const Eigen::MatrixX3d& c);
 
 }  // namespace miner::traj

@@ -5,6 +5,7 @@
 #include <numeric>
 
 #include "miner/core/error.hpp"
+#include "miner/core/text.hpp"
 
 namespace miner::traj {
 
@@ -15,6 +16,9 @@ double falling_factorial(int a, int k) {
 }
 
 Eigen::RowVectorXd monomial_derivative_row(int n, int k, double t) {
+  // Tenth campaign L4: k = -1 wrote before the row (heap corruption), n = -1 asked for 2^64 bytes.
+  if (n < 0 || n > kMaxCoefficientRows) throw Error("monomial_derivative_row: n must be in [0, " + std::to_string(kMaxCoefficientRows) + "], got " + std::to_string(n));
+  if (k < 0) throw Error("monomial_derivative_row: the derivative order k must be >= 0, got " + std::to_string(k));
   Eigen::RowVectorXd r = Eigen::RowVectorXd::Zero(n);
   for (int a = k; a < n; ++a) r(a) = falling_factorial(a, k) * std::pow(t, a - k);
   return r;
@@ -23,6 +27,14 @@ Eigen::RowVectorXd monomial_derivative_row(int n, int k, double t) {
 PolynomialTrajectory::PolynomialTrajectory(int order, std::vector<double> durations,
                                            Eigen::MatrixX3d coefficients)
     : order_(order), durations_(std::move(durations)), coefficients_(std::move(coefficients)) {
+  // Tenth campaign L17: an order of 0 or 20, negative or NaN durations and NaN coefficients
+  // made a trajectory every later step trusted.
+  if (order_ < 1 || 2 * order_ > kMaxCoefficientRows)
+    throw Error("trajectory: order must be in [1, " + std::to_string(kMaxCoefficientRows / 2) + "], got " + std::to_string(order_));
+  for (std::size_t i = 0; i < durations_.size(); ++i)
+    if (!(std::isfinite(durations_[i]) && durations_[i] > 0.0))
+      throw Error("trajectory: durations[" + std::to_string(i) + "] must be a positive finite time in s, got " + short_number(durations_[i]));
+  if (!coefficients_.allFinite()) throw Error("trajectory: coefficients must be finite numbers");
   if (coefficients_.rows() != 2 * order_ * static_cast<Eigen::Index>(durations_.size())) {
     throw Error("trajectory: expected " + std::to_string(2 * order_ * durations_.size()) +
                 " coefficient rows (2s per segment), got " + std::to_string(coefficients_.rows()));
@@ -34,6 +46,11 @@ double PolynomialTrajectory::total_duration() const {
 }
 
 Eigen::Vector3d PolynomialTrajectory::evaluate_segment(int i, double tau, int k) const {
+  // Tenth campaign L3: segment 99 of 5 read past the coefficients, -1 before them.
+  if (i < 0 || i >= segments())
+    throw Error("trajectory: segment " + std::to_string(i) + " does not exist (the trajectory has " +
+                std::to_string(segments()) + ")");
+  if (k < 0) throw Error("k: the derivative order must be >= 0, got " + std::to_string(k));
   const int n = 2 * order_;
   Eigen::Vector3d v = Eigen::Vector3d::Zero();
   const auto c = segment_coefficients(i);
@@ -55,6 +72,11 @@ Eigen::Vector3d PolynomialTrajectory::evaluate(double t, int k) const {
 }
 
 Eigen::MatrixXd monomial_cost_matrix(int order, double duration) {
+  // Tenth campaign L17: a negative duration gave a negative energy, NaN a NaN matrix.
+  if (order < 1 || 2 * order > kMaxCoefficientRows)
+    throw Error("monomial_cost_matrix: order must be in [1, " + std::to_string(kMaxCoefficientRows / 2) + "], got " + std::to_string(order));
+  if (!(std::isfinite(duration) && duration >= 0.0))
+    throw Error("monomial_cost_matrix: duration must be a finite time >= 0 s, got " + short_number(duration));
   const int n = 2 * order;
   Eigen::MatrixXd q = Eigen::MatrixXd::Zero(n, n);
   for (int a = order; a < n; ++a)

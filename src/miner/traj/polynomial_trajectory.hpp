@@ -12,10 +12,16 @@
 
 namespace miner::traj {
 
+/// The most coefficients per segment and axis (2s) a trajectory may have: s <= 4 (MINCO solves
+/// s = 3 and 4; the time allocation's samplers hold at most 8 rows).
+inline constexpr int kMaxCoefficientRows = 8;
+
 class PolynomialTrajectory {
  public:
   PolynomialTrajectory() = default;
-  /// `coefficients` stacks the M blocks c_i (2s rows each) into a (2s M) x 3 matrix.
+  /// `coefficients` stacks the M blocks c_i (2s rows each) into a (2s M) x 3 matrix. Throws
+  /// miner::Error for an order outside [1, kMaxCoefficientRows / 2], a duration that is not
+  /// positive and finite, a non-finite coefficient or a row count other than 2s M.
   PolynomialTrajectory(int order, std::vector<double> durations, Eigen::MatrixX3d coefficients);
 
   int order() const { return order_; }  ///< s
@@ -33,7 +39,8 @@ class PolynomialTrajectory {
   std::vector<double>& mutable_durations() { return durations_; }
 
   /// The k-th derivative (k = 0 position ... 4 snap, any k >= 0) of segment i at local
-  /// time tau (Horner's rule on the differentiated coefficients).
+  /// time tau (Horner's rule on the differentiated coefficients). Throws miner::Error for a
+  /// segment index outside [0, segments()) or k < 0.
   Eigen::Vector3d evaluate_segment(int i, double tau, int k = 0) const;
   /// The k-th derivative at global time t, clamped to [0, total_duration()]; at a
   /// junction the later segment is used.

@@ -26,6 +26,12 @@ void scale_time(PolynomialTrajectory& t, double k) {
 }
 
 std::pair<double, double> sampled_extremes(const PolynomialTrajectory& t, int samples) {
+  // Tenth campaign L13: INT_MAX samples ran for ever, 0 and -1 answered garbage (a peak speed
+  // of 241 m/s on a 4.6 m/s trajectory).
+  if (samples < 1 || samples > kMaxSamplesPerSegment)
+    throw Error("samples: must be in [1, " + std::to_string(kMaxSamplesPerSegment) + "] per segment, got " + std::to_string(samples));
+  if (t.order() < 1 || 2 * t.order() > kMaxCoefficientRows)
+    throw Error("sampled_extremes: order must be in [1, " + std::to_string(kMaxCoefficientRows / 2) + "], got " + std::to_string(t.order()));
   const int n = 2 * t.order();
   double v2 = 0.0, a2 = 0.0;
   Eigen::Matrix<double, 8, 3> dv, da;  // velocity and acceleration coefficients (n <= 8)
@@ -175,7 +181,9 @@ std::string short_number(double v) {
 void validate(const AllocationOptions& o) {
   validate(o.limits);
   if (!std::isfinite(o.rho) || !(o.rho > 0.0)) throw Error("rho: must be positive and finite, got " + short_number(o.rho));
-  if (o.samples_per_segment < 2) throw Error("samples per segment: must be at least 2");
+  if (o.samples_per_segment < 2 || o.samples_per_segment > kMaxSamplesPerSegment)
+    throw Error("samples per segment: must be in [2, " + std::to_string(kMaxSamplesPerSegment) + "], got " +
+                std::to_string(o.samples_per_segment));
   if (o.max_iterations < 1) throw Error("allocation iterations: must be at least 1");
 }
 
@@ -320,6 +328,14 @@ AllocationResult optimise_allocation(const MincoProblem& problem, const Allocati
 }
 
 std::pair<double, double> trajectory_extremes(const traj::PolynomialTrajectory& t, double step) {
+  // Tenth campaign L13: a step of 0, -1, NaN or 1e-300 was silently replaced by one sample per
+  // segment; the count is bounded before any evaluation.
+  if (!(std::isfinite(step) && step > 0.0)) throw Error("step: must be a positive finite time in s, got " + short_number(step));
+  double count = 0.0;
+  for (const double T : t.durations()) count += std::ceil(T / step) + 1.0;
+  if (!(count <= kMaxExtremeSamples))
+    throw Error("step: " + short_number(step) + " s over " + short_number(t.total_duration()) + " s would take " +
+                short_number(count) + " samples, more than the " + short_number(kMaxExtremeSamples) + " allowed: use a longer step");
   double v = 0.0, a = 0.0;
   for (int i = 0; i < t.segments(); ++i) {
     const double T = t.durations()[static_cast<std::size_t>(i)];

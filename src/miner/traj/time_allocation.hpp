@@ -32,12 +32,20 @@ namespace miner::traj {
 /// solution this is again the optimum for the scaled durations.
 void scale_time(PolynomialTrajectory& t, double k);
 
+/// The most samples per segment sampled_extremes and AllocationOptions take (the default is 32).
+inline constexpr int kMaxSamplesPerSegment = 4096;
+/// The most instants trajectory_extremes evaluates (10^7: ~1 s; a 1000 s flight at the
+/// pipeline's 1 ms step is 10^6).
+inline constexpr double kMaxExtremeSamples = 1e7;
+
 /// Largest speed and acceleration of t: per segment, `samples` + 1 evenly spaced instants
 /// (both ends included), then a golden-section search around the largest sample (to 1e-9 of
-/// the sample step): bounded work whatever the durations.
+/// the sample step): bounded work whatever the durations. Throws miner::Error for samples
+/// outside [1, kMaxSamplesPerSegment].
 std::pair<double, double> sampled_extremes(const PolynomialTrajectory& t, int samples);
 /// Maximum speed and acceleration of a trajectory, sampled every `step` seconds and at every
-/// segment end (the flight envelope's dense check).
+/// segment end (the flight envelope's dense check). Throws miner::Error for a step that is not
+/// positive and finite or that needs more than kMaxExtremeSamples instants.
 std::pair<double, double> trajectory_extremes(const PolynomialTrajectory& t, double step);
 
 struct AllocationOptions {
@@ -69,7 +77,7 @@ struct AllocationResult {
 inline constexpr int kMaxOptimisedSegments = 64;
 
 /// Throws miner::Error for a bad problem (validate()), moving ends, bad limits, rho <= 0 or
-/// not finite, samples_per_segment < 2, or more than kMaxOptimisedSegments segments. `problem.durations` are ignored: the start is the
+/// not finite, samples_per_segment outside [2, kMaxSamplesPerSegment], or more than kMaxOptimisedSegments segments. `problem.durations` are ignored: the start is the
 /// trapezoid.
 AllocationResult optimise_allocation(const MincoProblem& problem, const AllocationOptions& options);
 

@@ -86,13 +86,20 @@ Eigen::Vector3i endpoint_cell(const Map& map, const VoxelGrid& grid, const Eigen
 }  // namespace
 
 double octile_distance(const Eigen::Vector3i& a, const Eigen::Vector3i& b, double resolution) {
-  std::array<int, 3> d{std::abs(a.x() - b.x()), std::abs(a.y() - b.y()), std::abs(a.z() - b.z())};
+  // Differences in 64 bits: cells 2^31 apart do not wrap (tenth campaign L22).
+  std::array<double, 3> d{};
+  for (int k = 0; k < 3; ++k) d[static_cast<std::size_t>(k)] = std::fabs(static_cast<double>(static_cast<std::int64_t>(a[k]) - b[k]));
   std::sort(d.begin(), d.end(), std::greater<>());
   return resolution * (kSqrt3 * d[2] + kSqrt2 * (d[1] - d[2]) + (d[0] - d[1]));
 }
 
 GridPath astar(const Map& map, const VoxelGrid& grid, const Eigen::Vector3d& start,
                const Eigen::Vector3d& goal, const std::string& start_name, const std::string& goal_name) {
+  // The grid is this map's (issue 20, tenth campaign L7: a grid of an empty map walked A*
+  // through the walls of another with the same bounds).
+  if (grid.map_fingerprint() != map.fingerprint())
+    throw Error("astar: the grid was built from another map (its bounds, resolution, obstacles or voxels differ); "
+                "build the VoxelGrid from this map");
   const Eigen::Vector3i s = endpoint_cell(map, grid, start, start_name);
   const Eigen::Vector3i g = endpoint_cell(map, grid, goal, goal_name);
   // Index arithmetic in the inner loop: A* runs inside every generated map's solvability

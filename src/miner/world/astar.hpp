@@ -56,7 +56,8 @@ inline bool block_free(const Grid& grid, std::size_t from, const GridMove& m) {
 /// only if every cell of the 2x2 (or 2x2x2) block it crosses is free, so no move cuts a
 /// corner of an occupied cell.
 ///
-/// Throws miner::Error if start or goal is out of bounds, in collision (naming the
+/// Throws miner::Error if `grid` was built from another map (VoxelGrid::map_fingerprint), if
+/// start or goal is out of bounds, in collision (naming the
 /// obstacle) or in an occupied grid cell, and miner::NoSolution if the goal's cell
 /// is not reachable from the start's. Those messages call the ends `start_name` and
 /// `goal_name` (a command passes where they came from: "map.json: query.start", "--goal").

@@ -107,7 +107,16 @@ Map::Map(Box bounds, double resolution, std::vector<Box> obstacles, std::optiona
   check_resolution(resolution_, "resolution");
   (void)grid_dims(bounds_, resolution_);  // a grid A* and the voxel grid can hold
   for (std::size_t i = 0; i < obstacles_.size(); ++i) {
-    validate_box(obstacles_[i], "obstacles[" + std::to_string(i) + "]");
+    const std::string name = "obstacles[" + std::to_string(i) + "]";
+    validate_box(obstacles_[i], name);
+    // The metric range holds for obstacles too (issue 20, tenth campaign L9: a box of 1e300 m
+    // was accepted and planned around).
+    if (obstacles_[i].min.cwiseAbs().maxCoeff() > kMaxCoordinate || obstacles_[i].max.cwiseAbs().maxCoeff() > kMaxCoordinate) {
+      std::ostringstream os;
+      os << name << ": [" << format_point(obstacles_[i].min) << " - " << format_point(obstacles_[i].max)
+         << "] reaches farther than " << kMaxCoordinate << " m from the origin (use a local frame)";
+      throw Error(os.str());
+    }
   }
   if (query_) {
     require_finite(query_->start, "query.start");
@@ -118,6 +127,18 @@ Map::Map(Box bounds, double resolution, std::vector<Box> obstacles, std::optiona
   }
   if (source_) {
     if (!source_->layer) throw Error("voxels: no layer");
+    // Space inside the bounds but outside the voxels was never observed: it is unknown, and
+    // the queries would answer it free. Under the default policy (unknown is occupied,
+    // REQ-WORLD-013) such bounds are refused (issue 20, fourth campaign: a path through it;
+    // tenth campaign L8: the constructor let it through where the JSON reader did not).
+    if (source_->unknown == UnknownPolicy::kOccupied) {
+      const Box lb = source_->layer->bounds();
+      if ((bounds_.min.array() < lb.min.array()).any() || (bounds_.max.array() > lb.max.array()).any())
+        throw Error("bounds: [" + format_point(bounds_.min) + " - " + format_point(bounds_.max) +
+                    "] reaches beyond the voxels [" + format_point(lb.min) + " - " + format_point(lb.max) +
+                    "]: the space outside them is unknown, which this map treats as occupied; keep the "
+                    "bounds within the voxels or set \"voxels\": {\"unknown\": \"free\"}");
+    }
     const VoxelLayer& layer = *source_->layer;
     // The map's grid and the voxels share cells: same resolution, bounds.min on the lattice.
     constexpr double kLatticeTolerance = 1e-9;
@@ -138,9 +159,38 @@ Map::Map(Box bounds, double resolution, std::vector<Box> obstacles, std::optiona
     voxels_ = std::make_shared<const VoxelObstacles>(source_->layer, source_->unknown);
   }
   build_index();
+  // A stored query is one a planner can answer: both ends free at its radius (issue 20, tenth
+  // campaign C1: a start inside a box passed `map info` and failed only in `astar` / `plan`).
+  if (query_) {
+    require_free(query_->start, query_->robot_radius, "query.start");
+    require_free(query_->goal, query_->robot_radius, "query.goal");
+  }
+  compute_fingerprint();
+}
+
+void Map::compute_fingerprint() {
+  std::uint64_t h = fnv1a64(bounds_.min.data(), 3 * sizeof(double));
+  h = fnv1a64(bounds_.max.data(), 3 * sizeof(double), h);
+  h = fnv1a64(&resolution_, sizeof resolution_, h);
+  for (const Box& b : obstacles_) {
+    h = fnv1a64(b.min.data(), 3 * sizeof(double), h);
+    h = fnv1a64(b.max.data(), 3 * sizeof(double), h);
+  }
+  if (voxels_) {
+    const VoxelLayer& layer = voxels_->layer();
+    const std::uint8_t policy = source_->unknown == UnknownPolicy::kOccupied ? 1 : 0;
+    h = fnv1a64(&policy, 1, h);
+    h = fnv1a64(layer.origin_cells().data(), 3 * sizeof(int), h);
+    h = fnv1a64(layer.dims().data(), 3 * sizeof(int), h);
+    const double r = layer.resolution();
+    h = fnv1a64(&r, sizeof r, h);
+    h = fnv1a64(layer.states().data(), layer.states().size(), h);
+  }
+  fingerprint_ = h;
 }
 
 Map Map::from_voxels(VoxelSource voxels) {
+  if (!voxels.layer) throw Error("voxels: no layer");
   const VoxelLayer& layer = *voxels.layer;
   return Map(layer.bounds(), layer.resolution(), {}, std::nullopt, std::move(voxels));
 }
@@ -152,12 +202,37 @@ Map Map::with_unknown(UnknownPolicy policy) const {
   return Map(bounds_, resolution_, obstacles_, query_, std::move(source));
 }
 
+namespace {
+
+/// An obstacle index names a box or a voxel of this map (tenth campaign L3: an index of another
+/// map read past the end).
+void check_obstacle_index(std::size_t index, std::size_t boxes, const VoxelObstacles* voxels) {
+  const std::size_t total = boxes + (voxels ? voxels->layer().size() : 0);
+  if (index >= total)
+    throw Error("obstacle index " + std::to_string(index) + ": the map has " + std::to_string(boxes) + " boxes" +
+                (voxels ? " and " + std::to_string(voxels->layer().size()) + " voxels" : std::string()) +
+                " (indices 0 to " + (total == 0 ? std::string("none") : std::to_string(total - 1)) + ")");
+}
+
+/// A query point is finite and a radius is a number >= 0 (tenth campaign L1: a NaN point read
+/// the voxel layer at cell -2^31).
+void check_query(const Eigen::Vector3d& p, const char* field) {
+  if (!p.allFinite()) require_finite(p, field);
+}
+void check_query_radius(double radius, const char* field) {
+  if (!(radius >= 0.0)) throw Error(std::string(field) + ": must be a number >= 0, got " + short_number(radius));
+}
+
+}  // namespace
+
 Box Map::obstacle_box(std::size_t index) const {
+  check_obstacle_index(index, obstacles_.size(), voxels_.get());
   if (index < obstacles_.size()) return obstacles_[index];
   return voxels_->layer().cell_box(voxels_->layer().coords(index - obstacles_.size()));
 }
 
 std::string Map::obstacle_name(std::size_t index) const {
+  check_obstacle_index(index, obstacles_.size(), voxels_.get());
   if (index < obstacles_.size()) return box_name(index, obstacles_[index]);
   const VoxelLayer& layer = voxels_->layer();
   const std::size_t v = index - obstacles_.size();
@@ -324,17 +399,7 @@ Map Map::from_json(const Json& doc, const std::string& origin) {
     // (issue 20); 0 must be said.
     query = Query{q.at("start").vec3(), q.at("goal").vec3(), q.at("robot_radius").number()};
   }
-  // Space inside the bounds but outside the voxels was never observed: it is unknown, and
-  // the queries would answer it free. Under the default policy (unknown is occupied,
-  // REQ-WORLD-013) such bounds are refused (issue 20, fourth campaign: a path through it).
-  if (voxels && voxels->unknown == UnknownPolicy::kOccupied) {
-    const Box lb = voxels->layer->bounds();
-    if ((bounds.min.array() < lb.min.array()).any() || (bounds.max.array() > lb.max.array()).any())
-      root.at("bounds").fail("[" + format_point(bounds.min) + " - " + format_point(bounds.max) +
-                             "] reaches beyond the voxels [" + format_point(lb.min) + " - " + format_point(lb.max) +
-                             "]: the space outside them is unknown, which this map treats as occupied; keep the "
-                             "bounds within the voxels or set \"voxels\": {\"unknown\": \"free\"}");
-  }
+  // Bounds reaching beyond the voxels under the occupied policy are refused by the constructor.
   try {
     Map map(bounds, resolution, std::move(obstacles), query, std::move(voxels));
     // A box farther from the bounds than the largest robot radius can meet no query: in a
@@ -502,6 +567,8 @@ void Map::save(const std::string& path) const {
 }
 
 std::optional<std::size_t> Map::point_collision(const Eigen::Vector3d& p, double radius) const {
+  check_query(p, "point_collision: p");
+  check_query_radius(radius, "point_collision: radius");
   const Box region{p.array() - radius, p.array() + radius};
   if (auto hit = query_index(region, radius * radius, [&](const Box& b) { return squared_distance(p, b); }))
     return hit;
@@ -513,6 +580,9 @@ std::optional<std::size_t> Map::point_collision(const Eigen::Vector3d& p, double
 
 std::optional<std::size_t> Map::segment_collision(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                                   double radius) const {
+  check_query(a, "segment_collision: a");
+  check_query(b, "segment_collision: b");
+  check_query_radius(radius, "segment_collision: radius");
   const Box sweep{a.cwiseMin(b).array() - radius, a.cwiseMax(b).array() + radius};
   if (auto hit = query_index(sweep, radius * radius, [&](const Box& box) { return squared_distance(a, b, box); }))
     return hit;
@@ -523,6 +593,7 @@ std::optional<std::size_t> Map::segment_collision(const Eigen::Vector3d& a, cons
 }
 
 double Map::clearance(const Eigen::Vector3d& p) const {
+  check_query(p, "clearance: p");
   double best = std::numeric_limits<double>::infinity();
   for (const Box& b : obstacles_) best = std::min(best, squared_distance(p, b));
   best = std::sqrt(best);
@@ -530,6 +601,9 @@ double Map::clearance(const Eigen::Vector3d& p) const {
 }
 
 std::optional<double> Map::raycast(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double max_range) const {
+  check_query(origin, "raycast: origin");
+  check_query(dir, "raycast: dir");
+  check_query_radius(max_range, "raycast: max_range");
   std::optional<double> best = voxels_ ? voxels_->raycast(origin, dir, max_range) : std::nullopt;
   const auto consider = [&](std::size_t i) {
     if (const auto t = ray_interval(obstacles_[i], origin, dir, best ? *best : max_range)) best = t->first;
@@ -573,6 +647,7 @@ std::optional<double> Map::raycast(const Eigen::Vector3d& origin, const Eigen::V
 
 void Map::require_free(const Eigen::Vector3d& p, double radius, const std::string& what) const {
   require_finite(p, what);
+  check_robot_radius(radius, what + ": robot radius");
   if (!in_bounds(p)) {
     throw Error(what + " " + format_point(p) + " lies outside the map bounds [" +
                 format_point(bounds_.min) + " - " + format_point(bounds_.max) + "]");

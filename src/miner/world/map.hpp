@@ -86,12 +86,14 @@ struct VoxelSource {
 
 class Map {
  public:
-  /// Validates every argument (REQ-WORLD-002); throws miner::Error naming the fault. With
-  /// voxels, the resolution must be the layer's and bounds.min must lie on its lattice (so the
-  /// A* grid and the voxels share cells).
+  /// Validates every argument (REQ-WORLD-002); throws miner::Error naming the fault: every
+  /// coordinate within kMaxCoordinate, a stored query inside the bounds and free at its robot
+  /// radius. With voxels, the resolution must be the layer's and bounds.min must lie on its
+  /// lattice (so the A* grid and the voxels share cells), and under the occupied policy the
+  /// bounds may not reach beyond the voxels (the space outside them was never observed).
   Map(Box bounds, double resolution, std::vector<Box> obstacles,
       std::optional<Query> query = std::nullopt, std::optional<VoxelSource> voxels = std::nullopt);
-  /// A map of voxels alone, bounded by the layer.
+  /// A map of voxels alone, bounded by the layer. Throws miner::Error without a layer.
   static Map from_voxels(VoxelSource voxels);
   /// The same map read under another unknown-space policy (the distance field is rebuilt).
   Map with_unknown(UnknownPolicy policy) const;
@@ -133,15 +135,22 @@ class Map {
   const VoxelObstacles* voxels() const { return voxels_.get(); }
   const std::optional<VoxelSource>& voxel_source() const { return source_; }
   /// The box an obstacle index names: a box obstacle below obstacles().size(), else the voxel
-  /// obstacles().size() + i of the layer.
+  /// obstacles().size() + i of the layer. Throws miner::Error for an index past both.
   Box obstacle_box(std::size_t index) const;
   /// "obstacle 3 [..]" or "occupied voxel (i, j, k) [..]" / "unknown voxel ...".
   std::string obstacle_name(std::size_t index) const;
+  /// A 64-bit digest (FNV-1a) of what the map's collision answers depend on: bounds,
+  /// resolution, obstacles, the voxels' states and the unknown-space policy. Two maps with the
+  /// same fingerprint answer every query alike; a VoxelGrid keeps its map's, so A* refuses a grid
+  /// built for another map (issue 20, tenth campaign L7).
+  std::uint64_t fingerprint() const { return fingerprint_; }
 
   bool in_bounds(const Eigen::Vector3d& p) const { return bounds_.contains(p); }
 
   /// Index of an obstacle within distance `radius` of p (boundary counts), if any: boxes
-  /// first (the lowest index), then blocked voxels (see obstacle_box).
+  /// first (the lowest index), then blocked voxels (see obstacle_box). Every query below
+  /// throws miner::Error for a non-finite point or direction and a radius or range that is
+  /// NaN or negative (REQ-WORLD-002: no answer is made up for a point nowhere).
   std::optional<std::size_t> point_collision(const Eigen::Vector3d& p, double radius = 0.0) const;
   /// Index of an obstacle within `radius` of some point of segment [a, b], if any.
   std::optional<std::size_t> segment_collision(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
@@ -161,7 +170,8 @@ class Map {
   std::optional<double> raycast(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double max_range) const;
 
   /// Throws miner::Error unless a robot of `radius` can stand at p; `what` names the
-  /// point ("start", "goal") and the message names the offending obstacle.
+  /// point ("start", "goal") and the message names the offending obstacle. The radius must be
+  /// a robot radius (check_robot_radius).
   void require_free(const Eigen::Vector3d& p, double radius, const std::string& what) const;
 
  private:
@@ -171,6 +181,8 @@ class Map {
   std::optional<Query> query_;
   std::optional<VoxelSource> source_;
   std::shared_ptr<const VoxelObstacles> voxels_;
+  std::uint64_t fingerprint_ = 0;
+  void compute_fingerprint();
 
   /// Broad phase: a uniform grid of buckets over the bounds, each listing the obstacles
   /// that overlap it, so a query visits only nearby obstacles. Answers are identical to

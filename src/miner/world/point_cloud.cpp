@@ -492,7 +492,8 @@ std::shared_ptr<const VoxelLayer> integrate_clouds(const std::vector<CloudScan>&
   for (std::size_t s = 0; s < scans.size(); ++s) {
     if (!(scans[s].origin.allFinite() && scans[s].origin.cwiseAbs().maxCoeff() < reach))
       throw Error(label(s) + ": the sensor origin " + format_point(scans[s].origin) +
-                  " lies beyond OctoMap's key range at this resolution (32767 voxels from the origin)");
+                  " (--origin, or the cloud's own viewpoint) lies beyond OctoMap's key range at this resolution "
+                  "(32767 voxels from the origin)");
     finite_points += scans[s].cloud.points.size();
   }
   // Named by the clouds' files (seventh campaign C8: an empty PLY named none).

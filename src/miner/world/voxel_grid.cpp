@@ -31,9 +31,10 @@ std::pair<int, int> cell_span(double origin, double res, int n, double lo, doubl
 }  // namespace
 
 VoxelGrid::VoxelGrid(const Map& map, double robot_radius)
-    : origin_(map.bounds().min), resolution_(map.resolution()), robot_radius_(robot_radius) {
-  require_finite(robot_radius, "robot radius");
-  if (robot_radius < 0.0) throw Error("robot radius: must not be negative");
+    : origin_(map.bounds().min), resolution_(map.resolution()), robot_radius_(robot_radius),
+      map_fingerprint_(map.fingerprint()) {
+  // A robot radius, as every query has (tenth campaign L10: 1e300 made every cell occupied).
+  check_robot_radius(robot_radius, "robot radius");
   dims_ = grid_dims(map.bounds(), resolution_);  // checked when the map was built (REQ-WORLD-002)
   occupancy_.assign(static_cast<std::size_t>(dims_.x()) * static_cast<std::size_t>(dims_.y()) *
                         static_cast<std::size_t>(dims_.z()),

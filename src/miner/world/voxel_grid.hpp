@@ -33,6 +33,8 @@ class VoxelGrid {
   const Eigen::Vector3d& origin() const { return origin_; }
   double resolution() const { return resolution_; }
   double robot_radius() const { return robot_radius_; }
+  /// The fingerprint of the map the grid was built from (Map::fingerprint).
+  std::uint64_t map_fingerprint() const { return map_fingerprint_; }
   std::size_t cell_count() const { return occupancy_.size(); }
   std::size_t occupied_count() const;
 
@@ -59,6 +61,7 @@ class VoxelGrid {
   Eigen::Vector3d origin_;
   double resolution_;
   double robot_radius_;
+  std::uint64_t map_fingerprint_;
   std::vector<std::uint8_t> occupancy_;
   /// Blocked voxels of a voxel map, grown by the robot radius like the boxes.
   void mark_voxels(const VoxelObstacles& voxels, const Box& bounds);

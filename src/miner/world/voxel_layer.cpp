@@ -104,7 +104,15 @@ VoxelLayer::VoxelLayer(Eigen::Vector3i origin_cells, double resolution, Eigen::V
     os << "voxel resolution: must be positive and finite, got " << resolution_;
     throw Error(os.str());
   }
+  check_resolution(resolution_, "voxel resolution");
   if ((dims_.array() < 1).any()) throw Error("voxel layer: every dimension must hold at least one voxel");
+  // The layer's cells are ints: origin + dims must not wrap (tenth campaign L22: an origin of
+  // INT_MAX cells gave bounds whose max lay below their min).
+  for (int k = 0; k < 3; ++k)
+    if (static_cast<std::int64_t>(origin_cells_[k]) + dims_[k] > std::numeric_limits<int>::max() ||
+        static_cast<std::int64_t>(origin_cells_[k]) < std::numeric_limits<int>::min() / 2)
+      throw Error("voxel layer: origin cell " + std::to_string(origin_cells_[k]) + " + " + std::to_string(dims_[k]) +
+                  " voxels along axis " + std::to_string(k) + " leaves the range of cell indices");
   const double cells = static_cast<double>(dims_.x()) * dims_.y() * dims_.z();
   if (cells > kMaxGridCells) {
     std::ostringstream os;
@@ -145,7 +153,9 @@ Eigen::Vector3i VoxelLayer::clamped_cell(const Eigen::Vector3d& p) const {
   Eigen::Vector3i c;
   for (int a = 0; a < 3; ++a) {
     const double u = std::floor(p[a] / resolution_) - origin_cells_[a];
-    c[a] = static_cast<int>(std::clamp(u, 0.0, static_cast<double>(dims_[a] - 1)));
+    // Written so that NaN lands on cell 0 (std::clamp passes NaN through, and NaN cast to int
+    // is undefined: tenth campaign L1); Map's queries refuse a non-finite point before this.
+    c[a] = u >= dims_[a] - 1 ? dims_[a] - 1 : u > 0.0 ? static_cast<int>(u) : 0;
   }
   return c;
 }
@@ -186,6 +196,7 @@ std::vector<Box> decimated_occupied_boxes(const VoxelLayer& layer, std::size_t m
 
 VoxelObstacles::VoxelObstacles(std::shared_ptr<const VoxelLayer> layer, UnknownPolicy policy)
     : layer_(std::move(layer)), policy_(policy) {
+  if (!layer_) throw Error("voxels: no layer");
   const VoxelLayer& L = *layer_;
   blocked_.resize(L.size());
   for (std::size_t i = 0; i < L.size(); ++i) {

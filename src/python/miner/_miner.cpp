@@ -354,9 +354,9 @@ PYBIND11_MODULE(_miner, m) {
         const Query q = resolve(map, start, goal, radius);
         const std::vector<double> d = vector_of(dims_arg, "dims");
         if (d.size() != 3) throw miner::Error("dims: expected 3 integers nx ny nz, got " + std::to_string(d.size()));
-        Eigen::Vector3i dims;
+        Eigen::Vector3i dims;  // the array read once: each entry a whole number in [1, 4096]
         for (int k = 0; k < 3; ++k)
-          dims[k] = static_cast<int>(integer_in(py::reinterpret_borrow<py::object>(py::list(dims_arg)[k]),
+          dims[k] = static_cast<int>(integer_in(py::float_(d[static_cast<std::size_t>(k)]),
                                                 "dims[" + std::to_string(k) + "]", 1, 4096));
         const int dilation = static_cast<int>(integer_in(dilation_arg, "dilation", 0, 4));
         const auto problem = miner::plan::PlanningProblem::make(map, q.start, q.goal, q.radius);

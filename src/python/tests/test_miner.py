@@ -228,3 +228,8 @@ def test_none_for_an_object_and_whole_floats_for_integers():
     assert list(miner.astar_region(m, dims=np.array([8.0, 8.0, 4.0])).dims) == [8, 8, 4]
     with pytest.raises(miner.Error, match=r"dims\[0\]"):
         miner.astar_region(m, dims=[8.5, 8, 4])
+    # dims is read once: a tuple, a list and an array give the same region; a one-shot
+    # iterator is refused by name, never half-read.
+    assert list(miner.astar_region(m, dims=(8, 8, 4)).dims) == [8, 8, 4]
+    with pytest.raises(miner.Error, match="dims"):
+        miner.astar_region(m, dims=iter([8, 8, 4]))

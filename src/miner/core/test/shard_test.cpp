@@ -22,3 +22,15 @@ TEST_CASE("Parts of one split join: others are refused naming the part in plain 
   CHECK(miner::parse_shard("1/4") == std::pair<int, int>{1, 4});
   CHECK_THROWS_AS(miner::parse_shard("4/4"), miner::Error);
 }
+
+TEST_CASE("Part tags are checked against their names and their fields' types before they are read",
+          "[REQ-LIB-003][REQ-CORE-004]") {
+  // Tenth campaign L19: fewer names than tags read past the names (a crash); L18: a string
+  // "count" escaped as the JSON library's type_error.
+  const Json part{{"index", 0}, {"count", 2}};
+  CHECK_THROWS_WITH(miner::require_complete_parts({part, part}, {"only-one"}, "job"), Contains("2 part tags but 1 names"));
+  CHECK_THROWS_WITH(miner::require_complete_parts({Json{{"index", "0"}, {"count", 1}}}, {"a.json"}, "job"),
+                    Contains("a.json") && Contains("integer \"index\""));
+  CHECK_THROWS_WITH(miner::require_complete_parts({Json{{"index", 0}}}, {"a.json"}, "job"), Contains("integer \"count\""));
+  CHECK_NOTHROW(miner::require_complete_parts({part, Json{{"index", 1}, {"count", 2}}}, {"a", "b"}, "job"));
+}

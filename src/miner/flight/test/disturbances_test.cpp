@@ -452,6 +452,12 @@ TEST_CASE("The yaw reference turns toward the velocity at its rate limit and the
   CHECK(previous == Approx(-kPi / 2));
   ref.step(Eigen::Vector3d(0.01, 0.0, 0.0), 0.01);  // below min_speed: heading held
   CHECK(ref.yaw() == Approx(-kPi / 2));
+  // A climb or descent is no heading: the horizontal speed decides, not the 3-D one (held-out
+  // audit 8, h8-flight-04: a vertical climb with a hair of sideways drift swung the yaw).
+  for (const double vz : {2.0, -2.0}) {
+    ref.step(Eigen::Vector3d(0.001, 0.002, vz), 0.01);
+    CHECK(ref.yaw() == Approx(-kPi / 2));
+  }
 
   Eigen::MatrixX3d points(3, 3);
   points << 5, 5, 3, 5, 12, 3, 12, 12, 3;  // north, then east

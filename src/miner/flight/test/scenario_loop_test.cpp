@@ -90,6 +90,12 @@ TEST_CASE("Bad scenarios are refused before flight with the fault named", "[REQ-
   doc = default_doc();
   doc["trajectory"]["a_max"] = 9.0;
   expect_scenario_error(doc, "deg of tilt");
+  // Between 0.8 of the tilt limit (28 deg of 35) and the limit itself: refused as well; below
+  // 0.8 read (held-out audit 8, h8-flight-02: the margin was dropped and 29 deg flew).
+  doc["trajectory"]["a_max"] = 5.5;  // atan(5.5 / 9.81) = 29.3 deg
+  expect_scenario_error(doc, "deg of tilt");
+  doc["trajectory"]["a_max"] = 5.0;  // 27.0 deg
+  CHECK_NOTHROW(pipeline::scenario_from_json(doc, "s.json", kScenarios));
   // Seventh campaign C3: a vehicle file that cannot be read is named through the field; C7: a
   // name with a newline is quoted with the newline escaped.
   doc = default_doc();
@@ -561,4 +567,41 @@ TEST_CASE("A flight stops the first tick the vehicle is outside its world and sa
   REQUIRE(p.left_world);
   CHECK(p.left_world_position.x() > s.map->bounds().max.x());
   CHECK(p.flight_time == Approx(p.left_world_time_s));
+}
+
+TEST_CASE("flight::fly bounds the simulated time itself, whoever calls it", "[REQ-LIB-003][REQ-FLIGHT-007]") {
+  // Tenth campaign L12b: the pipeline refused a flight past kMaxFlightSeconds, but a library
+  // caller of flight::fly with a 10^7 s hover ran unbounded.
+  pipeline::Scenario s = pipeline::default_scenario();
+  const pipeline::ReferencePlan r = pipeline::build_reference(s);
+  flight::FlightSetup setup = s;
+  setup.collides = [](const Eigen::Vector3d&) { return false; };
+  setup.hover_after_s = 1e7;
+  CHECK_THROWS_WITH(flight::fly(setup, r), Contains("at most 1000 s of simulated flight"));
+  setup.hover_after_s = std::nan("");
+  CHECK_THROWS_WITH(flight::fly(setup, r), Contains("hover_after_s"));
+  setup.hover_after_s = flight::kMaxFlightSeconds - r.trajectory.total_duration() + 1.0;
+  CHECK_THROWS_WITH(flight::fly(setup, r), Contains("at most 1000 s"));
+  setup.hover_after_s = 0.5;
+  setup.n3.rate_hz = 0.0;
+  CHECK_THROWS_WITH(flight::fly(setup, r), Contains("rates"));
+}
+
+TEST_CASE("A collision is counted once per entry into an obstacle, not once per tick inside it",
+          "[REQ-FLIGHT-009][REQ-FLIGHT-007]") {
+  // Held-out audit 8, h8-flight-06: the count rose by one every N3 tick in contact (137 for a
+  // flight that touched twice). Here the vehicle crosses a 0.5 m slab once, and two slabs twice.
+  Eigen::MatrixX3d points(2, 3);
+  points << 5, 5, 3, 5, 12, 3;
+  const pipeline::Scenario s = miner::testing::open_room_scenario(points, 1.0, 1.0);
+  const pipeline::ReferencePlan r = pipeline::build_reference(s);
+  flight::FlightSetup setup = s;
+  setup.world = Eigen::AlignedBox3d(s.map->bounds().min, s.map->bounds().max);
+  setup.collides = [](const Eigen::Vector3d& p) { return p.y() > 8.0 && p.y() < 8.5; };
+  const flight::FlightResult once = flight::fly(setup, r);
+  CHECK(once.collisions == 1);
+  setup.collides = [](const Eigen::Vector3d& p) { return (p.y() > 7.0 && p.y() < 7.5) || (p.y() > 9.0 && p.y() < 9.5); };
+  CHECK(flight::fly(setup, r).collisions == 2);
+  setup.collides = [](const Eigen::Vector3d&) { return false; };
+  CHECK(flight::fly(setup, r).collisions == 0);
 }

@@ -44,6 +44,16 @@ TEST_CASE("Missing or non-physical vehicle parameters are refused naming the par
   doc = vehicle_doc();
   doc["rotor_speed_max_rad_s"] = 600.0;  // 8.4 N of thrust for 14.7 N of weight
   expect_vehicle_error(doc, "thrust-to-weight");
+  // Near the end of the range: 1 / cos(35 deg) = 1.2208 is the least thrust-to-weight that
+  // holds altitude at the tilt limit; 1.1 and 1.2 are refused (held-out audit 8, h8-flight-01: a
+  // bound of cos(35 deg) = 0.82 accepted 1.016).
+  for (const double ratio : {1.016, 1.1, 1.2}) {
+    doc = vehicle_doc();
+    const flight::VehicleParams v{};
+    doc["rotor_speed_max_rad_s"] = std::sqrt(ratio * v.weight() / (4.0 * v.thrust_coefficient));
+    INFO("thrust-to-weight " << ratio);
+    expect_vehicle_error(doc, "thrust-to-weight ratio of " + std::to_string(ratio).substr(0, 4));
+  }
   doc = vehicle_doc();
   doc["mass_kg"] = 1e300;  // issue 20: values near the largest double flew
   expect_vehicle_error(doc, "mass_kg: must be a finite number in (0, 1000], got 1e+300");

@@ -586,3 +586,15 @@ TEST_CASE("A sample whose bytes differ from the generator's is refused naming th
   edited[0].astar_cost += 1.0;
   CHECK_THROWS_WITH(heuristic::verify_samples(dir, edited), Contains("its index entry"));
 }
+
+TEST_CASE("The validation split is the fraction rounded to whole samples, not truncated", "[REQ-HEUR-001]") {
+  // Held-out audit 8, h8-heuristic-05: 0.5 of 3 samples gave 1 validation sample (truncated)
+  // instead of 2 (rounded, as the check against an empty training split counts it).
+  auto o = small_options();
+  o.count = 3;
+  o.val_fraction = 0.5;
+  o.test_count = 0;
+  const miner::Json doc = heuristic::write_dataset(o, temp_dir() + "/rounded", nullptr);
+  CHECK(doc["splits"]["val"]["count"] == 2);
+  CHECK(doc["splits"]["train"]["count"] == 1);
+}

@@ -1,6 +1,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <limits>
 
 #include "miner/core/rng.hpp"
 #include "miner/heuristic/grid.hpp"
@@ -231,4 +232,29 @@ TEST_CASE("With the widest rule the raw region joins start and goal whenever non
   g.env[heuristic::cell_index(kDims, 4, 3, 3)] = heuristic::kPartial;
   g.set_p(4, 3, 3, 0.1f);
   CHECK(heuristic::region_threshold(g.p, g.env, kDims, {0, 1, 1}, {7, 1, 1}, 0.2, true) == Approx(0.1f));
+}
+
+TEST_CASE("Tenth campaign: the filter refuses cells outside its grid and a NaN threshold; a moved-from network is named",
+          "[REQ-LIB-003][REQ-HEUR-007]") {
+  using Catch::Matchers::Contains;
+  Grid g;
+  // L4: a start cell outside the grid corrupted the heap; a goal outside it was read past the end.
+  CHECK_THROWS_WITH(heuristic::filter_region(g.p, g.env, kDims, Eigen::Vector3i(-5, 0, 0), Eigen::Vector3i(7, 3, 3), 0.5),
+                    Contains("start cell (-5, 0, 0) lies outside the 8 x 4 x 4 grid"));
+  CHECK_THROWS_WITH(heuristic::filter_region(g.p, g.env, kDims, Eigen::Vector3i(0, 0, 0), Eigen::Vector3i(8, 3, 3), 0.5),
+                    Contains("goal cell (8, 3, 3)"));
+  CHECK_THROWS_WITH(heuristic::widest_threshold(g.p, g.env, kDims, Eigen::Vector3i(0, 0, 0), Eigen::Vector3i(99, 0, 0), {}),
+                    Contains("goal cell (99, 0, 0)"));
+  CHECK_THROWS_WITH(heuristic::filter_region(g.p, g.env, kDims, Eigen::Vector3i(0, 0, 0), Eigen::Vector3i(7, 3, 3),
+                                             std::numeric_limits<double>::quiet_NaN()),
+                    Contains("threshold"));
+  CHECK_THROWS_WITH(heuristic::filter_region(g.p, g.env, Eigen::Vector3i(0, 4, 4), Eigen::Vector3i(0, 0, 0),
+                                             Eigen::Vector3i(0, 0, 0), 0.5),
+                    Contains("at least 1"));
+  CHECK_NOTHROW(heuristic::filter_region(g.p, g.env, kDims, Eigen::Vector3i(0, 0, 0), Eigen::Vector3i(7, 3, 3), 0.5));
+  // L21: a network moved from answers with an error, the one moved to works.
+  heuristic::Sgan a = heuristic::Sgan::builtin();
+  const heuristic::Sgan b = std::move(a);
+  CHECK_THROWS_WITH(a.architecture(), Contains("moved from"));  // NOLINT(bugprone-use-after-move)
+  CHECK(b.architecture().dims == Eigen::Vector3i(32, 32, 32));
 }

@@ -440,6 +440,14 @@ TEST_CASE("A missing, truncated, altered or mismatched weights file is refused n
     refuses([](miner::Json& h) { h["tensors"][1]["offset"] = 0; }, "two tensors overlap");
     refuses([](miner::Json& h) { h["tensors"][1]["offset"] = 2593; }, "must be a multiple of 4");
     refuses([](miner::Json& h) { h["tensors"][0]["extra"] = 1; }, "tensors[0].extra: unknown key");
+    // Every axis of dims, both ends of [8, 256] (held-out audit 8, h8-heuristic-02: a z of 12
+    // passed and oneDNN refused it without naming the field).
+    for (int axis = 0; axis < 3; ++axis)
+      for (const int bad : {12, 0, 264}) {
+        INFO("dims[" << axis << "] = " << bad);
+        refuses([&](miner::Json& h) { h["meta"]["architecture"]["dims"][axis] = bad; },
+                "meta.architecture.dims: each must be a multiple of 8 in [8, 256]");
+      }
     refuses([](miner::Json& h) { h["meta"]["architecture"]["environment_scale"] = -1e300; }, "environment_scale: must be in (0, 1]");
     refuses([](miner::Json& h) { h["meta"]["architecture"]["environment_scale"] = 0; }, "environment_scale: must be in (0, 1], got 0");
     refuses([](miner::Json& h) { h["meta"]["architecture"]["environment_scale"] = 1.0 + 1e-12; }, "environment_scale: must be in (0, 1]");
@@ -500,4 +508,38 @@ TEST_CASE("A query thresholds by the weights' rule: widest lowers it until start
   CHECK(widest.report.raw_connected);
   CHECK(widest.region.threshold() == widest.report.threshold);  // the raw region carries it
   CHECK(fixed.probabilities == widest.probabilities);           // the same network output
+}
+
+TEST_CASE("predict() reads the encoded E, S and P alike on both input paths, each blocked bit on its own axis",
+          "[REQ-HEUR-015][REQ-HEUR-005]") {
+  // Held-out audit 8, h8-heuristic-06: the own-kernels input path (set_input_encoded) swapped
+  // the y and z blocked bits; every probability moved on indoor-1. Both paths get the same
+  // encoding and noise here, with partial cells blocked along one axis at a time.
+  const std::string blob = miner::read_file_bytes(kFixtures + "sgan.bin");
+  const heuristic::Sgan fast = heuristic::Sgan::from_bytes(blob, "fast");
+  const heuristic::Sgan onednn = heuristic::Sgan::from_bytes(blob, "onednn", heuristic::Sgan::Kernels::kOneDnn);
+  REQUIRE(fast.own_kernels());
+  REQUIRE(fast.architecture().passability_channels == 3);
+  const std::size_t n = static_cast<std::size_t>(fast.architecture().dims.prod());
+  const miner::world::Box bounds{{0, 0, 0}, {40, 40, 20}};
+  for (const std::uint8_t open : {std::uint8_t(heuristic::kPassY | heuristic::kPassZ),
+                                  std::uint8_t(heuristic::kPassX | heuristic::kPassZ),
+                                  std::uint8_t(heuristic::kPassX | heuristic::kPassY)}) {
+    miner::Rng cells(7);
+    std::vector<std::uint8_t> env(n), state(n, 0), pass(n, 0);
+    for (std::size_t v = 0; v < n; ++v) {
+      env[v] = static_cast<std::uint8_t>(cells.uniform_index(3));
+      pass[v] = env[v] == heuristic::kFree ? std::uint8_t(heuristic::kPassX | heuristic::kPassY | heuristic::kPassZ)
+                : env[v] == 1                ? open
+                                             : std::uint8_t(0);
+    }
+    state[0] = state[n - 1] = 1;
+    miner::Rng r1(9), r2(9);
+    const std::vector<float> a = fast.predict(env, state, pass, bounds, 0.3, r1),
+                             b = onednn.predict(env, state, pass, bounds, 0.3, r2);
+    double worst = 0.0;
+    for (std::size_t v = 0; v < n; ++v) worst = std::max(worst, static_cast<double>(std::fabs(a[v] - b[v])));
+    INFO("open axes " << int(open));
+    CHECK(worst <= 1e-5);
+  }
 }

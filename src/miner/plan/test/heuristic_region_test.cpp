@@ -61,6 +61,17 @@ TEST_CASE("A region round-trips through miner-region-v1 and bad files name the f
   doc = r.to_json();
   doc["probabilities"][3] = 1.5;
   CHECK_THROWS_WITH(HeuristicRegion::from_json(doc, "r.json"), Contains("probabilities[3]") && Contains("[0, 1]"));
+  // Both ends of [0, 1] (held-out audit 8, h8-plan-01: a negative probability was accepted).
+  for (const double bad : {-0.5, -1e-12, 1.0 + 1e-12}) {
+    doc = r.to_json();
+    doc["probabilities"][3] = bad;
+    CHECK_THROWS_WITH(HeuristicRegion::from_json(doc, "r.json"), Contains("probabilities[3]") && Contains("[0, 1]"));
+  }
+  for (const double good : {0.0, 1.0}) {
+    doc = r.to_json();
+    doc["probabilities"][3] = good;
+    CHECK_NOTHROW(HeuristicRegion::from_json(doc, "r.json"));
+  }
   doc = r.to_json();
   doc["probabilities"].erase(0);
   CHECK_THROWS_WITH(HeuristicRegion::from_json(doc, "r.json"), Contains("expected nx*ny*nz = 8 values, got 7"));

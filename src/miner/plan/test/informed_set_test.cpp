@@ -1,5 +1,6 @@
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 
 #include "miner/core/rng.hpp"
@@ -82,4 +83,32 @@ TEST_CASE("Guided RRT*'s local subsets: the beacon's two sets, picked in proport
   // A straight-line solution (beacon on the segment, g and c_best exact) has no volume.
   const miner::plan::GuidedLocalSubsets flat(start, goal, V(4, 0, 0), 4.0, 10.0);
   CHECK_FALSE(flat.has_volume());
+}
+
+TEST_CASE("Informed-set samples fill the set when the foci lie along a coordinate axis", "[REQ-PLAN-002][REQ-PLAN-003]") {
+  // Held-out audit 8, h8-plan-04: the rotation's completion picked the focal axis itself when
+  // it was a coordinate axis, and every sample fell on the segment between the foci.
+  miner::Rng rng(11);
+  for (int axis = 0; axis < 3; ++axis)
+    for (const double sign : {1.0, -1.0}) {
+      const V a(1, 2, 3);
+      const V b = a + sign * 4.0 * V::Unit(axis);
+      const double c = 5.0;  // r1 = 2.5, r2 = sqrt(25 - 16) / 2 = 1.5
+      const ProlateHyperspheroid set(a, b, c);
+      const ProlateHyperspheroid inner(a, b, 4.5);
+      const int n = 20000;
+      int inside_inner = 0;
+      double widest = 0.0;
+      for (int i = 0; i < n; ++i) {
+        const V x = set.sample(rng);
+        REQUIRE(set.contains(x));
+        inside_inner += inner.contains(x);
+        const V off = (x - a) - (x - a).dot(V::Unit(axis)) * V::Unit(axis);
+        widest = std::max(widest, off.norm());
+      }
+      INFO("axis " << axis << ", sign " << sign);
+      CHECK(widest > 0.9 * 1.5);  // the samples reach the transverse radius r2
+      const double expected = inner.measure() / set.measure();
+      CHECK(std::abs(static_cast<double>(inside_inner) / n - expected) < 6 * std::sqrt(expected * (1 - expected) / n));
+    }
 }

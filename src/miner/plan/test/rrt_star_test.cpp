@@ -1,5 +1,6 @@
 #include <catch2/catch.hpp>
 
+#include <limits>
 #include <tuple>
 #include <type_traits>
 #include <utility>
@@ -438,4 +439,62 @@ TEST_CASE("A planning problem cannot be made from a temporary map", "[REQ-PLAN-0
   STATIC_REQUIRE(can_make<miner::world::Map&>::value);
   STATIC_REQUIRE_FALSE(can_make<miner::world::Map&&>::value);
   STATIC_REQUIRE_FALSE(can_make<miner::world::Map>::value);
+}
+
+TEST_CASE("Tenth campaign: plan() checks a problem however it was filled, and a region's path points first",
+          "[REQ-LIB-003][REQ-PLAN-001][REQ-PLAN-005]") {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const miner::world::Map map(miner::world::Box{{0, 0, 0}, {10, 10, 10}}, 0.5,
+                              {miner::world::Box{{4, 0, 0}, {6, 10, 10}}});
+  PlannerOptions o;
+  o.planner = PlannerKind::kRrtStar;
+  o.max_iterations = 200;
+  // L11: the struct's fields are public; a hand-filled problem gets make()'s checks.
+  PlanningProblem p;
+  p.map = &map;
+  p.start = V(1, 5, 5);
+  p.goal = V(9, 5, 5);
+  p.robot_radius = nan;
+  p.sampled_volume = 1000.0;
+  CHECK_THROWS_WITH(miner::plan::plan(p, o), Contains("robot_radius"));
+  p.robot_radius = 0.2;
+  for (const double volume : {0.0, -1.0, nan}) {
+    p.sampled_volume = volume;
+    CHECK_THROWS_WITH(miner::plan::plan(p, o), Contains("sampled_volume"));
+  }
+  p.sampled_volume = 1000.0;
+  p.start = V(5, 5, 5);  // inside the wall
+  CHECK_THROWS_WITH(miner::plan::plan(p, o), Contains("start") && Contains("inside obstacle 0"));
+  p.start = V(1, 5, nan);
+  CHECK_THROWS_WITH(miner::plan::plan(p, o), Contains("start[2]"));
+  p.start = V(1, 5, 5);
+  CHECK_NOTHROW(miner::plan::plan(p, o));
+  p.map = nullptr;
+  CHECK_THROWS_WITH(miner::plan::plan(p, o), Contains("no map"));
+  // L5: a NaN point anywhere in a region's path is named before any point is walked.
+  CHECK_THROWS_WITH(HeuristicRegion::from_path(map.bounds(), I(32, 32, 32), {V(1, 1, 1), V(nan, 9, 9)}, 1, "x"),
+                    Contains("region path point 1"));
+}
+
+TEST_CASE("A start within the goal radius is joined to the goal only by a free segment", "[REQ-PLAN-001][REQ-PLAN-015]") {
+  // Held-out audit 8, h8-plan-06: with the start inside X_goal the planners returned the direct
+  // segment without a collision check, through a wall 1 m thick. The way round is through the
+  // gap at y > 8: at least 2 x 7 m long.
+  const miner::world::Map map(miner::world::Box{{0, 0, 0}, {10, 10, 4}}, 0.25,
+                              {miner::world::Box{{4.8, 0, 0}, {5.2, 8, 4}}});
+  int solved = 0;
+  for (const PlannerKind kind : {PlannerKind::kRrtStar, PlannerKind::kInformed, PlannerKind::kGuided}) {
+    PlannerOptions o;
+    o.planner = kind;
+    o.goal_radius = 2.0;
+    o.max_iterations = 3000;
+    o.seed = 5;
+    const PlanResult r = miner::plan::plan(PlanningProblem::make(map, V(4.5, 1, 2), V(5.5, 1, 2), 0.1), o);
+    INFO(miner::plan::planner_name(kind));
+    if (!r.solved) continue;
+    ++solved;
+    for (std::size_t i = 1; i < r.path.size(); ++i) CHECK(map.segment_free(r.path[i - 1], r.path[i], 0.1));
+    CHECK(r.cost >= 14.0);
+  }
+  CHECK(solved >= 1);  // the test sees a path, not only refusals
 }

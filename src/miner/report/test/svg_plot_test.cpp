@@ -131,3 +131,14 @@ TEST_CASE("the event timeline has a lane per kind, a bar per interval, counts an
   CHECK_THAT(svg, Contains("height=\"134\""));
   CHECK(svg == svg_event_timeline(axes, lanes, 10.0));
 }
+
+TEST_CASE("Ticks of a finite range too wide or too narrow for a double are refused, not a crash",
+          "[REQ-LIB-003][REQ-REPORT-004]") {
+  // Tenth campaign L6: -1e308 .. 1e308 (its width overflows) and 0 .. 5e-324 (a denormal step)
+  // crashed nice_ticks and every plot drawing such data.
+  CHECK_THROWS_WITH(nice_ticks(-1e308, 1e308), Contains("too wide or too narrow"));
+  CHECK_THROWS_WITH(nice_ticks(0.0, 5e-324), Contains("too wide or too narrow"));
+  CHECK_THROWS_WITH(svg_line_plot(PlotAxes{}, {Series{"a", "red", {0, 1e-300, 1e300}, {-1e308, 0, 1e308}}}),
+                    Contains("nice_ticks"));
+  CHECK(nice_ticks(0.0, 10.0).size() >= 3);
+}

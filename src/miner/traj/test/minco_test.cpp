@@ -134,6 +134,10 @@ TEST_CASE("Bad problems are refused with the field named", "[REQ-TRAJ-007]") {
   p = good;
   p.durations.pop_back();
   CHECK_THROWS_WITH(validate(p), Contains("durations: expected 2 values (one per segment), got 1"));
+  // One too many as well (held-out audit 8, h8-traj-01: extra durations passed validation).
+  p = good;
+  p.durations.push_back(1.0);
+  CHECK_THROWS_WITH(validate(p), Contains("durations: expected 2 values (one per segment), got 3"));
   CHECK_THROWS_WITH(validate(rest_to_rest(3, line({0}), {})), Contains("points: need at least 2 points"));
   CHECK_THROWS_WITH(validate(rest_to_rest(3, line({0, 1, 1}), {1, 1})), Contains("points[1] and points[2] coincide"));
   // The first pair too (held-out audit 6, h6-traj-02: the check started at the second pair).

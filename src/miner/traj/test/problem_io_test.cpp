@@ -99,6 +99,13 @@ TEST_CASE("A trajectory answer file is read strictly: junctions meet, the cost i
   jump["coefficients"][1][0][0] = jump["coefficients"][1][0][0].get<double>() + 0.5;  // position x at the junction
   CHECK_THROWS_WITH(trajectory_from_answer_json(jump, "a.json"),
                     Contains("a.json: coefficients[1]: the position at the start of segment 1") && Contains("would jump"));
+  // A duration that is not positive is named by the reader, in the file's words (held-out
+  // audit 8, h8-traj-02: -10 s was read and the flight then failed on a 448 m/s speed).
+  for (const double bad : {-10.0, 0.0}) {
+    miner::Json negative = good;
+    negative["durations"][0] = bad;
+    CHECK_THROWS_WITH(trajectory_from_answer_json(negative, "a.json"), Contains("a.json: durations[0]: must be positive"));
+  }
   miner::Json kink = good;
   kink["coefficients"][1][1][1] = kink["coefficients"][1][1][1].get<double>() + 0.05;  // velocity y
   CHECK_THROWS_WITH(trajectory_from_answer_json(kink, "a.json"), Contains("the velocity at the start of segment 1"));

@@ -131,6 +131,15 @@ TEST_CASE("Optimised allocation refuses moving ends, naming why", "[REQ-TRAJ-011
   p.head.row(2) << 0.5, 0, 0;
   AllocationOptions o;
   CHECK_THROWS_WITH(optimise_allocation(p, o), Contains("needs a problem at rest at both ends"));
+  // Either end, any derivative above the position (held-out audit 8, h8-traj-03: a moving tail
+  // was optimised).
+  for (const bool at_tail : {false, true})
+    for (int k = 1; k < 4; ++k) {
+      auto q = rest_to_rest(4, zigzag(), {});
+      (at_tail ? q.tail : q.head).row(k) << 0, 0.25, 0;
+      INFO((at_tail ? "tail" : "head") << " derivative " << k);
+      CHECK_THROWS_WITH(optimise_allocation(q, o), Contains("needs a problem at rest at both ends"));
+    }
   o.rho = 0.0;
   CHECK_THROWS_WITH(optimise_allocation(rest_to_rest(4, zigzag(), {}), o), Contains("rho: must be positive"));
 }

@@ -1,9 +1,16 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <limits>
 
 #include "miner/core/error.hpp"
+#include "miner/traj/baselines.hpp"
+#include "miner/traj/collision_repair.hpp"
+#include "miner/traj/minco.hpp"
+#include "miner/traj/optimality_system.hpp"
+#include "miner/traj/time_allocation.hpp"
 #include "miner/traj/trapezoidal_allocation.hpp"
+#include "miner/world/map.hpp"
 
 using namespace miner::traj;
 using Catch::Matchers::Contains;
@@ -28,4 +35,105 @@ TEST_CASE("Trapezoidal allocation refuses non-positive or non-finite limits", "[
   CHECK_THROWS_WITH(trapezoidal_allocation(pts, Limits{0.0, 1.0}), Contains("limits.v_max: must be positive"));
   CHECK_THROWS_WITH(trapezoidal_allocation(pts, Limits{1.0, -1.0}), Contains("limits.a_max: must be positive"));
   CHECK_THROWS_WITH(trapezoidal_allocation(pts, Limits{NAN, 1.0}), Contains("limits.v_max: must be a finite"));
+}
+
+TEST_CASE("Tenth campaign: the trajectory API refuses what would give NaN, garbage or unbounded work, by name",
+          "[REQ-LIB-003][REQ-TRAJ-001][REQ-TRAJ-007][REQ-TRAJ-008]") {
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  // L15: the trapezoid of a negative, NaN or infinite distance, or of limits whose time
+  // overflows, named instead of returned as NaN / inf.
+  CHECK_THROWS_WITH(trapezoidal_duration(-1.0, Limits{2, 1}), Contains("distance"));
+  CHECK_THROWS_WITH(trapezoidal_duration(nan, Limits{2, 1}), Contains("distance"));
+  CHECK_THROWS_WITH(trapezoidal_duration(inf, Limits{2, 1}), Contains("distance"));
+  CHECK_THROWS_WITH(trapezoidal_duration(1.0, Limits{5e-324, 5e-324}), Contains("no finite time"));
+  Eigen::MatrixX3d one(1, 3);
+  one << 0, 0, 0;
+  CHECK_THROWS_WITH(trapezoidal_allocation(one, Limits{2, 1}), Contains("at least 2 points"));
+  Eigen::MatrixX3d far(2, 3);
+  far << -1e300, 0, 0, 1e300, 0, 0;
+  CHECK_THROWS_WITH(trapezoidal_allocation(far, Limits{2, 1}), Contains("points[0] and points[1]"));
+  far(1, 0) = nan;
+  CHECK_THROWS_WITH(trapezoidal_allocation(far, Limits{2, 1}), Contains("points[1]"));
+
+  Eigen::MatrixX3d pts(3, 3);
+  pts << 0, 0, 0, 2, 0, 0, 2, 2, 0;
+  const PolynomialTrajectory t = solve_minco(rest_to_rest(4, pts, {2.0, 2.0}));
+  // L3: a segment index past either end is named (segment 99 read past the coefficients).
+  CHECK_THROWS_WITH(t.evaluate_segment(99, 0.5), Contains("segment 99 does not exist"));
+  CHECK_THROWS_WITH(t.evaluate_segment(-1, 0.5), Contains("segment -1 does not exist"));
+  CHECK_THROWS_WITH(t.evaluate_segment(0, 0.5, -1), Contains("k: the derivative order"));
+  // L4: k < 0 wrote before the row (heap corruption); n < 0 asked for 2^64 bytes.
+  CHECK_THROWS_WITH(monomial_derivative_row(4, -1, 1.0), Contains("derivative order k"));
+  CHECK_THROWS_WITH(monomial_derivative_row(-1, 0, 1.0), Contains("n must be"));
+  // L17: the cost matrix of a negative or NaN duration, a trajectory of order 0 or NaN parts.
+  CHECK_THROWS_WITH(monomial_cost_matrix(3, -1.0), Contains("duration"));
+  CHECK_THROWS_WITH(monomial_cost_matrix(3, nan), Contains("duration"));
+  CHECK_THROWS_WITH(PolynomialTrajectory(0, {1.0}, Eigen::MatrixX3d::Zero(0, 3)), Contains("order"));
+  CHECK_THROWS_WITH(PolynomialTrajectory(3, {-1.0}, Eigen::MatrixX3d::Zero(6, 3)), Contains("durations[0]"));
+  CHECK_THROWS_WITH(PolynomialTrajectory(3, {nan}, Eigen::MatrixX3d::Zero(6, 3)), Contains("durations[0]"));
+  Eigen::MatrixX3d c = Eigen::MatrixX3d::Zero(6, 3);
+  c(2, 1) = nan;
+  CHECK_THROWS_WITH(PolynomialTrajectory(3, {1.0}, c), Contains("coefficients must be finite"));
+  // L13: sample counts and steps are bounded and checked; the answer for a valid count stays.
+  CHECK_THROWS_WITH(sampled_extremes(t, 0), Contains("samples"));
+  CHECK_THROWS_WITH(sampled_extremes(t, -1), Contains("samples"));
+  CHECK_THROWS_WITH(sampled_extremes(t, std::numeric_limits<int>::max()), Contains("samples"));
+  const auto [v, a] = sampled_extremes(t, 32);
+  const auto [v_dense, a_dense] = trajectory_extremes(t, 1e-3);
+  CHECK(v == Approx(v_dense).epsilon(1e-4));
+  CHECK(a == Approx(a_dense).epsilon(1e-4));
+  for (const double step : {0.0, -1.0, nan, inf, 1e-300})
+    CHECK_THROWS_WITH(trajectory_extremes(t, step), Contains("step"));
+  AllocationOptions too_many;
+  too_many.samples_per_segment = 100000000;
+  CHECK_THROWS_WITH(optimise_allocation(rest_to_rest(4, pts, {2.0, 2.0}), too_many), Contains("samples per segment"));
+  // L16: the dense baselines validate their problem and bound their matrices.
+  MincoProblem bad = rest_to_rest(4, pts, {2.0, 2.0});
+  bad.durations[1] = nan;
+  CHECK_THROWS_WITH(solve_closed_form(bad), Contains("durations"));
+  CHECK_THROWS_WITH(solve_kkt_qp(bad), Contains("durations"));
+  CHECK_THROWS_WITH(solve_dense_lu(bad), Contains("durations"));
+  bad.durations = {2.0};
+  CHECK_THROWS_WITH(optimality_system(bad), Contains("durations"));
+  Eigen::MatrixX3d many(kMaxDenseSegments + 2, 3);
+  for (Eigen::Index i = 0; i < many.rows(); ++i) many.row(i) << static_cast<double>(i), 0.0, 0.0;
+  const MincoProblem big = rest_to_rest(3, many, std::vector<double>(static_cast<std::size_t>(many.rows() - 1), 1.0));
+  CHECK_THROWS_WITH(solve_dense_lu(big), Contains("more than the " + std::to_string(kMaxDenseSegments)));
+  CHECK_NOTHROW(solve_minco(big));  // MINCO takes any number
+  CHECK_THROWS_WITH(relative_residual(optimality_system(rest_to_rest(4, pts, {2.0, 2.0})), Eigen::MatrixX3d::Zero(3, 3)),
+                    Contains("coefficient rows"));
+  // L21: a moved-from solver is named, not dereferenced.
+  MincoSolver a;
+  MincoSolver b(std::move(a));
+  PolynomialTrajectory out;
+  CHECK_THROWS_WITH(a.solve(rest_to_rest(4, pts, {2.0, 2.0}), out), Contains("moved from"));  // NOLINT(bugprone-use-after-move)
+  CHECK_NOTHROW(b.solve(rest_to_rest(4, pts, {2.0, 2.0}), out));
+}
+
+TEST_CASE("Collision checks of a trajectory take a robot radius and a positive step", "[REQ-LIB-003][REQ-TRAJ-008]") {
+  // Tenth campaign L10: a NaN or negative radius answered "no colliding segment" for a
+  // trajectory through a wall; a step of 0 was cast from infinity (the pipeline passed 0 and
+  // checked two chords per segment).
+  const miner::world::Map map(miner::world::Box{{0, 0, 0}, {10, 10, 10}}, 0.5,
+                              {miner::world::Box{{4, 0, 0}, {6, 10, 10}}});
+  Eigen::MatrixX3d pts(2, 3);
+  pts << 1, 5, 5, 9, 5, 5;
+  const PolynomialTrajectory through = solve_minco(rest_to_rest(3, pts, {4.0}));
+  CHECK(colliding_segments(through, map, 0.1, 0.05) == std::vector<int>{0});
+  CHECK_THROWS_WITH(colliding_segments(through, map, std::numeric_limits<double>::quiet_NaN(), 0.05), Contains("robot radius"));
+  CHECK_THROWS_WITH(colliding_segments(through, map, -5.0, 0.05), Contains("robot radius"));
+  CHECK_THROWS_WITH(colliding_segments(through, map, 0.1, 0.0), Contains("step"));
+  CHECK_THROWS_WITH(colliding_segments(through, map, 0.1, 1e-300), Contains("step"));
+  RepairOptions o;
+  o.robot_radius = -1.0;
+  Eigen::MatrixX3d path(2, 3);
+  path << 1, 1, 1, 3, 1, 1;
+  CHECK_THROWS_WITH(repair_collisions(map, path, o), Contains("robot radius"));
+  o.robot_radius = 0.2;
+  o.sample_step = -1.0;
+  CHECK_THROWS_WITH(repair_collisions(map, path, o), Contains("sample_step"));
+  // The step the pipeline and the repair share: half a cell, at most the radius.
+  CHECK(collision_sample_step(map, 0.0) == 0.25);
+  CHECK(collision_sample_step(map, 0.1) == 0.1);
+  CHECK(collision_sample_step(map, 0.4) == 0.25);
 }

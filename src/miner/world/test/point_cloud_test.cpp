@@ -247,6 +247,13 @@ TEST_CASE("Malformed point clouds are refused naming the fault, never crash", "[
   refuses(pcd_head + "WIDTH 5\nHEIGHT 1\nPOINTS 2\nDATA ascii\n0 0 1\n0 1 1\n", false,
           "WIDTH x HEIGHT = 5 x 1 does not match POINTS 2");
   refuses(pcd_head + "WIDTH 1\nHEIGHT 0\nPOINTS 1\nDATA ascii\n0 0 1\n", false, "HEIGHT is 0");
+  // An organised cloud: WIDTH x HEIGHT is the point count, HEIGHT counted (held-out audit 8,
+  // h8-world-02: WIDTH alone was compared with POINTS).
+  refuses(pcd_head + "WIDTH 4\nHEIGHT 2\nPOINTS 4\nDATA ascii\n0 0 1\n0 1 1\n1 0 1\n1 1 1\n", false,
+          "WIDTH x HEIGHT = 4 x 2 does not match POINTS 4");
+  CHECK(miner::world::parse_point_cloud(pcd_head + "WIDTH 2\nHEIGHT 2\nPOINTS 4\nDATA ascii\n0 0 1\n0 1 1\n1 0 1\n1 1 1\n",
+                                        false, "organised.pcd")
+            .points.size() == 4);
   refuses(pcd_head + "POINTS 1\nPOINTS 1\nDATA ascii\n0 0 1\n", false, "header line POINTS is given twice");
   refuses(pcd_head + "VIEWPOINT 0 0 0 0 0 0 0\nPOINTS 1\nDATA ascii\n0 0 1\n", false, "not a unit quaternion");
   refuses(pcd_head + "POINTS 1\nDATA binary\n" + std::string(12 + 8, '\0'), false,

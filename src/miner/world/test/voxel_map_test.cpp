@@ -1,17 +1,21 @@
 #include <catch2/catch.hpp>
 
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 
 #include "miner/core/error.hpp"
 #include "miner/core/json_io.hpp"
 #include "miner/core/sha256.hpp"
+#include "miner/world/astar.hpp"
 #include "miner/world/map.hpp"
 #include "miner/world/octree_io.hpp"
 #include "miner/world/voxel_grid.hpp"
 #include "test_maps.hpp"
 
 using namespace miner::world;
+using miner::Error;
 using Catch::Matchers::Contains;
 using V = Eigen::Vector3d;
 
@@ -156,4 +160,85 @@ TEST_CASE("A voxel map's grid grows a blocked voxel by the robot radius: cubes t
   CHECK(under.occupied_count() == 27);
   CHECK_FALSE(under.occupied(Eigen::Vector3i(0, 2, 2)));
   CHECK(VoxelGrid(open, 1.0).occupied(Eigen::Vector3i(0, 2, 2)));
+}
+
+TEST_CASE("Tenth campaign: the map's API refuses what it cannot answer, by name, and never crashes",
+          "[REQ-LIB-003][REQ-WORLD-002][REQ-WORLD-013][REQ-WORLD-008]") {
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  const Map voxels = Map::from_voxels({small_layer(), UnknownPolicy::kOccupied, "", ""});
+  const Map boxes(Box{{0, 0, 0}, {10, 10, 10}}, 0.5, {Box{{4, 0, 0}, {6, 10, 10}}});
+  for (const Map* m : {&voxels, &boxes}) {
+    // L1: a NaN or infinite point read the voxel layer at cell -2^31 (a segmentation fault).
+    CHECK_THROWS_WITH(m->point_collision(V(nan, 1, 1)), Contains("point_collision: p[0]"));
+    CHECK_THROWS_WITH(m->point_collision(V(1, 1, 1), nan), Contains("point_collision: radius"));
+    CHECK_THROWS_WITH(m->point_collision(V(1, 1, 1), -1.0), Contains("point_collision: radius"));
+    CHECK_THROWS_WITH(m->clearance(V(1, nan, 1)), Contains("clearance: p[1]"));
+    CHECK_THROWS_WITH(m->raycast(V(1, 1, 1), V(nan, 0, 0), 10.0), Contains("raycast: dir[0]"));
+    CHECK_THROWS_WITH(m->raycast(V(nan, 1, 1), V(1, 0, 0), 10.0), Contains("raycast: origin[0]"));
+    CHECK_THROWS_WITH(m->raycast(V(1, 1, 1), V(1, 0, 0), nan), Contains("raycast: max_range"));
+    CHECK_THROWS_WITH(m->segment_collision(V(1, 1, 1), V(inf, 1, 1), 0.1), Contains("segment_collision: b[0]"));
+    CHECK_THROWS_WITH(m->is_free(V(1, 1, nan)), Contains("p[2]"));
+    // L10: require_free checks the radius it is given like every reader does.
+    CHECK_THROWS_WITH(m->require_free(V(0.5, 0.5, 0.5), nan, "start"), Contains("start: robot radius"));
+    CHECK_THROWS_WITH(m->require_free(V(0.5, 0.5, 0.5), -5.0, "start"), Contains("start: robot radius"));
+    CHECK_THROWS_AS(VoxelGrid(*m, 10.5), Error);
+    // L3: an obstacle index past the map's boxes and voxels is named, not read.
+    const std::size_t past = m->obstacles().size() + (m->voxels() ? m->voxels()->layer().size() : 0);
+    CHECK_THROWS_WITH(m->obstacle_box(past), Contains("obstacle index " + std::to_string(past)));
+    CHECK_THROWS_WITH(m->obstacle_name(SIZE_MAX), Contains("obstacle index"));
+    CHECK_NOTHROW(m->obstacle_box(past - 1));
+  }
+  // Finite queries keep their answers.
+  CHECK(voxels.point_collision(V(2.5, 2.5, 2.5)).has_value());
+  CHECK_FALSE(boxes.point_collision(V(1, 1, 1)).has_value());
+  // L2: a missing layer is named wherever it is given.
+  CHECK_THROWS_WITH(Map::from_voxels(VoxelSource{}), Contains("voxels: no layer"));
+  CHECK_THROWS_WITH(VoxelObstacles(nullptr, UnknownPolicy::kOccupied), Contains("voxels: no layer"));
+  // L8: bounds beyond the voxels, under the occupied policy, are refused by the constructor as
+  // by the reader; with unknown space free they are accepted.
+  VoxelSource source{small_layer(), UnknownPolicy::kOccupied, "", ""};
+  CHECK_THROWS_WITH(Map(Box{{0, 0, 0}, {12, 4, 4}}, 1.0, {}, std::nullopt, source), Contains("reaches beyond the voxels"));
+  source.unknown = UnknownPolicy::kFree;
+  CHECK_FALSE(Map(Box{{0, 0, 0}, {12, 4, 4}}, 1.0, {}, std::nullopt, source).point_collision(V(8, 2, 2)).has_value());
+  // L9: obstacles beyond the metric range, and a stored query inside an obstacle (C1).
+  CHECK_THROWS_WITH(Map(Box{{0, 0, 0}, {10, 10, 10}}, 0.5, {Box{{-1e300, 0, 0}, {1e300, 1, 1}}}),
+                    Contains("obstacles[0]") && Contains("farther than"));
+  CHECK_THROWS_WITH(Map(Box{{0, 0, 0}, {10, 10, 10}}, 0.5, {Box{{0, 0, 0}, {2, 2, 2}}},
+                        Query{V(1, 1, 1), V(9, 9, 9), 0.2}),
+                    Contains("query.start") && Contains("inside obstacle 0"));
+  CHECK_THROWS_WITH(Map(Box{{0, 0, 0}, {10, 10, 10}}, 0.5, {Box{{0, 0, 0}, {2, 2, 2}}},
+                        Query{V(9, 9, 9), V(2.1, 1, 1), 0.2}),
+                    Contains("query.goal") && Contains("robot radius"));
+  // L22: a layer whose cell indices would wrap, and one of an impossible resolution.
+  CHECK_THROWS_WITH(VoxelLayer(Eigen::Vector3i(std::numeric_limits<int>::max(), 0, 0), 0.1, Eigen::Vector3i(2, 1, 1),
+                               std::vector<std::uint8_t>(2, 0)),
+                    Contains("leaves the range of cell indices"));
+  CHECK_THROWS_WITH(VoxelLayer(Eigen::Vector3i::Zero(), 1e-300, Eigen::Vector3i(1, 1, 1), std::vector<std::uint8_t>(1, 0)),
+                    Contains("voxel resolution"));
+  CHECK(octile_distance(Eigen::Vector3i(std::numeric_limits<int>::min(), 0, 0),
+                        Eigen::Vector3i(std::numeric_limits<int>::max(), 0, 0), 1.0) == 4294967295.0);
+}
+
+TEST_CASE("A* refuses a grid built from another map: its path would ignore this map's obstacles",
+          "[REQ-LIB-003][REQ-WORLD-008]") {
+  // Tenth campaign L7: a grid of the empty map, same bounds and resolution, walked A* through
+  // the wall of this one.
+  const Map walls(Box{{0, 0, 0}, {10, 10, 10}}, 0.5, {Box{{4, 0, 0}, {6, 4, 10}}});
+  const Map empty(Box{{0, 0, 0}, {10, 10, 10}}, 0.5, {});
+  const VoxelGrid of_empty(empty, 0.0), of_walls(walls, 0.0);
+  CHECK_THROWS_WITH(astar(walls, of_empty, V(1, 1, 1), V(9, 1, 1)), Contains("the grid was built from another map"));
+  CHECK_THROWS_WITH(astar(empty, of_walls, V(1, 1, 1), V(9, 1, 1)), Contains("the grid was built from another map"));
+  // A copy of the map, or the same geometry built again, is the same map.
+  const Map copy = walls;
+  const Map again(Box{{0, 0, 0}, {10, 10, 10}}, 0.5, {Box{{4, 0, 0}, {6, 4, 10}}});
+  CHECK(copy.fingerprint() == walls.fingerprint());
+  CHECK(again.fingerprint() == walls.fingerprint());
+  const GridPath path = astar(again, of_walls, V(1, 1, 1), V(9, 1, 1));
+  for (std::size_t i = 1; i < path.points.size(); ++i) CHECK(walls.segment_free(path.points[i - 1], path.points[i]));
+  // Any change of what the queries answer changes the fingerprint: an obstacle moved by 1 mm,
+  // the resolution, the voxels' unknown policy.
+  CHECK(Map(Box{{0, 0, 0}, {10, 10, 10}}, 0.5, {Box{{4, 0, 0}, {6.001, 4, 10}}}).fingerprint() != walls.fingerprint());
+  CHECK(Map(Box{{0, 0, 0}, {10, 10, 10}}, 0.25, {Box{{4, 0, 0}, {6, 4, 10}}}).fingerprint() != walls.fingerprint());
+  const Map voxels = Map::from_voxels({small_layer(), UnknownPolicy::kOccupied, "", ""});
+  CHECK(voxels.with_unknown(UnknownPolicy::kFree).fingerprint() != voxels.fingerprint());
 }

@@ -68,11 +68,18 @@ Map random_box_map(Rng& rng) {
 }
 
 /// A random voxel layer on the lattice of `res` overlapping [0, 10]^3 (partly outside it at
-/// times): free background, occupied and unknown blocks, scattered single voxels.
-std::shared_ptr<const VoxelLayer> random_layer(Rng& rng, double res) {
+/// times), or with `cover` holding all of it (a map whose unknown space is occupied must not
+/// reach beyond its voxels, REQ-WORLD-013): free background, occupied and unknown blocks,
+/// scattered single voxels.
+std::shared_ptr<const VoxelLayer> random_layer(Rng& rng, double res, bool cover = false) {
   const int side = static_cast<int>(std::round(10.0 / res));
   Eigen::Vector3i origin, dims;
   for (int k = 0; k < 3; ++k) {
+    if (cover) {
+      origin[k] = -static_cast<int>(rng.uniform_index(3));
+      dims[k] = side - origin[k] + static_cast<int>(rng.uniform_index(3));
+      continue;
+    }
     origin[k] = static_cast<int>(rng.uniform_index(side / 2 + 3)) - 2;
     dims[k] = 1 + static_cast<int>(rng.uniform_index(side));
   }
@@ -98,8 +105,8 @@ std::shared_ptr<const VoxelLayer> random_layer(Rng& rng, double res) {
 Map random_map(Rng& rng) {
   const Map boxes = random_box_map(rng);
   if (rng.uniform01() < 0.5) return boxes;
-  VoxelSource source{random_layer(rng, boxes.resolution()),
-                     rng.uniform01() < 0.5 ? UnknownPolicy::kOccupied : UnknownPolicy::kFree, "", ""};
+  const UnknownPolicy policy = rng.uniform01() < 0.5 ? UnknownPolicy::kOccupied : UnknownPolicy::kFree;
+  VoxelSource source{random_layer(rng, boxes.resolution(), policy == UnknownPolicy::kOccupied), policy, "", ""};
   return Map(boxes.bounds(), boxes.resolution(), boxes.obstacles(), std::nullopt, std::move(source));
 }
 

@@ -352,12 +352,18 @@ PYBIND11_MODULE(_miner, m) {
                            py::object dilation_arg) {
         const Map& map = object_of<Map>(map_arg, "map", "Map");
         const Query q = resolve(map, start, goal, radius);
-        const std::vector<double> d = vector_of(dims_arg, "dims");
+        // Read once into a list (an iterator is consumed once), then each entry as an integer
+        // in [1, 4096] by Python's own rules (a bool is no integer here).
+        py::list d;
+        try {
+          d = py::list(dims_arg);
+        } catch (const py::error_already_set&) {
+          throw miner::Error("dims: expected 3 integers nx ny nz, got " + type_name(dims_arg));
+        }
         if (d.size() != 3) throw miner::Error("dims: expected 3 integers nx ny nz, got " + std::to_string(d.size()));
-        Eigen::Vector3i dims;  // the array read once: each entry a whole number in [1, 4096]
+        Eigen::Vector3i dims;
         for (int k = 0; k < 3; ++k)
-          dims[k] = static_cast<int>(integer_in(py::float_(d[static_cast<std::size_t>(k)]),
-                                                "dims[" + std::to_string(k) + "]", 1, 4096));
+          dims[k] = static_cast<int>(integer_in(d[static_cast<std::size_t>(k)], "dims[" + std::to_string(k) + "]", 1, 4096));
         const int dilation = static_cast<int>(integer_in(dilation_arg, "dilation", 0, 4));
         const auto problem = miner::plan::PlanningProblem::make(map, q.start, q.goal, q.radius);
         return miner::plan::astar_dilated_region(problem, miner::plan::astar_reference(problem), dims, dilation);

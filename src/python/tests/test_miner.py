@@ -228,8 +228,10 @@ def test_none_for_an_object_and_whole_floats_for_integers():
     assert list(miner.astar_region(m, dims=np.array([8.0, 8.0, 4.0])).dims) == [8, 8, 4]
     with pytest.raises(miner.Error, match=r"dims\[0\]"):
         miner.astar_region(m, dims=[8.5, 8, 4])
-    # dims is read once: a tuple, a list and an array give the same region; a one-shot
-    # iterator is refused by name, never half-read.
+    # dims is read once: a tuple, a list, an array and a one-shot iterator give the same region;
+    # what is not a sequence of 3 is named.
     assert list(miner.astar_region(m, dims=(8, 8, 4)).dims) == [8, 8, 4]
-    with pytest.raises(miner.Error, match="dims"):
-        miner.astar_region(m, dims=iter([8, 8, 4]))
+    assert list(miner.astar_region(m, dims=iter([8, 8, 4])).dims) == [8, 8, 4]
+    for bad in (5, [8, 8], "884"):
+        with pytest.raises(miner.Error, match="dims"):
+            miner.astar_region(m, dims=bad)

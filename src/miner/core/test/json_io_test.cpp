@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include <unistd.h>
 
@@ -291,13 +292,13 @@ TEST_CASE("A path holding a NUL byte is refused, not opened cut short", "[REQ-CO
   CHECK(read_all(good) == "{}\n");  // nothing was written through the cut path
 }
 
-TEST_CASE("An atomic folder holds plain names only; an atomic write names an empty or repeated file before writing",
+TEST_CASE("An atomic folder holds plain names only and an atomic write names an empty or repeated file before writing",
           "[REQ-LIB-003][REQ-CORE-004]") {
   // Tenth campaign L20: "../x" and absolute names were written outside the folder; L18: an
   // empty name and one file given twice failed at the rename with "cannot replace file: Success".
   const std::filesystem::path dir = temp_dir("plain_names");
   const std::string out = (dir / "run").string();
-  for (const std::string name : {"../escaped.txt", (dir / "abs.txt").string(), "sub/x.txt", "..", ""})
+  for (const std::string& name : std::vector<std::string>{"../escaped.txt", (dir / "abs.txt").string(), "sub/x.txt", "..", ""})
     CHECK_THROWS_WITH(miner::write_folder_atomic(out, {{"a.txt", "a"}, {name, "x"}}), Contains("not a plain name"));
   CHECK_FALSE(std::filesystem::exists(dir / "escaped.txt"));
   CHECK_FALSE(std::filesystem::exists(dir / "abs.txt"));

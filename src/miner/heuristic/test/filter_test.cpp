@@ -234,7 +234,7 @@ TEST_CASE("With the widest rule the raw region joins start and goal whenever non
   CHECK(heuristic::region_threshold(g.p, g.env, kDims, {0, 1, 1}, {7, 1, 1}, 0.2, true) == Approx(0.1f));
 }
 
-TEST_CASE("Tenth campaign: the filter refuses cells outside its grid and a NaN threshold; a moved-from network is named",
+TEST_CASE("Tenth campaign: the filter refuses cells outside its grid and a NaN threshold and a moved-from network is named",
           "[REQ-LIB-003][REQ-HEUR-007]") {
   using Catch::Matchers::Contains;
   Grid g;

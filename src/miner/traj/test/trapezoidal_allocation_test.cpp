@@ -103,11 +103,11 @@ TEST_CASE("Tenth campaign: the trajectory API refuses what would give NaN, garba
   CHECK_THROWS_WITH(relative_residual(optimality_system(rest_to_rest(4, pts, {2.0, 2.0})), Eigen::MatrixX3d::Zero(3, 3)),
                     Contains("coefficient rows"));
   // L21: a moved-from solver is named, not dereferenced.
-  MincoSolver a;
-  MincoSolver b(std::move(a));
+  MincoSolver from;
+  MincoSolver to(std::move(from));
   PolynomialTrajectory out;
-  CHECK_THROWS_WITH(a.solve(rest_to_rest(4, pts, {2.0, 2.0}), out), Contains("moved from"));  // NOLINT(bugprone-use-after-move)
-  CHECK_NOTHROW(b.solve(rest_to_rest(4, pts, {2.0, 2.0}), out));
+  CHECK_THROWS_WITH(from.solve(rest_to_rest(4, pts, {2.0, 2.0}), out), Contains("moved from"));  // NOLINT(bugprone-use-after-move)
+  CHECK_NOTHROW(to.solve(rest_to_rest(4, pts, {2.0, 2.0}), out));
 }
 
 TEST_CASE("Collision checks of a trajectory take a robot radius and a positive step", "[REQ-LIB-003][REQ-TRAJ-008]") {

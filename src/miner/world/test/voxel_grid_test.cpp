@@ -35,7 +35,7 @@ TEST_CASE("The robot radius inflates obstacles by whole cells it reaches into", 
   CHECK(grid.occupied(I(3, 3, 5)));
   CHECK_FALSE(grid.occupied(I(2, 3, 5)));
   CHECK(grid.robot_radius() == 0.5);
-  CHECK_THROWS_WITH(VoxelGrid(map, -1.0), Contains("robot radius: must not be negative"));
+  CHECK_THROWS_WITH(VoxelGrid(map, -1.0), Contains("robot radius: -1 m is outside [0, 10] m"));
 }
 
 TEST_CASE("Cells whose centre lies outside the bounds are occupied", "[REQ-WORLD-006]") {

@@ -12,11 +12,16 @@ std::size_t KdTree::insert(const Eigen::Vector3d& p) {
   const auto index = static_cast<std::uint32_t>(nodes_.size());
   Node node;
   node.p = p;
+  std::size_t depth = 1;
   if (!nodes_.empty()) {
     std::uint32_t at = 0;
-    for (;;) {
+    for (;; ++depth) {
       Node& n = nodes_[at];
-      const int side = p[n.axis] < n.p[n.axis] ? 0 : 1;
+      int side = p[n.axis] < n.p[n.axis] ? 0 : 1;
+      if (p[n.axis] == n.p[n.axis]) {  // equal to the split: the two sides in turn
+        side = n.tie_side;
+        n.tie_side ^= 1U;
+      }
       if (n.child[side] == kNone) {
         n.child[side] = index;
         node.axis = (n.axis + 1) % 3;
@@ -26,6 +31,7 @@ std::size_t KdTree::insert(const Eigen::Vector3d& p) {
     }
   }
   nodes_.push_back(node);
+  height_ = std::max(height_, depth + (nodes_.size() > 1 ? 1 : 0));
   return index;
 }
 
@@ -71,8 +77,8 @@ void KdTree::within(const Eigen::Vector3d& q, double r, std::vector<std::size_t>
     const Node& n = nodes_[at];
     if ((n.p - q).squaredNorm() <= r2) out.push_back(at);
     const double diff = q[n.axis] - n.p[n.axis];
-    // Left subtree holds coordinates < split: reachable if q - r < split.
-    if (n.child[0] != kNone && diff - r < 0.0) stack.push_back(n.child[0]);
+    // Left subtree holds coordinates <= split: reachable if q - r <= split.
+    if (n.child[0] != kNone && diff - r <= 0.0) stack.push_back(n.child[0]);
     if (n.child[1] != kNone && diff + r >= 0.0) stack.push_back(n.child[1]);
   }
   std::sort(out.begin(), out.end());

@@ -1,6 +1,8 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <cmath>
+#include <vector>
 
 #include "miner/core/error.hpp"
 #include "miner/core/rng.hpp"
@@ -109,4 +111,47 @@ TEST_CASE("A radius query returns the closed ball: points exactly at distance r 
   tree.within(V::Zero(), 3.0, got);
   CHECK(has(V(1, 2, 2)));
   CHECK(has(V(-2, 1, -2)));
+}
+
+TEST_CASE("Points equal to a split go to both sides in turn: duplicates make a shallow tree and exact answers",
+          "[REQ-PLAN-006][REQ-LIB-003]") {
+  // Tenth campaign L14: equal coordinates all went to the >= side, so 10^5 copies of one point
+  // made a chain 10^5 deep (insertion quadratic, over 20 s).
+  KdTree same;
+  const int n = 1 << 14;
+  for (int i = 0; i < n; ++i) same.insert(V(1, 1, 1));
+  CHECK(same.height() <= 2 * 14 + 2);  // a chain would be 16384
+  CHECK(same.nearest(V(1, 1, 1)) == 0);
+  CHECK(same.nearest(V(5, 5, 5)) == 0);
+  std::vector<std::size_t> out;
+  same.within(V(1, 1, 1), 0.0, out);
+  CHECK(out.size() == static_cast<std::size_t>(n));
+  // Duplicates and ties on one axis mixed with random points: the answers are a linear scan's,
+  // the closed ball on both sides of every split (points equal to a split sit on either side).
+  miner::Rng rng(13);
+  KdTree tree;
+  std::vector<V> points;
+  for (int i = 0; i < 3000; ++i) {
+    const double u = rng.uniform01();
+    const V p = u < 0.3 ? V(2, 2, 2)
+                : u < 0.6 ? V(std::round(4 * rng.uniform01()) / 2, 2, std::round(4 * rng.uniform01()) / 2)
+                          : V(4 * rng.uniform01(), 4 * rng.uniform01(), 4 * rng.uniform01());
+    tree.insert(p);
+    points.push_back(p);
+  }
+  CHECK(tree.height() < 200);
+  for (int k = 0; k < 300; ++k) {
+    const V q = k % 3 == 0 ? V(2, 2, 2) : k % 3 == 1 ? V(std::round(4 * rng.uniform01()) / 2, 2, 1.5)
+                                                  : V(4 * rng.uniform01(), 4 * rng.uniform01(), 4 * rng.uniform01());
+    std::size_t best = 0;
+    for (std::size_t i = 1; i < points.size(); ++i)
+      if ((points[i] - q).squaredNorm() < (points[best] - q).squaredNorm()) best = i;
+    CHECK(tree.nearest(q) == best);
+    const double r = k % 2 == 0 ? 0.5 : 0.0;
+    std::vector<std::size_t> expected;
+    for (std::size_t i = 0; i < points.size(); ++i)
+      if ((points[i] - q).squaredNorm() <= r * r) expected.push_back(i);
+    tree.within(q, r, out);
+    CHECK(out == expected);
+  }
 }

@@ -438,6 +438,12 @@ std::uint8_t passability_of(std::uint64_t free_subcells) {
 
 std::vector<std::uint8_t> encode_state(const world::Box& b, const Eigen::Vector3i& dims, const Eigen::Vector3d& start,
                                        const Eigen::Vector3d& goal, int dilation) {
+  // Tenth campaign L17: a NaN start and a dilation of -1 encoded silently.
+  require_finite(start, "state: start");
+  require_finite(goal, "state: goal");
+  if ((dims.array() < 1).any()) throw Error("state: every grid dimension must be at least 1");
+  if (dilation < 0 || dilation > dims.maxCoeff())
+    throw Error("state: dilation must be in [0, " + std::to_string(dims.maxCoeff()) + "] cells, got " + std::to_string(dilation));
   std::vector<std::uint8_t> s(static_cast<std::size_t>(dims.prod()), 0);
   for (const Eigen::Vector3d& p : {start, goal}) {
     const Eigen::Vector3i c = cell_of(b, dims, p);
@@ -449,7 +455,25 @@ std::vector<std::uint8_t> encode_state(const world::Box& b, const Eigen::Vector3
   return s;
 }
 
+namespace {
+
+/// A mask of dims.prod() cells (tenth campaign L17: a mask of 5 cells for 32^3 was read past).
+void require_mask(const std::vector<std::uint8_t>& mask, const Eigen::Vector3i& dims) {
+  if ((dims.array() < 1).any() || static_cast<double>(dims.x()) * dims.y() * dims.z() != static_cast<double>(mask.size()))
+    throw Error("grid mask: " + std::to_string(mask.size()) + " cells for a grid of " + std::to_string(dims.x()) + " x " +
+                std::to_string(dims.y()) + " x " + std::to_string(dims.z()));
+}
+
+void require_cell(const Eigen::Vector3i& c, const Eigen::Vector3i& dims, const char* name) {
+  if ((c.array() < 0).any() || (c.array() >= dims.array()).any())
+    throw Error(std::string("grid cell ") + name + " (" + std::to_string(c.x()) + ", " + std::to_string(c.y()) + ", " +
+                std::to_string(c.z()) + ") lies outside the grid");
+}
+
+}  // namespace
+
 std::vector<int> label_components(const std::vector<std::uint8_t>& mask, const Eigen::Vector3i& dims) {
+  require_mask(mask, dims);
   std::vector<int> label(mask.size(), 0);
   std::deque<std::size_t> queue;
   int next = 0;
@@ -514,6 +538,9 @@ std::vector<std::uint8_t> component_of(const std::vector<std::uint8_t>& mask, co
 
 bool connects(const std::vector<std::uint8_t>& mask, const Eigen::Vector3i& dims, const Eigen::Vector3i& a,
               const Eigen::Vector3i& b) {
+  require_mask(mask, dims);
+  require_cell(a, dims, "a");
+  require_cell(b, dims, "b");
   const std::size_t ia = cell_index(dims, a.x(), a.y(), a.z());
   const std::size_t ib = cell_index(dims, b.x(), b.y(), b.z());
   if (!mask[ia] || !mask[ib]) return false;

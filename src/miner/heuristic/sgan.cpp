@@ -686,6 +686,9 @@ std::vector<float> scale_input(const world::Box& bounds, const Eigen::Vector3i& 
                                double divisor) {
   if (!(std::isfinite(robot_radius) && robot_radius >= 0.0))
     throw Error("sgan: the robot radius must be >= 0 and finite for the scale input");
+  if (!(std::isfinite(divisor) && divisor > 0.0))
+    throw Error("sgan: the scale divisor must be positive and finite, got " + short_number(divisor));
+  if ((dims.array() < 1).any()) throw Error("sgan: every grid dimension must be at least 1 for the scale input");
   std::vector<float> sigma(3);
   for (int a = 0; a < 3; ++a) {
     const double cell = (bounds.max[a] - bounds.min[a]) / dims[a];

@@ -5,12 +5,17 @@
 
 #include <Eigen/Geometry>
 
+#include "miner/core/error.hpp"
 #include "miner/core/rng.hpp"
 
 namespace miner::plan {
 
 ProlateHyperspheroid::ProlateHyperspheroid(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double c)
     : a_(a), b_(b), centre_(0.5 * (a + b)) {
+  // Tenth campaign L17: NaN or infinite foci or diameter gave NaN samples.
+  require_finite(a, "informed set: focus a");
+  require_finite(b, "informed set: focus b");
+  require_finite(c, "informed set: transverse diameter c");
   const double c_min = (b - a).norm();
   c_ = std::max(c, c_min);
   r1_ = 0.5 * c_;

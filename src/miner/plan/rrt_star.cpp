@@ -471,6 +471,7 @@ PlanResult plan(const PlanningProblem& problem, const PlannerOptions& options, c
 }
 
 void add_setup_time(PlanResult& result, double ms) {
+  if (!(std::isfinite(ms) && ms >= 0.0)) throw Error("setup time: must be a finite time >= 0 ms, got " + short_number(ms));
   result.time_ms += ms;
   if (result.first) result.first->time_ms += ms;
   if (result.target) result.target->time_ms += ms;

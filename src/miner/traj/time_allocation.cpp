@@ -16,6 +16,9 @@ namespace miner::traj {
 
 void scale_time(PolynomialTrajectory& t, double k) {
   if (!(k > 0.0) || !std::isfinite(k)) throw Error("scale_time: k must be positive and finite");
+  // The scaled durations stay finite (tenth campaign L17: k = 1e300 made infinite ones).
+  for (const double d : t.durations())
+    if (!std::isfinite(d * k)) throw Error("scale_time: k = " + short_number(k) + " makes a duration infinite");
   auto& c = t.mutable_coefficients();
   const int n = 2 * t.order();
   for (int i = 0; i < t.segments(); ++i) {
@@ -192,6 +195,9 @@ void validate(const AllocationOptions& o) {
 std::pair<double, double> feasible_objective(const MincoProblem& problem, const std::vector<double>& durations,
                                              const AllocationOptions& options) {
   validate(options);
+  validate(problem);
+  if (durations.size() + 1 != static_cast<std::size_t>(problem.points.rows()))
+    throw Error("durations: " + std::to_string(durations.size()) + " for " + std::to_string(problem.points.rows() - 1) + " segments");
   MincoSolver solver;
   Evaluation e;
   if (!evaluate(problem, durations, options, solver, e))
@@ -202,6 +208,9 @@ std::pair<double, double> feasible_objective(const MincoProblem& problem, const 
 std::pair<double, std::vector<double>> log_time_objective(const MincoProblem& problem, const std::vector<double>& tau,
                                                           const AllocationOptions& options) {
   validate(options);
+  validate(problem);
+  if (tau.size() + 1 != static_cast<std::size_t>(problem.points.rows()))
+    throw Error("tau: " + std::to_string(tau.size()) + " log-durations for " + std::to_string(problem.points.rows() - 1) + " segments");
   std::vector<double> start(tau.size());
   for (std::size_t i = 0; i < tau.size(); ++i) start[i] = std::exp(tau[i]);
   const AllocationObjective objective(problem, options, start);

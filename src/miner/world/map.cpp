@@ -65,6 +65,11 @@ void check_robot_radius(double radius, const std::string& field) {
 }
 
 Eigen::Vector3i grid_dims(const Box& bounds, double resolution) {
+  // Tenth campaign L17: NaN bounds gave one cell.
+  require_finite(bounds.min, "bounds.min");
+  require_finite(bounds.max, "bounds.max");
+  if (!(std::isfinite(resolution) && resolution > 0.0))
+    throw Error("resolution: must be a positive finite length, got " + short_number(resolution));
   // Snaps in the cell count: a face within this many cells of a whole number is on it.
   constexpr double kGridSnapTolerance = 1e-9;
   const Eigen::Vector3d extent = bounds.extent();

@@ -248,6 +248,23 @@ std::shared_ptr<const VoxelLayer> layer_from_leaves(const std::vector<OctreeLeaf
 std::shared_ptr<const VoxelLayer> layer_from_leaves(const std::vector<OctreeLeaf>& leaves, double resolution,
                                                     const std::string& origin, double max_cells) {
   if (leaves.empty()) fail(origin, "the tree has no known leaf");
+  // Tenth campaign L18: a NaN or infinite budget asked for 2^48 bytes (bad_alloc); a leaf below
+  // the tree's depth or off its own lattice made a std::length_error or overlapping voxels.
+  if (!(max_cells >= 1.0 && max_cells <= kMaxGridCells)) {
+    std::ostringstream os;
+    os << "the cell budget must be in [1, " << kMaxGridCells << "], got " << max_cells;
+    fail(origin, os.str());
+  }
+  for (std::size_t i = 0; i < leaves.size(); ++i) {
+    const Leaf& l = leaves[i];
+    if (l.depth > kTreeDepth) fail(origin, "leaf " + std::to_string(i) + " has depth " + std::to_string(l.depth) +
+                                               ", below the tree's " + std::to_string(kTreeDepth));
+    const std::int64_t size = std::int64_t{1} << (kTreeDepth - l.depth);
+    for (int a = 0; a < 3; ++a)
+      if (l.key[a] % size != 0)
+        fail(origin, "leaf " + std::to_string(i) + "'s key " + std::to_string(l.key[a]) + " is not on its depth's lattice (multiples of " +
+                         std::to_string(size) + ")");
+  }
   std::array<std::int64_t, 3> lo{}, hi{};
   lo.fill(INT64_MAX);
   hi.fill(INT64_MIN);

@@ -57,6 +57,11 @@ void distance_transform_1d(const std::vector<double>& f, std::vector<double>& ou
 
 std::vector<double> squared_distance_transform(const std::vector<std::uint8_t>& seeds, const Eigen::Vector3i& n,
                                                bool cube_to_cube) {
+  // Tenth campaign L17/L18: seeds shorter than the grid were read past their end, negative dims
+  // escaped as std::length_error.
+  if ((n.array() < 1).any() || static_cast<double>(n.x()) * n.y() * n.z() != static_cast<double>(seeds.size()))
+    throw Error("distance transform: " + std::to_string(seeds.size()) + " seeds for a grid of " + std::to_string(n.x()) +
+                " x " + std::to_string(n.y()) + " x " + std::to_string(n.z()) + " cells");
   std::vector<double> sq(seeds.size());
   for (std::size_t i = 0; i < seeds.size(); ++i) sq[i] = seeds[i] ? 0.0 : kInf;
   const int longest = n.maxCoeff();

@@ -258,3 +258,21 @@ TEST_CASE("Tenth campaign: the filter refuses cells outside its grid and a NaN t
   CHECK_THROWS_WITH(a.architecture(), Contains("moved from"));  // NOLINT(bugprone-use-after-move)
   CHECK(b.architecture().dims == Eigen::Vector3i(32, 32, 32));
 }
+
+TEST_CASE("Tenth campaign: grid masks cells dilations and scale divisors are checked before use", "[REQ-LIB-003][REQ-HEUR-004]") {
+  using Catch::Matchers::Contains;
+  const Eigen::Vector3i d(4, 4, 4);
+  CHECK_THROWS_WITH(heuristic::label_components(std::vector<std::uint8_t>(5, 1), Eigen::Vector3i(32, 32, 32)),
+                    Contains("grid mask: 5 cells"));
+  const std::vector<std::uint8_t> full(64, 1);
+  CHECK(heuristic::connects(full, d, Eigen::Vector3i(0, 0, 0), Eigen::Vector3i(3, 3, 3)));
+  CHECK_THROWS_WITH(heuristic::connects(full, d, Eigen::Vector3i(-1, 0, 0), Eigen::Vector3i(3, 3, 3)), Contains("grid cell a"));
+  CHECK_THROWS_WITH(heuristic::connects(full, d, Eigen::Vector3i(0, 0, 0), Eigen::Vector3i(5, 5, 5)), Contains("grid cell b"));
+  const miner::world::Box b{{0, 0, 0}, {4, 4, 4}};
+  CHECK_THROWS_WITH(heuristic::encode_state(b, d, Eigen::Vector3d(1, 1, 1), Eigen::Vector3d(3, 3, 3), -1), Contains("dilation"));
+  CHECK_THROWS_WITH(heuristic::encode_state(b, d, Eigen::Vector3d(NAN, 1, 1), Eigen::Vector3d(3, 3, 3), 1),
+                    Contains("state: start[0]"));
+  CHECK(heuristic::encode_state(b, d, Eigen::Vector3d(0.5, 0.5, 0.5), Eigen::Vector3d(3.5, 3.5, 3.5), 0)[0] == 1);
+  CHECK_THROWS_WITH(heuristic::scale_input(b, d, 0.2, 0.0), Contains("scale divisor"));
+  CHECK_THROWS_WITH(heuristic::scale_input(b, d, 0.2, NAN), Contains("scale divisor"));
+}

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "miner/core/rng.hpp"
 #include "miner/plan/informed_set.hpp"
@@ -111,4 +112,12 @@ TEST_CASE("Informed-set samples fill the set when the foci lie along a coordinat
       const double expected = inner.measure() / set.measure();
       CHECK(std::abs(static_cast<double>(inside_inner) / n - expected) < 6 * std::sqrt(expected * (1 - expected) / n));
     }
+}
+
+TEST_CASE("An informed set of non-finite foci or diameter is refused, not sampled as NaN", "[REQ-LIB-003][REQ-PLAN-002]") {
+  using Catch::Matchers::Contains;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  CHECK_THROWS_WITH(ProlateHyperspheroid(V(nan, 0, 0), V(1, 0, 0), 2.0), Contains("focus a"));
+  CHECK_THROWS_WITH(ProlateHyperspheroid(V(0, 0, 0), V(1, 0, std::numeric_limits<double>::infinity()), 2.0), Contains("focus b"));
+  CHECK_THROWS_WITH(ProlateHyperspheroid(V(0, 0, 0), V(1, 0, 0), nan), Contains("transverse diameter"));
 }

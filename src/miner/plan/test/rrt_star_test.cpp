@@ -471,6 +471,10 @@ TEST_CASE("Tenth campaign: plan() checks a problem however it was filled, and a 
   CHECK_NOTHROW(miner::plan::plan(p, o));
   p.map = nullptr;
   CHECK_THROWS_WITH(miner::plan::plan(p, o), Contains("no map"));
+  // L17: a setup time that is no time.
+  PlanResult timed;
+  CHECK_THROWS_WITH(miner::plan::add_setup_time(timed, nan), Contains("setup time"));
+  CHECK_THROWS_WITH(miner::plan::add_setup_time(timed, -1.0), Contains("setup time"));
   // L5: a NaN point anywhere in a region's path is named before any point is walked.
   CHECK_THROWS_WITH(HeuristicRegion::from_path(map.bounds(), I(32, 32, 32), {V(1, 1, 1), V(nan, 9, 9)}, 1, "x"),
                     Contains("region path point 1"));

@@ -102,6 +102,11 @@ TEST_CASE("Tenth campaign: the trajectory API refuses what would give NaN, garba
   CHECK_NOTHROW(solve_minco(big));  // MINCO takes any number
   CHECK_THROWS_WITH(relative_residual(optimality_system(rest_to_rest(4, pts, {2.0, 2.0})), Eigen::MatrixX3d::Zero(3, 3)),
                     Contains("coefficient rows"));
+  // L17: scaling to infinite durations, and objectives of the wrong number of durations.
+  PolynomialTrajectory scaled = t;
+  CHECK_THROWS_WITH(scale_time(scaled, 1e308), Contains("infinite"));
+  CHECK_THROWS_WITH(feasible_objective(rest_to_rest(4, pts, {2.0, 2.0}), {2.0}, AllocationOptions{}), Contains("durations: 1 for 2 segments"));
+  CHECK_THROWS_WITH(log_time_objective(rest_to_rest(4, pts, {2.0, 2.0}), {0.1, 0.2, 0.3}, AllocationOptions{}), Contains("tau: 3"));
   // L21: a moved-from solver is named, not dereferenced.
   MincoSolver from;
   MincoSolver to(std::move(from));

@@ -242,3 +242,24 @@ TEST_CASE("A* refuses a grid built from another map: its path would ignore this 
   const Map voxels = Map::from_voxels({small_layer(), UnknownPolicy::kOccupied, "", ""});
   CHECK(voxels.with_unknown(UnknownPolicy::kFree).fingerprint() != voxels.fingerprint());
 }
+
+TEST_CASE("Tenth campaign: grid helpers refuse sizes and leaves they cannot hold by name", "[REQ-LIB-003][REQ-WORLD-012]") {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  // L17/L18: seeds shorter than the grid were read past their end; negative dims escaped as
+  // std::length_error; NaN bounds gave one cell.
+  CHECK_THROWS_WITH(squared_distance_transform(std::vector<std::uint8_t>(5, 0), Eigen::Vector3i(4, 4, 4), false),
+                    Contains("5 seeds for a grid of 4 x 4 x 4"));
+  CHECK_THROWS_WITH(squared_distance_transform({}, Eigen::Vector3i(-2, 1, 1), false), Contains("seeds for a grid"));
+  CHECK(squared_distance_transform(std::vector<std::uint8_t>(8, 1), Eigen::Vector3i(2, 2, 2), false) == std::vector<double>(8, 0.0));
+  CHECK_THROWS_WITH(grid_dims(Box{{0, 0, 0}, {nan, 1, 1}}, 0.1), Contains("bounds.max[0]"));
+  CHECK_THROWS_WITH(grid_dims(Box{{0, 0, 0}, {1, 1, 1}}, nan), Contains("resolution"));
+  // Leaves below the tree's depth, off their lattice, or a budget that is no cell count.
+  const OctreeLeaf ok{{32768, 32768, 32768}, 16, VoxelState::kOccupied};
+  CHECK(layer_from_leaves({ok}, 0.1, "t")->size() == 1);
+  CHECK_THROWS_WITH(layer_from_leaves({OctreeLeaf{{32768, 32768, 32768}, 17, VoxelState::kFree}}, 0.1, "t"),
+                    Contains("depth 17"));
+  CHECK_THROWS_WITH(layer_from_leaves({OctreeLeaf{{32769, 32768, 32768}, 15, VoxelState::kFree}}, 0.1, "t"),
+                    Contains("not on its depth's lattice"));
+  for (const double budget : {nan, std::numeric_limits<double>::infinity(), 0.0})
+    CHECK_THROWS_WITH(layer_from_leaves({ok}, 0.1, "t", budget), Contains("cell budget"));
+}

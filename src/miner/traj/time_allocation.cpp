@@ -195,9 +195,11 @@ void validate(const AllocationOptions& o) {
 std::pair<double, double> feasible_objective(const MincoProblem& problem, const std::vector<double>& durations,
                                              const AllocationOptions& options) {
   validate(options);
-  validate(problem);
-  if (durations.size() + 1 != static_cast<std::size_t>(problem.points.rows()))
-    throw Error("durations: " + std::to_string(durations.size()) + " for " + std::to_string(problem.points.rows() - 1) + " segments");
+  {  // the problem with these durations is a valid one (tenth campaign L17: 1 for 2 segments)
+    MincoProblem with = problem;
+    with.durations = durations;
+    validate(with);
+  }
   MincoSolver solver;
   Evaluation e;
   if (!evaluate(problem, durations, options, solver, e))
@@ -208,11 +210,13 @@ std::pair<double, double> feasible_objective(const MincoProblem& problem, const 
 std::pair<double, std::vector<double>> log_time_objective(const MincoProblem& problem, const std::vector<double>& tau,
                                                           const AllocationOptions& options) {
   validate(options);
-  validate(problem);
-  if (tau.size() + 1 != static_cast<std::size_t>(problem.points.rows()))
-    throw Error("tau: " + std::to_string(tau.size()) + " log-durations for " + std::to_string(problem.points.rows() - 1) + " segments");
   std::vector<double> start(tau.size());
   for (std::size_t i = 0; i < tau.size(); ++i) start[i] = std::exp(tau[i]);
+  {  // durations exp(tau) of a valid problem (tenth campaign L17: 3 for 2 segments)
+    MincoProblem with = problem;
+    with.durations = start;
+    validate(with);
+  }
   const AllocationObjective objective(problem, options, start);
   double F = 0.0;
   std::vector<double> gradient(tau.size());

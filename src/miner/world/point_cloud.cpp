@@ -552,7 +552,12 @@ std::shared_ptr<const VoxelLayer> integrate_clouds(const std::vector<CloudScan>&
                     " lies beyond OctoMap's key range at this resolution (32767 voxels from the origin)");
       cloud.push_back(point(p));
     }
-    tree.insertPointCloud(cloud, point(scan.origin), max_range > 0.0 ? max_range : -1.0);
+    // Discretized insertion (OctoMap's own option): the points of one voxel share one ray to
+    // that voxel's centre, so a dense scan casts one ray per hit voxel, not per point (issue 20,
+    // tenth campaign I1: 10^7 points of a room took 72 s; now ~3.5 s). The occupied voxels are the
+    // same; the free ones differ only where a ray's last stretch crosses another voxel.
+    tree.insertPointCloud(cloud, point(scan.origin), max_range > 0.0 ? max_range : -1.0, /*lazy_eval=*/false,
+                          /*discretize=*/true);
   }
   tree.updateInnerOccupancy();
   return layer_of_tree(tree, "point clouds");

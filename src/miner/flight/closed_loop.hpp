@@ -131,6 +131,8 @@ struct FlightResult {
 /// flight (~4 x 10^5 N3 ticks, a ~100 MB log at most). fly() refuses more, whoever calls it
 /// (REQ-FLIGHT-007; tenth campaign L12b: a library caller's 10^7 s hover ran unbounded).
 inline constexpr double kMaxFlightSeconds = 1000.0;
+/// Arrival within 5 m: a wider tolerance no longer says the vehicle reached its goal.
+inline constexpr double kMaxGoalTolerance = 5.0;  ///< m
 
 /// Flies `reference` from setup.start in closed loop until it ends plus the hover; the same
 /// setup (seed included) gives the same bytes.

@@ -51,8 +51,7 @@ using flight::kMaxFlightSeconds;
 inline constexpr double kMinLimit = 0.01;
 inline constexpr double kMaxSpeed = 50.0;          ///< m/s
 inline constexpr double kMaxAcceleration = 50.0;   ///< m/s^2
-/// Arrival within 5 m: a wider tolerance no longer says the vehicle reached its goal.
-inline constexpr double kMaxGoalTolerance = 5.0;   ///< m
+using flight::kMaxGoalTolerance;
 /// The planning margin grows the robot radius; 10 m is the largest robot radius a map takes.
 inline constexpr double kMaxPlanningMargin = 10.0;  ///< m
 /// The planner's iteration budget (plan::kMaxIterations, the CLI's --iterations bound).

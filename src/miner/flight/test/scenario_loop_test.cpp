@@ -585,6 +585,17 @@ TEST_CASE("flight::fly bounds the simulated time itself, whoever calls it", "[RE
   setup.hover_after_s = 0.5;
   setup.n3.rate_hz = 0.0;
   CHECK_THROWS_WITH(flight::fly(setup, r), Contains("rates"));
+  // L12: the verdict's own fields, changed after reading, are checked by the flight.
+  setup.n3 = s.n3;
+  for (const double tolerance : {1e9, 0.0, std::nan("")}) {
+    setup.goal_tolerance = tolerance;
+    CHECK_THROWS_WITH(flight::fly(setup, r), Contains("goal_tolerance"));
+  }
+  setup.goal_tolerance = s.goal_tolerance;
+  setup.command_dropout = std::make_pair(std::nan(""), 1.0);
+  CHECK_THROWS_WITH(flight::fly(setup, r), Contains("command_dropout"));
+  setup.command_dropout = std::make_pair(5.0, 1.0);
+  CHECK_THROWS_WITH(flight::fly(setup, r), Contains("command_dropout"));
 }
 
 TEST_CASE("A collision is counted once per entry into an obstacle, not once per tick inside it",

@@ -464,13 +464,14 @@ void require_mask(const std::vector<std::uint8_t>& mask, const Eigen::Vector3i& 
                 std::to_string(dims.y()) + " x " + std::to_string(dims.z()));
 }
 
-void require_cell(const Eigen::Vector3i& c, const Eigen::Vector3i& dims, const char* name) {
-  if ((c.array() < 0).any() || (c.array() >= dims.array()).any())
-    throw Error(std::string("grid cell ") + name + " (" + std::to_string(c.x()) + ", " + std::to_string(c.y()) + ", " +
-                std::to_string(c.z()) + ") lies outside the grid");
-}
-
 }  // namespace
+
+void require_cell_in_grid(const Eigen::Vector3i& c, const Eigen::Vector3i& dims, const std::string& what) {
+  if ((c.array() < 0).any() || (c.array() >= dims.array()).any())
+    throw Error(what + " (" + std::to_string(c.x()) + ", " + std::to_string(c.y()) + ", " + std::to_string(c.z()) +
+                ") lies outside the " + std::to_string(dims.x()) + " x " + std::to_string(dims.y()) + " x " +
+                std::to_string(dims.z()) + " grid");
+}
 
 std::vector<int> label_components(const std::vector<std::uint8_t>& mask, const Eigen::Vector3i& dims) {
   require_mask(mask, dims);
@@ -539,8 +540,8 @@ std::vector<std::uint8_t> component_of(const std::vector<std::uint8_t>& mask, co
 bool connects(const std::vector<std::uint8_t>& mask, const Eigen::Vector3i& dims, const Eigen::Vector3i& a,
               const Eigen::Vector3i& b) {
   require_mask(mask, dims);
-  require_cell(a, dims, "a");
-  require_cell(b, dims, "b");
+  require_cell_in_grid(a, dims, "grid cell a");
+  require_cell_in_grid(b, dims, "grid cell b");
   const std::size_t ia = cell_index(dims, a.x(), a.y(), a.z());
   const std::size_t ib = cell_index(dims, b.x(), b.y(), b.z());
   if (!mask[ia] || !mask[ib]) return false;

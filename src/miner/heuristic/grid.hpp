@@ -20,6 +20,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -102,6 +103,10 @@ std::uint64_t subcells_inside(const world::Box& cell, const world::Box& g);
 /// Channel S: the (2 dilation + 1)^3 cubes around the cells of start and goal.
 std::vector<std::uint8_t> encode_state(const world::Box& bounds, const Eigen::Vector3i& dims,
                                        const Eigen::Vector3d& start, const Eigen::Vector3d& goal, int dilation);
+
+/// Throws miner::Error "<what> (x, y, z) lies outside the nx x ny x nz grid" unless cell c is in
+/// the grid: the check of every function here that takes a cell.
+void require_cell_in_grid(const Eigen::Vector3i& c, const Eigen::Vector3i& dims, const std::string& what);
 
 /// Labels the 26-connected components of the cells with mask != 0: label 0 for cells
 /// outside the mask, 1.. for components in order of their lowest index.

@@ -42,11 +42,8 @@ void require_one_grid(const std::vector<float>& p, const std::vector<std::uint8_
     throw Error("region filter: grids of different sizes");
   // Tenth campaign L4: a cell outside the grid corrupted the heap (filter_region) or read
   // outside it (widest_threshold).
-  for (const auto& [c, name] : {std::pair{&start_cell, "start cell"}, std::pair{&goal_cell, "goal cell"}})
-    if ((c->array() < 0).any() || (c->array() >= dims.array()).any())
-      throw Error(std::string("region filter: the ") + name + " (" + std::to_string(c->x()) + ", " +
-                  std::to_string(c->y()) + ", " + std::to_string(c->z()) + ") lies outside the " +
-                  std::to_string(dims.x()) + " x " + std::to_string(dims.y()) + " x " + std::to_string(dims.z()) + " grid");
+  require_cell_in_grid(start_cell, dims, "region filter: the start cell");
+  require_cell_in_grid(goal_cell, dims, "region filter: the goal cell");
 }
 
 /// A chain's step from cell u to its neighbour v: v not solid and, with channel P, every axis

@@ -15,6 +15,11 @@ double falling_factorial(int a, int k) {
   return f;
 }
 
+void check_order(int order, const std::string& who) {
+  if (order < 1 || 2 * order > kMaxCoefficientRows)
+    throw Error(who + ": order must be in [1, " + std::to_string(kMaxCoefficientRows / 2) + "], got " + std::to_string(order));
+}
+
 Eigen::RowVectorXd monomial_derivative_row(int n, int k, double t) {
   // Tenth campaign L4: k = -1 wrote before the row (heap corruption), n = -1 asked for 2^64 bytes.
   if (n < 0 || n > kMaxCoefficientRows) throw Error("monomial_derivative_row: n must be in [0, " + std::to_string(kMaxCoefficientRows) + "], got " + std::to_string(n));
@@ -29,8 +34,7 @@ PolynomialTrajectory::PolynomialTrajectory(int order, std::vector<double> durati
     : order_(order), durations_(std::move(durations)), coefficients_(std::move(coefficients)) {
   // Tenth campaign L17: an order of 0 or 20, negative or NaN durations and NaN coefficients
   // made a trajectory every later step trusted.
-  if (order_ < 1 || 2 * order_ > kMaxCoefficientRows)
-    throw Error("trajectory: order must be in [1, " + std::to_string(kMaxCoefficientRows / 2) + "], got " + std::to_string(order_));
+  check_order(order_, "trajectory");
   for (std::size_t i = 0; i < durations_.size(); ++i)
     if (!(std::isfinite(durations_[i]) && durations_[i] > 0.0))
       throw Error("trajectory: durations[" + std::to_string(i) + "] must be a positive finite time in s, got " + short_number(durations_[i]));
@@ -73,8 +77,7 @@ Eigen::Vector3d PolynomialTrajectory::evaluate(double t, int k) const {
 
 Eigen::MatrixXd monomial_cost_matrix(int order, double duration) {
   // Tenth campaign L17: a negative duration gave a negative energy, NaN a NaN matrix.
-  if (order < 1 || 2 * order > kMaxCoefficientRows)
-    throw Error("monomial_cost_matrix: order must be in [1, " + std::to_string(kMaxCoefficientRows / 2) + "], got " + std::to_string(order));
+  check_order(order, "monomial_cost_matrix");
   if (!(std::isfinite(duration) && duration >= 0.0))
     throw Error("monomial_cost_matrix: duration must be a finite time >= 0 s, got " + short_number(duration));
   const int n = 2 * order;

@@ -6,6 +6,7 @@
 /// effort J = sum_i int_0^{T_i} |p_i^{(s)}(t)|^2 dt (no 1/2 factor) and its gradient with
 /// respect to the coefficients (REQ-TRAJ-004, REQ-TRAJ-005).
 
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -15,6 +16,8 @@ namespace miner::traj {
 /// The most coefficients per segment and axis (2s) a trajectory may have: s <= 4 (MINCO solves
 /// s = 3 and 4; the time allocation's samplers hold at most 8 rows).
 inline constexpr int kMaxCoefficientRows = 8;
+/// Throws miner::Error "<who>: order must be in [1, kMaxCoefficientRows / 2], got <order>".
+void check_order(int order, const std::string& who);
 
 class PolynomialTrajectory {
  public:

@@ -33,8 +33,7 @@ std::pair<double, double> sampled_extremes(const PolynomialTrajectory& t, int sa
   // of 241 m/s on a 4.6 m/s trajectory).
   if (samples < 1 || samples > kMaxSamplesPerSegment)
     throw Error("samples: must be in [1, " + std::to_string(kMaxSamplesPerSegment) + "] per segment, got " + std::to_string(samples));
-  if (t.order() < 1 || 2 * t.order() > kMaxCoefficientRows)
-    throw Error("sampled_extremes: order must be in [1, " + std::to_string(kMaxCoefficientRows / 2) + "], got " + std::to_string(t.order()));
+  check_order(t.order(), "sampled_extremes");
   const int n = 2 * t.order();
   double v2 = 0.0, a2 = 0.0;
   Eigen::Matrix<double, 8, 3> dv, da;  // velocity and acceleration coefficients (n <= 8)

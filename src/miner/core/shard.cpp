@@ -8,8 +8,13 @@ namespace miner {
 
 std::pair<int, int> parse_shard(const std::string& text) {
   const auto slash = text.find('/');
+  // Decimal digits on both sides of one slash, nothing else: std::stoi alone skipped leading
+  // blanks and took a sign (tenth campaign recheck: " 0/2" and "+0/2" were read as 0/2).
+  const bool plain = slash != std::string::npos && slash > 0 && slash + 1 < text.size() &&
+                     text.find_first_not_of("0123456789/") == std::string::npos &&
+                     text.find('/', slash + 1) == std::string::npos;
   try {
-    if (slash != std::string::npos) {
+    if (plain) {
       std::size_t a = 0, b = 0;
       const int i = std::stoi(text.substr(0, slash), &a);
       const int n = std::stoi(text.substr(slash + 1), &b);

@@ -115,6 +115,14 @@ FlightResult fly(const FlightSetup& s, const ReferenceTrajectory& reference, con
                              s.command_dropout->second <= kMaxFlightSeconds))
     throw Error("flight: command_dropout needs 0 <= t0 < t1 <= " + short_number(kMaxFlightSeconds) + " s, got [" +
                 short_number(s.command_dropout->first) + ", " + short_number(s.command_dropout->second) + "]");
+  // The vehicle starts hovering at s.start: a reference starting elsewhere is a step the
+  // controller would chase at full tilt (tenth campaign recheck: a reference 42 m away flew 6 s
+  // and came back as an ordinary flight). The pipeline's own tolerance for the reference's ends.
+  constexpr double kReferenceStartTolerance = 1e-6;  // m
+  const Eigen::Vector3d reference_start = trajectory.evaluate(0.0);
+  if (!((reference_start - s.start).norm() <= kReferenceStartTolerance))
+    throw Error("flight: the reference starts at " + format_point(reference_start) + ", not at the setup's start " +
+                format_point(s.start) + " where the vehicle hovers");
   const long total_ticks = static_cast<long>(std::ceil((t_traj + s.hover_after_s) / dt));
 
   Rng imu_rng(s.seed, streams::kImuNoise), pose_rng(s.seed, streams::kPoseNoise),

@@ -7,6 +7,7 @@
 #include <type_traits>
 
 #include "miner/core/error.hpp"
+#include "miner/plan/heuristic_region.hpp"
 #include "miner/world/map.hpp"
 
 namespace miner::heuristic {
@@ -222,9 +223,13 @@ std::vector<std::uint8_t> encode(const world::Map& map, const Eigen::Vector3i& d
     EncodeScratch& s;
     ~Trim() { s.trim(); }
   } trim_on_exit{scratch};
+  // Tenth campaign recheck: dims of 0 encoded an empty grid, a NaN radius grew no obstacle
+  // (every cell free). The region's cell rule (each dim >= 1, at most kMaxCells, no int wrap)
+  // and the map's radius rule.
+  const std::size_t cells = plan::HeuristicRegion::cell_count(dims);
+  world::check_robot_radius(radius, "encode: robot radius");
   const world::Box& b = map.bounds();
   const Eigen::Vector3d c = cell_size(b, dims);
-  const auto cells = static_cast<std::size_t>(dims.prod());
   std::vector<std::uint8_t> e(cells, kFree);
   // The grown obstacles and the cell range each one meets: cell i's closed box
   // [b + i c, b + (i+1) c] meets [g.min, g.max] iff (g.min - b)/c - 1 <= i <= (g.max - b)/c;
@@ -441,10 +446,10 @@ std::vector<std::uint8_t> encode_state(const world::Box& b, const Eigen::Vector3
   // Tenth campaign L17: a NaN start and a dilation of -1 encoded silently.
   require_finite(start, "state: start");
   require_finite(goal, "state: goal");
-  if ((dims.array() < 1).any()) throw Error("state: every grid dimension must be at least 1");
+  const std::size_t cells = plan::HeuristicRegion::cell_count(dims);
   if (dilation < 0 || dilation > dims.maxCoeff())
     throw Error("state: dilation must be in [0, " + std::to_string(dims.maxCoeff()) + "] cells, got " + std::to_string(dilation));
-  std::vector<std::uint8_t> s(static_cast<std::size_t>(dims.prod()), 0);
+  std::vector<std::uint8_t> s(cells, 0);
   for (const Eigen::Vector3d& p : {start, goal}) {
     const Eigen::Vector3i c = cell_of(b, dims, p);
     for (int k = std::max(0, c.z() - dilation); k <= std::min(dims.z() - 1, c.z() + dilation); ++k)

@@ -44,16 +44,12 @@ int ticks_per(const JsonField& where, double loop_rate, double rate, const char*
   return static_cast<int>(rounded);
 }
 
-}  // namespace
-
-Scenario scenario_from_json(const Json& doc, const std::string& origin, const std::string& base_dir) {
-  const JsonField root(doc, "", origin);
-  root.require_format(kScenarioFormat);
-  root.only_keys({"format", "name", "map", "vehicle", "start", "goal", "waypoints", "trajectory", "planner", "seed",
-                  "hover_after_s", "goal_tolerance_m", "planning_margin_m", "imu", "pose", "n3", "controller", "ekf",
-                  "command_dropout_s", "wind", "mismatch", "battery", "yaw", "controller_reads"});
-  Scenario s;
-  s.origin = origin;
+/// Everything of a scenario document but its format and map (s.map is set): every field's
+/// range and the cross-checks. scenario_from_json reads files with it, and check_scenario
+/// checks a struct by writing it back as a document, so one set of rules holds both.
+/// `trajectory_given`: the route is a trajectory already in s (a file's, or a struct's).
+void read_scenario_fields(const JsonField& root, const std::string& origin, const std::string& base_dir,
+                          bool trajectory_given, Scenario& s) {
   if (root.has("name")) {
     // The name becomes the default run folder runs/<name>-seed<seed>: one plain, visible name
     // (issue 20: "../../x" wrote outside runs/, "" made runs/-seed1).
@@ -66,18 +62,6 @@ Scenario scenario_from_json(const Json& doc, const std::string& origin, const st
                            root.at("name").value().dump());
   }
 
-  const JsonField map_field = root.at("map");
-  if (map_field.value().is_string()) {
-    // A map that cannot be read is named as the scenario's field (issue 20: "/tmp: cannot open
-    // file" named neither).
-    try {
-      s.map = std::make_shared<const world::Map>(world::Map::load(resolve(base_dir, map_field.string())));
-    } catch (const Error& e) {
-      map_field.fail(e.what());
-    }
-  } else {
-    s.map = std::make_shared<const world::Map>(world::Map::from_json(map_field.value(), origin + ": map"));
-  }
   if (root.has("vehicle")) {
     const JsonField v = root.at("vehicle");
     if (v.value().is_string()) {
@@ -106,13 +90,15 @@ Scenario scenario_from_json(const Json& doc, const std::string& origin, const st
   // The route comes from exactly one source; the keys of the others would be read and then
   // ignored without a word (issue 20, third campaign: an empty "waypoints" flew a straight
   // line through the map, a planner block beside waypoints was never used).
-  const bool trajectory_file = root.has("trajectory") && root.at("trajectory").has("file");
+  const bool trajectory_file = trajectory_given || (root.has("trajectory") && root.at("trajectory").has("file"));
   if (trajectory_file) {
     for (const char* key : {"waypoints", "planner"})
       if (root.has(key)) root.at(key).fail("unused: the route is the trajectory file's (trajectory.file)");
-    const JsonField t = root.at("trajectory");
-    for (const char* key : {"order", "allocation", "rho"})
-      if (t.has(key)) t.at(key).fail("unused: the trajectory file fixes the order and the durations");
+    if (root.has("trajectory")) {
+      const JsonField t = root.at("trajectory");
+      for (const char* key : {"order", "allocation", "rho"})
+        if (t.has(key)) t.at(key).fail("unused: the trajectory file fixes the order and the durations");
+    }
   }
   if (root.has("waypoints") && root.has("planner"))
     root.at("planner").fail("unused: the route is given by \"waypoints\" (leave them out to plan with MINER RRT*)");
@@ -299,7 +285,118 @@ Scenario scenario_from_json(const Json& doc, const std::string& origin, const st
               std::to_string(tilt_needed * 180.0 / kPi) + " deg of tilt, more than " +
               std::to_string(kEnvelopeMargin * s.controller.max_tilt_deg) + " deg (" +
               std::to_string(kEnvelopeMargin) + " of the tilt limit)");
+}
+
+}  // namespace
+
+Scenario scenario_from_json(const Json& doc, const std::string& origin, const std::string& base_dir) {
+  const JsonField root(doc, "", origin);
+  root.require_format(kScenarioFormat);
+  root.only_keys({"format", "name", "map", "vehicle", "start", "goal", "waypoints", "trajectory", "planner", "seed",
+                  "hover_after_s", "goal_tolerance_m", "planning_margin_m", "imu", "pose", "n3", "controller", "ekf",
+                  "command_dropout_s", "wind", "mismatch", "battery", "yaw", "controller_reads"});
+  Scenario s;
+  s.origin = origin;
+  const JsonField map_field = root.at("map");
+  if (map_field.value().is_string()) {
+    // A map that cannot be read is named as the scenario's field (issue 20: "/tmp: cannot open
+    // file" named neither).
+    try {
+      s.map = std::make_shared<const world::Map>(world::Map::load(resolve(base_dir, map_field.string())));
+    } catch (const Error& e) {
+      map_field.fail(e.what());
+    }
+  } else {
+    s.map = std::make_shared<const world::Map>(world::Map::from_json(map_field.value(), origin + ": map"));
+  }
+  read_scenario_fields(root, origin, base_dir, false, s);
   return s;
+}
+
+namespace {
+
+/// An angle for a reader that takes degrees within [-limit, limit]: the struct's radians
+/// converted back, a rounding past the limit (rad2deg(deg2rad(180)) may be 180 + 3e-14) taken
+/// as the limit.
+double degrees_within(double radians, double limit) {
+  const double d = rad2deg(radians);
+  constexpr double kRounding = 1e-12;  // relative: far below any angle a scenario means
+  if (std::abs(d) > limit && std::abs(d) <= limit * (1.0 + kRounding)) return std::copysign(limit, d);
+  return d;
+}
+
+}  // namespace
+
+Json scenario_document(const Scenario& s) {
+  Json d{{"format", kScenarioFormat},
+         {"name", s.name},
+         {"vehicle", to_json(s.vehicle)},
+         {"start", vec3_json(s.start)},
+         {"goal", vec3_json(s.goal)},
+         {"seed", s.seed},
+         {"hover_after_s", s.hover_after_s},
+         {"goal_tolerance_m", s.goal_tolerance},
+         {"planning_margin_m", s.planning_margin},
+         {"imu", to_json(s.imu)},
+         {"n3", to_json(s.n3)},
+         {"controller", to_json(s.controller)},
+         {"ekf",
+          {{"gate_probability", s.ekf.gate_probability},
+           {"initial_position_sigma", s.ekf.initial_position_sigma},
+           {"initial_velocity_sigma", s.ekf.initial_velocity_sigma},
+           {"initial_attitude_sigma", s.ekf.initial_attitude_sigma}}},
+         {"mismatch", to_json(s.mismatch)},
+         {"controller_reads", s.controller_reads_truth ? "ground-truth" : "ekf"}};
+  // Keys a file may give only in some modes are written only then (the reader refuses them as
+  // unused otherwise): a pose's dropout length without dropouts, the yaw of the other mode.
+  Json pose = to_json(s.pose);
+  if (pose.contains("dropout_mean_s") && s.pose.dropout_rate_hz == 0.0 && s.pose.dropout_mean_s == 0.0)
+    pose.erase("dropout_mean_s");
+  d["pose"] = pose;
+  Json yaw{{"mode", s.yaw.mode == YawParams::Mode::kFixed ? "fixed" : "velocity"},
+           {"rate_limit_deg_s", degrees_within(s.yaw.rate_limit, 3600.0)}};
+  if (s.yaw.mode == YawParams::Mode::kFixed) yaw["fixed_deg"] = degrees_within(s.yaw.fixed, 180.0);
+  else yaw["min_speed_m_s"] = s.yaw.min_speed;
+  d["yaw"] = yaw;
+  if (s.wind.enabled) d["wind"] = to_json(s.wind);
+  if (s.battery.enabled) d["battery"] = to_json(s.battery);
+  // A struct's empty waypoint list is the straight leg from start to goal (a file says that
+  // with waypoints left out and no planner; an empty list there is refused as ambiguous).
+  if (s.waypoints && s.waypoints->rows() > 0) {
+    Json w = Json::array();
+    for (Eigen::Index i = 0; i < s.waypoints->rows(); ++i) w.push_back(vec3_json(s.waypoints->row(i).transpose()));
+    d["waypoints"] = w;
+  }
+  Json t{{"v_max", s.limits.v_max}, {"a_max", s.limits.a_max}};
+  if (!s.trajectory_file) {
+    t["order"] = s.order;
+    t["allocation"] = s.allocation;
+    if (s.allocation == "optimise") t["rho"] = s.rho;
+    if (!s.waypoints) {
+      Json p{{"region", s.region}, {"iterations", s.planner_iterations}};
+      if (!s.weights.empty()) p["weights"] = s.weights;
+      d["planner"] = p;
+    }
+  }
+  d["trajectory"] = t;
+  if (s.command_dropout) d["command_dropout_s"] = Json::array({s.command_dropout->first, s.command_dropout->second});
+  return d;
+}
+
+void check_scenario(const Scenario& s) {
+  const std::string origin = (s.origin.empty() ? std::string("scenario") : s.origin) + " (the Scenario struct)";
+  // Tenth campaign recheck: a scenario whose map was reset to null crashed build_reference.
+  if (!s.map) throw Error(origin + ": map: none (a scenario needs its map)");
+  // L12: the struct's fields are public; whatever was changed after reading is checked by the
+  // reader's own rules, the struct written back as a document.
+  const Json doc = scenario_document(s);
+  Scenario copy;
+  copy.map = s.map;
+  read_scenario_fields(JsonField(doc, "", origin), origin, "", s.trajectory_file.has_value(), copy);
+  // What the reader copies: the EKF models the sensors it is given.
+  if (to_json(s.ekf.imu) != to_json(s.imu) || to_json(s.ekf.pose) != to_json(s.pose))
+    throw Error(origin + ": ekf.imu / ekf.pose differ from imu / pose: the EKF's noise model is the sensors' " +
+                "(set both, as the scenario reader does)");
 }
 
 Json self_contained_scenario(Json doc, const std::string& base_dir) {
@@ -445,6 +542,7 @@ void check_envelope(const Scenario& s, const traj::PolynomialTrajectory& t) {
 }  // namespace
 
 ReferencePlan build_reference(const Scenario& s) {
+  check_scenario(s);
   ReferencePlan r;
   // Plan and repair with the tracking margin added: a reference that grazes the inflated
   // map would be left by any tracking error (the flight checks the vehicle radius alone).
@@ -624,6 +722,7 @@ void check_reference(const Scenario& s, const ReferencePlan& reference) {
 }
 
 flight::FlightResult fly(const Scenario& scenario, const ReferencePlan& reference, const flight::FlyOptions& options) {
+  check_scenario(scenario);
   check_reference(scenario, reference);
   flight::FlightSetup setup = scenario;
   const std::shared_ptr<const world::Map> map = scenario.map;

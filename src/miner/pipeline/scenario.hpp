@@ -91,6 +91,17 @@ struct Scenario : flight::FlightSetup {
 Scenario scenario_from_json(const Json& doc, const std::string& origin, const std::string& base_dir);
 Scenario load_scenario(const std::string& path);
 
+/// Throws miner::Error naming the field unless the struct is a scenario a file could say:
+/// its map set, and every field within the reader's ranges and cross-checks (the struct is
+/// written back with scenario_document and read again, so the rules are the reader's; the EKF's
+/// imu/pose must be the scenario's). build_reference() and fly() call it, so fields changed in
+/// C++ after reading are checked like a file's (issue 20, tenth campaign L12).
+void check_scenario(const Scenario& s);
+/// The scenario as a document of the scenario format, without its map (a Map has no single
+/// document: a voxel map names its file) and without a trajectory file's path (the struct holds
+/// the trajectory itself): what check_scenario reads back.
+Json scenario_document(const Scenario& s);
+
 /// The embedded default scenario (fixtures/scenarios/default.json with its map and
 /// vehicle inlined at build time), so `miner fly` runs with no argument anywhere.
 Scenario default_scenario();

@@ -433,6 +433,11 @@ PlanResult plan(const PlanningProblem& problem, const PlannerOptions& options, c
   // The problem's fields are public: one filled by hand is checked like make()'s (tenth
   // campaign L11: a NaN radius "solved" with a vacuous collision check).
   validate(problem);
+  // An int cast to the enum outside its four values planned as RRT* under a name of "?"
+  // (tenth campaign recheck).
+  if (static_cast<unsigned>(options.planner) > static_cast<unsigned>(PlannerKind::kMiner))
+    throw Error("planner: " + std::to_string(static_cast<int>(options.planner)) +
+                " is not a PlannerKind (rrtstar, informed, guided, miner)");
   require_probability(options.goal_bias, "goal_bias", true);
   require_probability(options.mu_1, "mu_1", true);
   require_probability(options.mu_2, "mu_2", true);
@@ -460,7 +465,10 @@ PlanResult plan(const PlanningProblem& problem, const PlannerOptions& options, c
   if (options.max_iterations > kMaxIterations)
     throw Error("max_iterations: " + std::to_string(options.max_iterations) + " is above the largest budget " +
                 std::to_string(kMaxIterations) + " (a run of minutes; see plan::kMaxIterations)");
-  if (options.target_cost) require_finite(*options.target_cost, "target_cost");
+  // A path's length is >= 0: a negative target could never be met and only hid a sign error
+  // (tenth campaign recheck).
+  if (options.target_cost && !(std::isfinite(*options.target_cost) && *options.target_cost >= 0.0))
+    throw Error("target_cost: must be a finite path length >= 0 m, got " + short_number(*options.target_cost));
   if (options.safeguard_iterations < 1) throw Error("safeguard_iterations: must be >= 1 (k_0 of the safeguard)");
   if (options.planner == PlannerKind::kMiner) {
     if (region == nullptr) throw Error("planner miner: needs a heuristic region");

@@ -47,7 +47,9 @@ std::string svg_box_plot(const PlotAxes& axes, const std::vector<BoxGroup>& grou
 
 /// An event timeline: one lane per kind of event, a bar over each interval [t0, t1] in which
 /// it was active (an instant event gets a bar of at least 2 px), the lane's label with the
-/// count and total time, "none" on an empty lane; x is time over [0, t_end].
+/// count and total time, "none" on an empty lane; x is time over [0, t_end]. Bars that overlap
+/// or touch once drawn are one rectangle, so a lane has at most about the plot's width of them
+/// whatever the number of intervals; a non-finite interval is refused (miner::Error).
 struct EventLane {
   std::string name;
   std::string color;

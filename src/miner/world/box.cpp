@@ -2,6 +2,10 @@
 
 #include <algorithm>
 #include <array>
+#include <string>
+
+#include "miner/core/error.hpp"
+#include "miner/core/text.hpp"
 
 namespace miner::world {
 
@@ -79,6 +83,14 @@ double squared_distance(const Eigen::Vector3d& a, const Eigen::Vector3d& b, cons
     }
   }
   return best;
+}
+
+void check_query_point(const Eigen::Vector3d& p, const char* field) {
+  if (!p.allFinite()) require_finite(p, field);
+}
+
+void check_query_radius(double radius, const char* field) {
+  if (!(radius >= 0.0)) throw Error(std::string(field) + ": must be a number >= 0, got " + short_number(radius));
 }
 
 }  // namespace miner::world

@@ -50,4 +50,11 @@ double squared_distance(const Eigen::Vector3d& p, const Box& box);
 /// these candidates are evaluated exactly, so the result is exact up to rounding.
 double squared_distance(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Box& box);
 
+/// The argument checks of every geometric query (Map's and VoxelObstacles'): a point or
+/// direction is finite, a radius or range a number >= 0; otherwise an Error naming `field`.
+/// Tenth campaign L1: a NaN point read a voxel layer at cell -2^31. Cheap when they hold (no
+/// string is built), so the hot queries call them each time.
+void check_query_point(const Eigen::Vector3d& p, const char* field);
+void check_query_radius(double radius, const char* field);
+
 }  // namespace miner::world

@@ -219,15 +219,6 @@ void check_obstacle_index(std::size_t index, std::size_t boxes, const VoxelObsta
                 " (indices 0 to " + (total == 0 ? std::string("none") : std::to_string(total - 1)) + ")");
 }
 
-/// A query point is finite and a radius is a number >= 0 (tenth campaign L1: a NaN point read
-/// the voxel layer at cell -2^31).
-void check_query(const Eigen::Vector3d& p, const char* field) {
-  if (!p.allFinite()) require_finite(p, field);
-}
-void check_query_radius(double radius, const char* field) {
-  if (!(radius >= 0.0)) throw Error(std::string(field) + ": must be a number >= 0, got " + short_number(radius));
-}
-
 }  // namespace
 
 Box Map::obstacle_box(std::size_t index) const {
@@ -325,6 +316,8 @@ std::optional<std::size_t> Map::query_index(const Box& region, double r2, const 
 
 std::string Map::voxel_file_path(const std::string& map_path, const std::string& file) {
   namespace fs = std::filesystem;
+  // An empty name is no file: the map's folder itself came back (tenth campaign recheck).
+  if (file.empty()) throw Error(map_path + ": voxels.file: is empty: name the voxel file (.bt or .ot)");
   fs::path p = file;
   if (p.is_relative()) p = fs::path(map_path).parent_path() / p;
   return fs::absolute(p).lexically_normal().string();
@@ -572,7 +565,7 @@ void Map::save(const std::string& path) const {
 }
 
 std::optional<std::size_t> Map::point_collision(const Eigen::Vector3d& p, double radius) const {
-  check_query(p, "point_collision: p");
+  check_query_point(p, "point_collision: p");
   check_query_radius(radius, "point_collision: radius");
   const Box region{p.array() - radius, p.array() + radius};
   if (auto hit = query_index(region, radius * radius, [&](const Box& b) { return squared_distance(p, b); }))
@@ -585,8 +578,8 @@ std::optional<std::size_t> Map::point_collision(const Eigen::Vector3d& p, double
 
 std::optional<std::size_t> Map::segment_collision(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                                   double radius) const {
-  check_query(a, "segment_collision: a");
-  check_query(b, "segment_collision: b");
+  check_query_point(a, "segment_collision: a");
+  check_query_point(b, "segment_collision: b");
   check_query_radius(radius, "segment_collision: radius");
   const Box sweep{a.cwiseMin(b).array() - radius, a.cwiseMax(b).array() + radius};
   if (auto hit = query_index(sweep, radius * radius, [&](const Box& box) { return squared_distance(a, b, box); }))
@@ -598,7 +591,7 @@ std::optional<std::size_t> Map::segment_collision(const Eigen::Vector3d& a, cons
 }
 
 double Map::clearance(const Eigen::Vector3d& p) const {
-  check_query(p, "clearance: p");
+  check_query_point(p, "clearance: p");
   double best = std::numeric_limits<double>::infinity();
   for (const Box& b : obstacles_) best = std::min(best, squared_distance(p, b));
   best = std::sqrt(best);
@@ -606,8 +599,8 @@ double Map::clearance(const Eigen::Vector3d& p) const {
 }
 
 std::optional<double> Map::raycast(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double max_range) const {
-  check_query(origin, "raycast: origin");
-  check_query(dir, "raycast: dir");
+  check_query_point(origin, "raycast: origin");
+  check_query_point(dir, "raycast: dir");
   check_query_radius(max_range, "raycast: max_range");
   std::optional<double> best = voxels_ ? voxels_->raycast(origin, dir, max_range) : std::nullopt;
   const auto consider = [&](std::size_t i) {

@@ -104,7 +104,7 @@ class Map {
   /// anchors a relative voxel file.
   static Map from_json(const Json& doc, const std::string& origin);
   /// Where a map file's "voxels.file" lies: relative names are taken from the map file's folder
-  /// (`map_path` is the map file), the result absolute and normalised.
+  /// (`map_path` is the map file), the result absolute and normalised. An empty `file` is refused.
   static std::string voxel_file_path(const std::string& map_path, const std::string& file);
   /// An OctoMap file as a voxel map (world::read_octree), bounded by its known leaves.
   static Map load_octomap(const std::string& path);

@@ -216,6 +216,7 @@ VoxelObstacles::VoxelObstacles(std::shared_ptr<const VoxelLayer> layer, UnknownP
 }
 
 double VoxelObstacles::distance_lower_bound(const Eigen::Vector3d& p) const {
+  check_query_point(p, "distance_lower_bound: p");
   if (blocked_count_ == 0) return kInf;
   const VoxelLayer& L = *layer_;
   const Eigen::Vector3i c = L.clamped_cell(p);
@@ -259,6 +260,8 @@ std::optional<std::size_t> VoxelObstacles::containing_blocked(const Eigen::Vecto
 }
 
 std::optional<std::size_t> VoxelObstacles::point_hit(const Eigen::Vector3d& p, double radius) const {
+  check_query_point(p, "point_hit: p");
+  check_query_radius(radius, "point_hit: radius");
   if (blocked_count_ == 0 || distance_lower_bound(p) > radius) return std::nullopt;
   if (const auto inside = containing_blocked(p)) return inside;
   return exact_hit(p, p, radius);
@@ -266,6 +269,9 @@ std::optional<std::size_t> VoxelObstacles::point_hit(const Eigen::Vector3d& p, d
 
 std::optional<std::size_t> VoxelObstacles::segment_hit(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                                        double radius) const {
+  check_query_point(a, "segment_hit: a");
+  check_query_point(b, "segment_hit: b");
+  check_query_radius(radius, "segment_hit: radius");
   if (blocked_count_ == 0) return std::nullopt;
   const Eigen::Vector3d d = b - a;
   const double len = d.norm();
@@ -313,6 +319,7 @@ std::optional<std::size_t> VoxelObstacles::segment_hit(const Eigen::Vector3d& a,
 }
 
 double VoxelObstacles::clearance(const Eigen::Vector3d& p) const {
+  check_query_point(p, "clearance: p");
   if (blocked_count_ == 0) return kInf;
   // The nearest blocked cube lies within upper = d_c + |p - centre_c| + half diagonal of p:
   // test the cubes of that ball's box exactly.
@@ -340,6 +347,9 @@ double VoxelObstacles::clearance(const Eigen::Vector3d& p) const {
 
 std::optional<double> VoxelObstacles::raycast(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
                                               double max_range) const {
+  check_query_point(origin, "raycast: origin");
+  check_query_point(dir, "raycast: dir");
+  check_query_radius(max_range, "raycast: max_range");
   if (blocked_count_ == 0) return std::nullopt;
   const VoxelLayer& L = *layer_;
   const Box box = L.bounds();

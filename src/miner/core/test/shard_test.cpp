@@ -34,3 +34,12 @@ TEST_CASE("Part tags are checked against their names and their fields' types bef
   CHECK_THROWS_WITH(miner::require_complete_parts({Json{{"index", 0}}}, {"a.json"}, "job"), Contains("integer \"count\""));
   CHECK_NOTHROW(miner::require_complete_parts({part, Json{{"index", 1}, {"count", 2}}}, {"a", "b"}, "job"));
 }
+
+TEST_CASE("A shard is two decimal numbers and one slash: blanks, signs and other bases are refused",
+          "[REQ-LIB-003][REQ-REPORT-006]") {
+  // Tenth campaign recheck: std::stoi skipped a leading blank and took a sign.
+  CHECK(miner::parse_shard("0/2") == std::pair<int, int>{0, 2});
+  CHECK(miner::parse_shard("11/12") == std::pair<int, int>{11, 12});
+  for (const char* bad : {" 0/2", "0/2 ", "+0/2", "0/+2", "-0/2", "0x1/2", "0/2/3", "/2", "0/", "0 / 2", "0/1e1", ""})
+    CHECK_THROWS_WITH(miner::parse_shard(bad), Contains("--shard: expected i/N"));
+}

@@ -8,6 +8,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 
 #include <unistd.h>
@@ -498,9 +499,9 @@ TEST_CASE("A reference flies only in the scenario it was built for", "[REQ-FLIGH
   auto slow = s;
   slow.limits.v_max = 0.5 * ref.max_speed;
   CHECK_THROWS_WITH(pipeline::fly(slow, ref), Contains("exceed the scenario's trajectory.v_max"));
-  auto walled = s;  // the same room with a pillar on the reference's way
+  auto walled = s;  // the same room with a pillar on the reference's way, between two waypoints
   auto obstacles = s.map->obstacles();
-  const Eigen::Vector3d mid = ref.trajectory.evaluate(0.5 * ref.trajectory.total_duration());
+  const Eigen::Vector3d mid = ref.trajectory.evaluate(0.3 * ref.trajectory.total_duration());
   obstacles.push_back(miner::world::Box{mid - Eigen::Vector3d::Constant(0.2), mid + Eigen::Vector3d::Constant(0.2)});
   walled.map = std::make_shared<const miner::world::Map>(s.map->bounds(), s.map->resolution(), obstacles);
   CHECK_THROWS_WITH(pipeline::fly(walled, ref), Contains("of an obstacle of the scenario's map"));
@@ -556,7 +557,8 @@ TEST_CASE("A flight stops the first tick the vehicle is outside its world and sa
   auto small = s;
   small.map = std::make_shared<const miner::world::Map>(miner::world::Box{{0, 0, 0}, {kWallX, 20, 10}}, 0.5,
                                                         std::vector<miner::world::Box>{});
-  CHECK_THROWS_WITH(pipeline::fly(small, ref), Contains("build the reference from this scenario"));
+  // (Its goal now lies outside the map: the scenario itself is refused, by check_scenario.)
+  CHECK_THROWS_WITH(pipeline::fly(small, ref), Contains("goal (11, 6, 3) lies outside the map bounds"));
   // ... and bounds the flight by the scenario's map: a wind the vehicle cannot hold against
   // blows it out, and the flight stops there.
   auto windy = s;
@@ -596,6 +598,88 @@ TEST_CASE("flight::fly bounds the simulated time itself, whoever calls it", "[RE
   CHECK_THROWS_WITH(flight::fly(setup, r), Contains("command_dropout"));
   setup.command_dropout = std::make_pair(5.0, 1.0);
   CHECK_THROWS_WITH(flight::fly(setup, r), Contains("command_dropout"));
+}
+
+TEST_CASE("A Scenario changed in C++ after reading is checked by the reader's own rules before it is built or flown",
+          "[REQ-LIB-003][REQ-FLIGHT-007]") {
+  // Tenth campaign L12: a scenario's sensor, EKF, wind and controller fields changed after
+  // reading were flown unchecked (an IMU noise of NaN flew and missed the goal); a null map
+  // crashed build_reference; an unknown region or allocation name was built with a default.
+  const pipeline::Scenario s = pipeline::default_scenario();
+  CHECK_NOTHROW(pipeline::check_scenario(s));
+  // Every shipped scenario passes as read: the struct written back says what its file said ...
+  for (const char* name : {"default", "realistic", "forest-lidar", "indoor-1-lidar", "rooms-depth"}) {
+    INFO(name);
+    const pipeline::Scenario read = pipeline::load_scenario(kScenarios + "/" + name + ".json");
+    CHECK_NOTHROW(pipeline::check_scenario(read));
+    // ... and reads back to the same document (a box map inlined; a voxel map stays the file's).
+    if (read.map->voxels()) continue;
+    miner::Json doc = pipeline::scenario_document(read);
+    doc["map"] = read.map->to_json();
+    const pipeline::Scenario again = pipeline::scenario_from_json(doc, "again", "");
+    CHECK(pipeline::scenario_document(again) == pipeline::scenario_document(read));
+  }
+  const pipeline::ReferencePlan r = pipeline::build_reference(s);
+  const double nan = std::nan("");
+  // Each change is refused by build_reference and by fly, naming the field as a file would.
+  const auto refused = [&](const std::function<void(pipeline::Scenario&)>& change, const std::string& field) {
+    pipeline::Scenario changed = s;
+    change(changed);
+    CHECK_THROWS_WITH(pipeline::check_scenario(changed), Contains("(the Scenario struct)") && Contains(field));
+    CHECK_THROWS_WITH(pipeline::build_reference(changed), Contains(field));
+    CHECK_THROWS_WITH(pipeline::fly(changed, r), Contains(field));
+  };
+  refused([](pipeline::Scenario& c) { c.map.reset(); }, "map: none");
+  refused([&](pipeline::Scenario& c) { c.imu.accel_noise_density = c.ekf.imu.accel_noise_density = nan; }, "imu.accel_noise_density");
+  refused([](pipeline::Scenario& c) { c.imu.gyro_noise_density = c.ekf.imu.gyro_noise_density = 1e6; }, "imu.gyro_noise_density");
+  refused([](pipeline::Scenario& c) { c.imu.accel_noise_density = 0.5; }, "ekf.imu / ekf.pose differ");
+  refused([](pipeline::Scenario& c) {
+    c.wind.enabled = true;
+    c.wind.mean = Eigen::Vector3d(1e3, 0, 0);
+  }, "wind.mean_m_s");
+  refused([](pipeline::Scenario& c) {
+    c.wind.enabled = true;
+    c.wind.sigma_horizontal = -1.0;
+  }, "wind.sigma_horizontal_m_s");
+  refused([](pipeline::Scenario& c) {
+    c.wind.enabled = true;
+    c.wind.length_vertical = 0.0;
+  }, "wind.length_vertical_m");
+  refused([](pipeline::Scenario& c) { c.controller.kp = Eigen::Vector3d(1e300, 1, 1); }, "controller.kp");
+  refused([](pipeline::Scenario& c) { c.n3.timeout_s = 1e-6; }, "n3.timeout_s");
+  refused([](pipeline::Scenario& c) { c.ekf.gate_probability = 1.0; }, "ekf.gate_probability");
+  refused([](pipeline::Scenario& c) { c.region = "bogus"; }, "planner.region");
+  refused([](pipeline::Scenario& c) { c.allocation = "bogus"; }, "trajectory.allocation");
+  refused([](pipeline::Scenario& c) { c.order = 7; }, "trajectory.order");
+  refused([](pipeline::Scenario& c) { c.limits.v_max = -1.0; }, "trajectory.v_max");
+  refused([&](pipeline::Scenario& c) { c.start = Eigen::Vector3d(nan, 1, 1); }, "start");
+  refused([](pipeline::Scenario& c) { c.vehicle.mass = 0.0; }, "vehicle");
+  refused([](pipeline::Scenario& c) { c.mismatch.mass = 5.0; }, "mismatch.mass");
+  refused([](pipeline::Scenario& c) { c.name = "../x"; }, "name");
+  // What the checks leave alone still builds and flies: a struct's empty waypoint list is the
+  // straight leg, a velocity-mode yaw keeps its unused fixed angle, a yaw of exactly 180 deg.
+  pipeline::Scenario fine = s;
+  fine.yaw.mode = flight::YawParams::Mode::kVelocity;
+  fine.yaw.fixed = 3.0;
+  CHECK_NOTHROW(pipeline::check_scenario(fine));
+  fine.yaw.mode = flight::YawParams::Mode::kFixed;
+  fine.yaw.fixed = miner::kPi;
+  CHECK_NOTHROW(pipeline::check_scenario(fine));
+  fine.waypoints = Eigen::MatrixX3d(0, 3);
+  CHECK_NOTHROW(pipeline::check_scenario(fine));
+}
+
+TEST_CASE("flight::fly refuses a reference that does not start where the vehicle hovers", "[REQ-LIB-003][REQ-FLIGHT-007]") {
+  // Tenth campaign recheck: a reference 42 m from the setup's start was flown (6 s, RMSE 42 m)
+  // and came back as an ordinary flight.
+  const pipeline::Scenario s = pipeline::default_scenario();
+  const pipeline::ReferencePlan r = pipeline::build_reference(s);
+  flight::FlightSetup setup = s;
+  setup.hover_after_s = 0.1;
+  setup.start += Eigen::Vector3d(1e-3, 0, 0);
+  CHECK_THROWS_WITH(flight::fly(setup, r), Contains("the reference starts at") && Contains("where the vehicle hovers"));
+  setup.start = s.start + Eigen::Vector3d(0, 0, 1e-8);  // within the ends' tolerance: flown
+  CHECK_NOTHROW(flight::fly(setup, r));
 }
 
 TEST_CASE("A collision is counted once per entry into an obstacle, not once per tick inside it",

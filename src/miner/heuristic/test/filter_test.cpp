@@ -275,4 +275,16 @@ TEST_CASE("Tenth campaign: grid masks cells dilations and scale divisors are che
   CHECK(heuristic::encode_state(b, d, Eigen::Vector3d(0.5, 0.5, 0.5), Eigen::Vector3d(3.5, 3.5, 3.5), 0)[0] == 1);
   CHECK_THROWS_WITH(heuristic::scale_input(b, d, 0.2, 0.0), Contains("scale divisor"));
   CHECK_THROWS_WITH(heuristic::scale_input(b, d, 0.2, NAN), Contains("scale divisor"));
+  // Recheck: dims of 0 encoded an empty environment; a NaN radius grew no obstacle (all free).
+  const miner::world::Map walled(b, 0.5, {miner::world::Box{{1.5, 0, 0}, {2, 4, 4}}});
+  CHECK_THROWS_WITH(heuristic::encode_environment(walled, Eigen::Vector3i(0, 4, 4), 0.2), Contains("region dims"));
+  CHECK_THROWS_WITH(heuristic::encode_environment(walled, Eigen::Vector3i(1 << 20, 1 << 20, 1 << 20), 0.2),
+                    Contains("more than the limit"));
+  CHECK_THROWS_WITH(heuristic::encode_environment(walled, Eigen::Vector3i(4, 4, 4), std::nan("")),
+                    Contains("encode: robot radius"));
+  CHECK_THROWS_WITH(heuristic::encode_environment_passability(walled, Eigen::Vector3i(4, 4, 4), -1.0),
+                    Contains("encode: robot radius"));
+  CHECK_THROWS_WITH(heuristic::encode_state(b, Eigen::Vector3i(4, 0, 4), Eigen::Vector3d(1, 1, 1), Eigen::Vector3d(3, 3, 3), 0),
+                    Contains("region dims"));
+  CHECK(heuristic::encode_environment(walled, Eigen::Vector3i(4, 4, 4), 0.2).size() == 64);
 }

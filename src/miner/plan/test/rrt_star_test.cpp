@@ -478,6 +478,23 @@ TEST_CASE("Tenth campaign: plan() checks a problem however it was filled, and a 
   // L5: a NaN point anywhere in a region's path is named before any point is walked.
   CHECK_THROWS_WITH(HeuristicRegion::from_path(map.bounds(), I(32, 32, 32), {V(1, 1, 1), V(nan, 9, 9)}, 1, "x"),
                     Contains("region path point 1"));
+  // Recheck: an int cast to PlannerKind outside its four values planned as RRT*; a negative
+  // target cost could never be met; a region of +-1e300 m had a volume of 1e302 m^3.
+  p.map = &map;
+  o.planner = static_cast<PlannerKind>(9);
+  CHECK_THROWS_WITH(miner::plan::plan(p, o), Contains("planner: 9 is not a PlannerKind"));
+  o.planner = static_cast<PlannerKind>(-1);
+  CHECK_THROWS_WITH(miner::plan::plan(p, o), Contains("is not a PlannerKind"));
+  o.planner = PlannerKind::kGuided;
+  CHECK_NOTHROW(miner::plan::plan(p, o));
+  o.target_cost = -1.0;
+  CHECK_THROWS_WITH(miner::plan::plan(p, o), Contains("target_cost: must be a finite path length >= 0"));
+  o.target_cost = 0.0;  // met by nothing but a start in the goal: runs the budget
+  CHECK_NOTHROW(miner::plan::plan(p, o));
+  CHECK_THROWS_WITH(HeuristicRegion(miner::world::Box{{-1e300, 0, 0}, {1e300, 10, 10}}, I(2, 2, 2),
+                                    std::vector<double>(8, 1.0), 0.5),
+                    Contains("region bounds.min") && Contains("farther than"));
+  CHECK_NOTHROW(HeuristicRegion(miner::world::Box{{-1e6, 0, 0}, {1e6, 10, 10}}, I(2, 2, 2), std::vector<double>(8, 1.0), 0.5));
 }
 
 TEST_CASE("A start within the goal radius is joined to the goal only by a free segment", "[REQ-PLAN-001][REQ-PLAN-015]") {

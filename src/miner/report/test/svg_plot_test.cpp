@@ -1,4 +1,5 @@
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include <catch2/catch.hpp>
@@ -130,6 +131,35 @@ TEST_CASE("the event timeline has a lane per kind, a bar per interval, counts an
   // Three lanes: the svg's height grows with them.
   CHECK_THAT(svg, Contains("height=\"134\""));
   CHECK(svg == svg_event_timeline(axes, lanes, 10.0));
+}
+
+TEST_CASE("the event timeline draws overlapping bars as one, so its size is bounded by the plot, and refuses NaN",
+          "[REQ-LIB-003][REQ-REPORT-012]") {
+  PlotAxes axes{"Events", "time (s)", ""};
+  axes.width = 1200;
+  // Two intervals that overlap, and one instant inside another: two bars, not four.
+  const std::vector<EventLane> overlapping{{"failsafe", "#d62728", {{2.0, 4.5}, {4.0, 6.0}, {8.0, 9.0}, {8.5, 8.5}}}};
+  const std::string two = svg_event_timeline(axes, overlapping, 10.0);
+  CHECK(count(two, "class=\"event\"") == 2);
+  CHECK_THAT(two, Contains("failsafe: 4,"));  // the label still counts every interval
+  // Tenth campaign recheck: 10^6 intervals drew 10^6 rectangles (> 20 s). Now at most one bar per
+  // pixel column of the 1200 px plot, whatever their number and order.
+  EventLane many{"collision", "#000000", {}};
+  for (int i = 0; i < 1000000; ++i) {
+    const double t = 10.0 * static_cast<double>((static_cast<long long>(i) * 7919) % 1000000) / 1e6;  // every 10 us, shuffled
+    many.intervals.emplace_back(t, t);
+  }
+  const std::string dense = svg_event_timeline(axes, {many}, 10.0);
+  CHECK(count(dense, "class=\"event\"") == 1);  // 2 px bars every 0.012 px touch: one bar
+  CHECK_THAT(dense, Contains("collision: 1000000,"));
+  CHECK(dense.size() < 10000);
+  // Bars farther apart than 2 px stay apart.
+  EventLane sparse{"dropout", "#9467bd", {}};
+  for (int i = 0; i < 100; ++i) sparse.intervals.emplace_back(0.1 * i, 0.1 * i);
+  CHECK(count(svg_event_timeline(axes, {sparse}, 10.0), "class=\"event\"") == 100);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  CHECK_THROWS_WITH(svg_event_timeline(axes, {EventLane{"failsafe", "#000", {{1.0, nan}}}}, 10.0),
+                    Contains("lane \"failsafe\": interval 0") && Contains("not finite"));
 }
 
 TEST_CASE("Ticks of a finite range too wide or too narrow for a double are refused, not a crash",

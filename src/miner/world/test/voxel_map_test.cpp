@@ -194,6 +194,21 @@ TEST_CASE("Tenth campaign: the map API refuses what it cannot answer by name and
   // L2: a missing layer is named wherever it is given.
   CHECK_THROWS_WITH(Map::from_voxels(VoxelSource{}), Contains("voxels: no layer"));
   CHECK_THROWS_WITH(VoxelObstacles(nullptr, UnknownPolicy::kOccupied), Contains("voxels: no layer"));
+  // Recheck: the voxel obstacles' own queries, called directly, read cell -2^31 for a NaN point
+  // (a segmentation fault); they check their arguments as Map's do.
+  const VoxelObstacles& direct = *voxels.voxels();
+  CHECK_THROWS_WITH(direct.point_hit(V(nan, 1, 1), 0.1), Contains("point_hit: p[0]"));
+  CHECK_THROWS_WITH(direct.point_hit(V(1, 1, 1), nan), Contains("point_hit: radius"));
+  CHECK_THROWS_WITH(direct.segment_hit(V(1, 1, 1), V(1, inf, 1), 0.1), Contains("segment_hit: b[1]"));
+  CHECK_THROWS_WITH(direct.segment_hit(V(1, 1, 1), V(2, 1, 1), -1.0), Contains("segment_hit: radius"));
+  CHECK_THROWS_WITH(direct.clearance(V(1, 1, inf)), Contains("clearance: p[2]"));
+  CHECK_THROWS_WITH(direct.raycast(V(1, 1, 1), V(nan, 0, 0), 5.0), Contains("raycast: dir[0]"));
+  CHECK_THROWS_WITH(direct.raycast(V(1, 1, 1), V(1, 0, 0), -5.0), Contains("raycast: max_range"));
+  CHECK_THROWS_WITH(direct.distance_lower_bound(V(nan, nan, nan)), Contains("distance_lower_bound: p[0]"));
+  CHECK(direct.point_hit(V(2.5, 2.5, 2.5), 0.0).has_value());
+  // An empty voxel file name is no file (the map's folder came back).
+  CHECK_THROWS_WITH(Map::voxel_file_path("/a/b/map.json", ""), Contains("voxels.file: is empty"));
+  CHECK(Map::voxel_file_path("/a/b/map.json", "v.bt") == "/a/b/v.bt");
   // L8: bounds beyond the voxels, under the occupied policy, are refused by the constructor as
   // by the reader; with unknown space free they are accepted.
   VoxelSource source{small_layer(), UnknownPolicy::kOccupied, "", ""};

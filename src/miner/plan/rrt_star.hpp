@@ -134,7 +134,7 @@ struct PlanResult {
   PlannerKind planner = PlannerKind::kRrtStar;
   bool solved = false;
   std::string reason;  ///< why not solved (empty if solved)
-  std::vector<Eigen::Vector3d> path;  ///< x_init, ..., x_goal
+  std::vector<Eigen::Vector3d> path;  ///< x_init, ..., x_goal (the one point x_init when start == goal, cost 0)
   double cost = 0.0;                  ///< Euclidean length of path
   std::size_t iterations = 0;
   std::size_t nodes = 0;

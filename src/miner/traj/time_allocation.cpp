@@ -186,7 +186,9 @@ void validate(const AllocationOptions& o) {
   if (o.samples_per_segment < 2 || o.samples_per_segment > kMaxSamplesPerSegment)
     throw Error("samples per segment: must be in [2, " + std::to_string(kMaxSamplesPerSegment) + "], got " +
                 std::to_string(o.samples_per_segment));
-  if (o.max_iterations < 1) throw Error("allocation iterations: must be at least 1");
+  if (o.max_iterations < 1 || o.max_iterations > kMaxAllocationIterations)
+    throw Error("allocation iterations: must be in [1, " + std::to_string(kMaxAllocationIterations) + "], got " +
+                std::to_string(o.max_iterations));
 }
 
 }  // namespace

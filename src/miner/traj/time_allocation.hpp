@@ -54,8 +54,13 @@ struct AllocationOptions {
   /// Speed and acceleration are checked at this many + 1 instants per segment (and the limits
   /// said to hold there).
   int samples_per_segment = 32;
-  int max_iterations = 100;   ///< Ceres line-search iterations per round
+  int max_iterations = 100;   ///< Ceres line-search iterations per round, in [1, kMaxAllocationIterations]
 };
+
+/// The most Ceres iterations a round may take: each is a MINCO solve and a sampled limit check,
+/// and the default converges in tens; INT_MAX was accepted and bounded only by convergence
+/// (tenth campaign recheck).
+inline constexpr int kMaxAllocationIterations = 10000;
 
 struct AllocationResult {
   std::vector<double> durations;          ///< the optimised, feasible durations

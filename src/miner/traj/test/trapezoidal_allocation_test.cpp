@@ -87,6 +87,17 @@ TEST_CASE("Tenth campaign: the trajectory API refuses what would give NaN, garba
   AllocationOptions too_many;
   too_many.samples_per_segment = 100000000;
   CHECK_THROWS_WITH(optimise_allocation(rest_to_rest(4, pts, {2.0, 2.0}), too_many), Contains("samples per segment"));
+  // Recheck: INT_MAX Ceres iterations were bounded only by convergence.
+  AllocationOptions endless;
+  endless.max_iterations = kMaxAllocationIterations + 1;
+  CHECK_THROWS_WITH(optimise_allocation(rest_to_rest(4, pts, {2.0, 2.0}), endless), Contains("allocation iterations: must be in [1, 10000]"));
+  endless.max_iterations = 0;
+  CHECK_THROWS_WITH(optimise_allocation(rest_to_rest(4, pts, {2.0, 2.0}), endless), Contains("allocation iterations"));
+  // A coefficient matrix resized through mutable_coefficients() is named, not read past its end.
+  PolynomialTrajectory cut = t;
+  cut.mutable_coefficients().conservativeResize(10, 3);
+  CHECK_THROWS_WITH(cut.evaluate_segment(1, 0.5), Contains("segment 1 needs coefficient rows up to 16, the matrix has 10"));
+  CHECK(cut.evaluate_segment(0, 0.5) == t.evaluate_segment(0, 0.5));
   // L16: the dense baselines validate their problem and bound their matrices.
   MincoProblem bad = rest_to_rest(4, pts, {2.0, 2.0});
   bad.durations[1] = nan;

@@ -101,9 +101,11 @@ def sync_tree(root: pathlib.Path, tree: pathlib.Path) -> None:
         shutil.copy2(src, dst)
 
 
-def sh(cmd: list[str], timeout: float | None = None, cwd: pathlib.Path | None = None) -> tuple[int, str]:
+def sh(cmd: list[str], timeout: float | None = None, cwd: pathlib.Path | None = None,
+       env: dict[str, str] | None = None) -> tuple[int, str]:
     try:
-        r = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, cwd=cwd)
+        r = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, cwd=cwd,
+                           env=None if env is None else {**os.environ, **env})
         return r.returncode, r.stdout + r.stderr
     except subprocess.TimeoutExpired:
         return -9, f"timed out after {timeout} s"
@@ -163,7 +165,10 @@ class Build:
     def run(self, selection: list[tuple[str, str]], timeout: float) -> tuple[bool, str]:
         """True when every selected test passes; else the first failing (target, spec)."""
         for target, spec in selection:
-            rc, out = sh([self.binaries[target]["path"], spec], timeout=timeout, cwd=self.dir)
+            # As ctest runs them: MINER_SOURCE_DIR names the (scratch) tree (the session 31 audit:
+            # two cli_test cases read fixtures relative to the working folder and failed unmutated).
+            rc, out = sh([self.binaries[target]["path"], spec], timeout=timeout, cwd=self.dir,
+                         env={"MINER_SOURCE_DIR": str(self.tree)})
             if rc != 0:
                 return False, f"{target} {spec}" + (" (timeout)" if rc == -9 else "")
         return True, ""

@@ -1323,7 +1323,7 @@ TEST_CASE("miner fly runs sGAN region, MINER RRT*, MINCO and flight and keeps ev
 }
 
 TEST_CASE("miner bench paper writes the four tables beside the paper's numbers, with box plots", "[REQ-REPORT-005]") {
-  const std::string src = std::getenv("MINER_SOURCE_DIR") ? std::getenv("MINER_SOURCE_DIR") : ".";
+  const std::string src = MINER_SOURCE_DIR;  // the build's source tree, whatever the working folder
   const std::string results = dir() + "/paper/results.md";
   const Run r = miner_cli({"bench", "paper", "--maps", src + "/fixtures/maps/sim-1.json", "--planners",
                            "rrtstar,miner-sgan,miner,ompl:RRTConnect", "--runs", "2", "--time-limit", "0.2",
@@ -1389,7 +1389,7 @@ miner::Json without_clock(const miner::Json& j) {
 }  // namespace
 
 TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[REQ-REPORT-006][REQ-PLAN-017]") {
-  const std::string src = std::getenv("MINER_SOURCE_DIR") ? std::getenv("MINER_SOURCE_DIR") : ".";
+  const std::string src = MINER_SOURCE_DIR;  // the build's source tree, whatever the working folder
   // OMPL planners too: each OMPL run is seeded from the campaign's stream for that run, so
   // a shard holding runs 1 and 4 gives what the unsharded campaign gives for them.
   const std::string planners = miner::bench::ompl_available() ? "rrtstar,informed,miner,ompl:RRTstar,ompl:RRTConnect"

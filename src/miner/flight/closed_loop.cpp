@@ -162,6 +162,7 @@ FlightResult fly(const FlightSetup& s, const ReferenceTrajectory& reference, con
 
   long ticks = total_ticks;
   for (long k = 0; k < total_ticks; ++k) {
+    if (options.poll && k % kPollTicks == kPollTicks - 1) options.poll();
     const double t = static_cast<double>(k) * dt;
     // Outside the world nothing is left to simulate (no map, no obstacles, no goal to fly
     // back to): the flight ends the first N3 tick the vehicle is out, and says where.

@@ -80,7 +80,13 @@ struct FlyOptions {
   bool record_log = true;         ///< keep the flight log rows
   bool record_consistency = false;  ///< NEES at the EKF horizon every control tick
   IntegratorOptions integrator;
+  /// Called every kPollTicks N3 ticks, if set; it may throw to abandon the flight (the Python
+  /// module raises KeyboardInterrupt through it: eleventh campaign P1).
+  std::function<void()> poll;
 };
+
+/// How often FlyOptions::poll is called: 4000 ticks are 10 s of flight at the N3's 400 Hz.
+inline constexpr long kPollTicks = 4000;
 
 /// Column names of the flight log (one row per controller tick) and their units.
 const std::vector<std::string>& flight_log_columns();

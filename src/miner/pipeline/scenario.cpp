@@ -406,7 +406,11 @@ Json self_contained_scenario(Json doc, const std::string& base_dir) {
   if (!doc.is_object()) return doc;  // scenario_from_json names the fault
   if (doc.contains("map") && doc["map"].is_string()) {
     const std::string map = resolve(base_dir, doc["map"].get<std::string>());
-    doc["map"] = std::filesystem::path(map).extension() == ".json" ? read_json_file(map) : Json(absolute(map));
+    // `map` is already resolved against base_dir: made absolute as it is (eleventh campaign C1:
+    // resolving it a second time recorded "scen/out/m.bt" for "../out/m.bt" of scen/x.json).
+    doc["map"] = std::filesystem::path(map).extension() == ".json"
+                     ? read_json_file(map)
+                     : Json(std::filesystem::absolute(map).lexically_normal().string());
     // An inlined map's voxel file is relative to the map's folder, not the scenario's.
     Json& m = doc["map"];
     if (m.is_object() && m.contains("voxels") && m["voxels"].is_object() && m["voxels"].contains("file") &&

@@ -287,6 +287,7 @@ PlanResult RrtStar::run() {
     // grow the tree (issue 20, third campaign: 20 000 iterations after a cost-0 answer).
     if (best_cost_ <= (problem_.goal - problem_.start).norm()) break;
     ++iteration;
+    if (options_.poll && iteration % kPollIterations == 0) options_.poll();
     update_trust(iteration);
     const Eigen::Vector3d x_rand = sample();
     const std::size_t nearest = tree_.nearest(x_rand);

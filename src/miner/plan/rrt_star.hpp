@@ -38,6 +38,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -87,7 +88,14 @@ struct PlannerOptions {
   std::optional<double> target_cost;   ///< stop as soon as the cost is <= this
   bool stop_at_first = false;          ///< stop at the first solution (Alg. 1 Line 24)
   bool record_tree = false;            ///< keep the final tree in the result
+  /// Called every kPollIterations iterations on the planning thread, if set; it may throw to
+  /// abandon the run (the exception leaves plan()). The Python module raises KeyboardInterrupt
+  /// through it (eleventh campaign P1: Ctrl-C waited for the whole budget, ~40 s at 10^6).
+  std::function<void()> poll;
 };
+
+/// How often PlannerOptions::poll is called: ~1024 iterations are tens of milliseconds.
+inline constexpr std::size_t kPollIterations = 1024;
 
 /// eta actually used: options.steer_step, or 0.1 x the diagonal of the map's bounds.
 double resolved_steer_step(const PlannerOptions& options, const world::Map& map);

@@ -1,6 +1,7 @@
 #include "miner/world/box.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <array>
 #include <string>
 
@@ -87,6 +88,22 @@ double squared_distance(const Eigen::Vector3d& a, const Eigen::Vector3d& b, cons
 
 void check_query_point(const Eigen::Vector3d& p, const char* field) {
   if (!p.allFinite()) require_finite(p, field);
+}
+
+void check_query_direction(const Eigen::Vector3d& dir, const char* field) {
+  check_query_point(dir, field);
+  // |dir| of a normalised vector is 1 within a few ulps; 1e-6 forgives a float-made direction.
+  constexpr double kUnitTolerance = 1e-6;
+  const double n = dir.norm();
+  if (!(std::abs(n - 1.0) <= kUnitTolerance))
+    throw Error(std::string(field) + ": must be a unit vector (the distance is measured along it), got length " +
+                short_number(n));
+}
+
+void check_clearance_range(const Eigen::Vector3d& p) {
+  if (!(p.cwiseAbs().maxCoeff() <= kMaxCoordinate))
+    throw Error("clearance: p " + format_point(p) + " lies farther than " + short_number(kMaxCoordinate) +
+                " m from the origin (a map's range): no distance is asked that far");
 }
 
 void check_query_radius(double radius, const char* field) {

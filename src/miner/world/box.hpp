@@ -14,6 +14,10 @@
 
 namespace miner::world {
 
+/// 1000 km from the origin: double then keeps metres to ~1e-10 m, and a map of the Earth's
+/// scale still fits; beyond it a local frame is what the user needs.
+inline constexpr double kMaxCoordinate = 1e6;
+
 struct Box {
   Eigen::Vector3d min;
   Eigen::Vector3d max;
@@ -56,5 +60,13 @@ double squared_distance(const Eigen::Vector3d& a, const Eigen::Vector3d& b, cons
 /// string is built), so the hot queries call them each time.
 void check_query_point(const Eigen::Vector3d& p, const char* field);
 void check_query_radius(double radius, const char* field);
+/// A ray's direction is a finite unit vector (within kUnitTolerance): the distance a raycast
+/// answers is measured along it (eleventh campaign L2: a direction of length 10 answered a
+/// tenth of the distance, a zero one "nothing within range").
+void check_query_direction(const Eigen::Vector3d& dir, const char* field);
+/// A clearance is asked within 10^6 m (kMaxCoordinate, a map's range) of the origin on every
+/// axis: at 1e155 m the squared distance overflowed and the answer was +infinity (eleventh
+/// campaign P3), and a voxel map walked every cell for it.
+void check_clearance_range(const Eigen::Vector3d& p);
 
 }  // namespace miner::world

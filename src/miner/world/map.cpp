@@ -592,6 +592,7 @@ std::optional<std::size_t> Map::segment_collision(const Eigen::Vector3d& a, cons
 
 double Map::clearance(const Eigen::Vector3d& p) const {
   check_query_point(p, "clearance: p");
+  check_clearance_range(p);
   double best = std::numeric_limits<double>::infinity();
   for (const Box& b : obstacles_) best = std::min(best, squared_distance(p, b));
   best = std::sqrt(best);
@@ -600,7 +601,7 @@ double Map::clearance(const Eigen::Vector3d& p) const {
 
 std::optional<double> Map::raycast(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double max_range) const {
   check_query_point(origin, "raycast: origin");
-  check_query_point(dir, "raycast: dir");
+  check_query_direction(dir, "raycast: dir");
   check_query_radius(max_range, "raycast: max_range");
   std::optional<double> best = voxels_ ? voxels_->raycast(origin, dir, max_range) : std::nullopt;
   const auto consider = [&](std::size_t i) {

@@ -49,9 +49,6 @@ inline constexpr double kMinResolution = 1e-3;
 inline constexpr double kMaxResolution = 100.0;
 /// The resolutions a generated family map may be given (`map gen --resolution`): 1 cm to 10 m.
 inline constexpr double kMinFamilyResolution = 0.01, kMaxFamilyResolution = 10.0;
-/// 1000 km from the origin: double then keeps metres to ~1e-10 m, and a map of the Earth's
-/// scale still fits; beyond it a local frame is what the user needs.
-inline constexpr double kMaxCoordinate = 1e6;
 /// A vehicle 20 m across; the scan's swept body has the same bound (core/units.hpp).
 using miner::kMaxRobotRadius;
 /// Throws miner::Error "<field>: ..." unless `resolution` is finite and in [kMinResolution,
@@ -164,9 +161,11 @@ class Map {
     return in_bounds(a) && in_bounds(b) && !segment_collision(a, b, radius);
   }
 
-  /// Distance from p to the nearest obstacle (+infinity with no obstacles).
+  /// Distance from p to the nearest obstacle (+infinity with no obstacles). p lies within
+  /// kMaxCoordinate of the origin on every axis (the squares of farther distances overflow).
   double clearance(const Eigen::Vector3d& p) const;
-  /// Distance along the unit direction `dir` to the first obstacle surface within max_range.
+  /// Distance along the unit direction `dir` (|dir| = 1 within 1e-6, else miner::Error) to the
+  /// first obstacle surface within max_range.
   std::optional<double> raycast(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double max_range) const;
 
   /// Throws miner::Error unless a robot of `radius` can stand at p; `what` names the

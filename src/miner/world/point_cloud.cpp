@@ -11,6 +11,7 @@
 #include <octomap/OcTree.h>
 
 #include "miner/core/error.hpp"
+#include "miner/core/text.hpp"
 #include "miner/core/json_io.hpp"
 #include "miner/world/map.hpp"
 #include "miner/world/octree_leaves.hpp"
@@ -476,6 +477,10 @@ PointCloud read_point_cloud(const std::string& path) {
 std::shared_ptr<const VoxelLayer> integrate_clouds(const std::vector<CloudScan>& scans, double resolution,
                                                    double max_range) {
   check_resolution(resolution, "resolution");
+  // "If positive": 0 is no limit; a NaN or negative range was also taken as none (eleventh
+  // campaign L3).
+  if (!(std::isfinite(max_range) && max_range >= 0.0))
+    throw Error("max_range: must be a finite range >= 0 m (0: no limit), got " + short_number(max_range));
   octomap::OcTree tree(resolution);
   const double reach = 32767.0 * resolution;
   const auto point = [](const Eigen::Vector3d& p) {
@@ -494,7 +499,15 @@ std::shared_ptr<const VoxelLayer> integrate_clouds(const std::vector<CloudScan>&
       throw Error(label(s) + ": the sensor origin " + format_point(scans[s].origin) +
                   " (--origin, or the cloud's own viewpoint) lies beyond OctoMap's key range at this resolution "
                   "(32767 voxels from the origin)");
-    finite_points += scans[s].cloud.points.size();
+    // The file readers skip and count non-finite points; a cloud filled in code must leave them
+    // out too (eleventh campaign L3: (3, 0, NaN) was integrated as some voxel, (NaN, 0, 1) blamed
+    // on the key range).
+    const auto& points = scans[s].cloud.points;
+    for (std::size_t i = 0; i < points.size(); ++i)
+      if (!points[i].allFinite())
+        throw Error(label(s) + ": point " + std::to_string(i) + " " + format_point(points[i]) +
+                    " is not finite (leave such points out, as the file readers do: they skip and count them)");
+    finite_points += points.size();
   }
   // Named by the clouds' files (seventh campaign C8: an empty PLY named none).
   if (finite_points == 0) {

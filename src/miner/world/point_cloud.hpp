@@ -45,9 +45,10 @@ struct CloudScan {
 };
 
 /// Integrates the scans with OctoMap at `resolution` (rays longer than max_range, if positive,
-/// mark free space up to it and no occupied end) into a voxel layer. Throws when the resolution
-/// is not positive and finite, a point or origin lies beyond OctoMap's key range, or no voxel
-/// becomes known.
+/// mark free space up to it and no occupied end; 0: no limit) into a voxel layer. Throws when
+/// the resolution is not positive and finite, max_range is NaN, infinite or negative, a point
+/// is not finite (the readers skip such points; a cloud filled in code must too), a point or
+/// origin lies beyond OctoMap's key range, or no voxel becomes known.
 std::shared_ptr<const VoxelLayer> integrate_clouds(const std::vector<CloudScan>& scans, double resolution,
                                                    double max_range);
 

@@ -320,6 +320,7 @@ std::optional<std::size_t> VoxelObstacles::segment_hit(const Eigen::Vector3d& a,
 
 double VoxelObstacles::clearance(const Eigen::Vector3d& p) const {
   check_query_point(p, "clearance: p");
+  check_clearance_range(p);
   if (blocked_count_ == 0) return kInf;
   // The nearest blocked cube lies within upper = d_c + |p - centre_c| + half diagonal of p:
   // test the cubes of that ball's box exactly.
@@ -348,7 +349,7 @@ double VoxelObstacles::clearance(const Eigen::Vector3d& p) const {
 std::optional<double> VoxelObstacles::raycast(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
                                               double max_range) const {
   check_query_point(origin, "raycast: origin");
-  check_query_point(dir, "raycast: dir");
+  check_query_direction(dir, "raycast: dir");
   check_query_radius(max_range, "raycast: max_range");
   if (blocked_count_ == 0) return std::nullopt;
   const VoxelLayer& L = *layer_;

@@ -40,6 +40,14 @@ using V3 = Eigen::Vector3d;
 
 namespace {
 
+/// The poll of a long plan or flight: with the GIL held, raise what Python has pending (Ctrl-C's
+/// KeyboardInterrupt) through the C++ call (eleventh campaign P1: a SIGINT waited for the whole
+/// budget, ~40 s, and the result was then thrown away).
+void python_signals() {
+  py::gil_scoped_acquire locked;
+  if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+}
+
 // ---------------------------------------------------------------- argument checks
 // Every argument is taken as a Python object and converted here, so a wrong type or value is a
 // miner.Error naming the argument (REQ-LIB-002), never pybind11's "incompatible function
@@ -404,6 +412,19 @@ PYBIND11_MODULE(_miner, m) {
         const HeuristicRegion* region = region_arg.is_none() ? nullptr : &object_of<HeuristicRegion>(region_arg, "region", "Region");
         if (o.planner == miner::plan::PlannerKind::kMiner && region == nullptr)
           throw miner::Error("planner \"miner\" needs a region (miner.sgan_region or miner.astar_region)");
+        // The region and the safeguard are miner's; the others would ignore them without a word
+        // (eleventh campaign P2; the CLI refuses --region for them too).
+        if (o.planner != miner::plan::PlannerKind::kMiner) {
+          if (region != nullptr)
+            throw miner::Error("region: only planner \"miner\" samples a region, not \"" +
+                               miner::plan::planner_name(o.planner) + "\"");
+          if (!o.safeguard)
+            throw miner::Error("safeguard: only planner \"miner\" has the safeguard, not \"" +
+                               miner::plan::planner_name(o.planner) + "\"");
+        }
+        // Ctrl-C reaches a long plan: the planner polls, and the poll raises what Python has
+        // pending (KeyboardInterrupt) with the GIL held (eleventh campaign P1).
+        o.poll = python_signals;
         miner::plan::PlanResult r;
         {
           py::gil_scoped_release unlocked;
@@ -532,6 +553,7 @@ PYBIND11_MODULE(_miner, m) {
         const ReferencePlan& reference = object_of<ReferencePlan>(reference_arg, "reference", "Reference");
         miner::flight::FlyOptions o;
         o.record_log = flag(log, "log");
+        o.poll = python_signals;  // Ctrl-C stops a long flight too
         py::gil_scoped_release unlocked;
         return miner::pipeline::fly(s, reference, o);
       }, py::arg("scenario"), py::arg("reference"), py::arg("log") = true,

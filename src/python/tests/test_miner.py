@@ -235,3 +235,70 @@ def test_none_for_an_object_and_whole_floats_for_integers():
     for bad in (5, [8, 8], "884"):
         with pytest.raises(miner.Error, match="dims"):
             miner.astar_region(m, dims=bad)
+
+
+# ---- issue 20, eleventh campaign: Python refuses what the CLI refuses; Ctrl-C stops a long plan ----
+def test_plan_refuses_miner_options_for_the_other_planners():
+    m = miner.Map.load(SIM1)
+    region = miner.astar_region(m)
+    for planner in ("rrtstar", "informed", "guided"):  # P2: the region was ignored without a word
+        with pytest.raises(miner.Error, match="region: only planner \"miner\""):
+            miner.plan(m, planner=planner, region=region, iterations=300)
+        with pytest.raises(miner.Error, match="safeguard: only planner \"miner\""):
+            miner.plan(m, planner=planner, safeguard=False, iterations=300)
+    assert miner.plan(m, planner="miner", region=region, safeguard=False, iterations=2000).cost > 0
+
+
+def test_ctrl_c_stops_a_long_plan_at_once():
+    # P1: a SIGINT during a 10^6-iteration plan waited for the whole budget (43 s), then raised.
+    # The planner polls every 1024 iterations: interrupted 50 ms in, the call must cost less CPU
+    # than an uninterrupted 20 000-iteration plan of the same map (the budget it would have run is
+    # 50 times that); CPU time of this process, compared within the test.
+    import resource
+    import signal
+    import threading
+
+    m = miner.Map.load(SIM1)
+
+    def cpu():
+        u = resource.getrusage(resource.RUSAGE_SELF)
+        return u.ru_utime + u.ru_stime
+
+    t0 = cpu()
+    miner.plan(m, planner="rrtstar", seed=4, iterations=20000)
+    uninterrupted = cpu() - t0
+    timer = threading.Timer(0.05, lambda: os.kill(os.getpid(), signal.SIGINT))
+    t0 = cpu()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        miner.plan(m, planner="rrtstar", seed=4, iterations=1000000)
+    interrupted = cpu() - t0
+    timer.join()
+    assert interrupted < uninterrupted, (interrupted, uninterrupted)
+    assert miner.plan(m, planner="rrtstar", seed=4, iterations=300).cost > 0  # the module is usable after it
+
+
+def test_ctrl_c_stops_a_long_flight():
+    # P1 for flights: the flight polls every 4000 N3 ticks (10 s of its ~38 s); interrupted 50 ms
+    # in, it costs less CPU than the whole flight.
+    import resource
+    import signal
+    import threading
+
+    def cpu():
+        u = resource.getrusage(resource.RUSAGE_SELF)
+        return u.ru_utime + u.ru_stime
+
+    s = miner.Scenario.default()
+    ref = miner.build_reference(s)
+    t0 = cpu()
+    miner.fly(s, ref, log=False)
+    whole = cpu() - t0
+    timer = threading.Timer(0.05, lambda: os.kill(os.getpid(), signal.SIGINT))
+    t0 = cpu()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        miner.fly(s, ref, log=False)
+    interrupted = cpu() - t0
+    timer.join()
+    assert interrupted < whole, (interrupted, whole)

@@ -669,6 +669,26 @@ TEST_CASE("A Scenario changed in C++ after reading is checked by the reader's ow
   CHECK_NOTHROW(pipeline::check_scenario(fine));
 }
 
+TEST_CASE("A run folder's scenario names an OctoMap map by the absolute path the scenario meant", "[REQ-REPORT-001]") {
+  // Eleventh campaign C1: a scenario scen/x.json with "map": "../out/m.bt" was recorded as
+  // <cwd>/scen/out/m.bt (the path resolved against scen/ twice), so its replay failed or loaded
+  // another file.
+  namespace fs = std::filesystem;
+  const fs::path cwd = fs::current_path();
+  for (const auto& [base, map, meant] : std::vector<std::tuple<std::string, std::string, fs::path>>{
+           {"scen", "../out/m.bt", cwd / "out/m.bt"},
+           {"./scen", "./../out/m.bt", cwd / "out/m.bt"},
+           {"scen", "../scen/../out/m.ot", cwd / "out/m.ot"},
+           {"a/b", "../../c.bt", cwd / "c.bt"},
+           {"scen", "m.bt", cwd / "scen/m.bt"},
+           {"", "m.bt", cwd / "m.bt"},
+           {"scen", "/abs/m.bt", fs::path("/abs/m.bt")}}) {
+    INFO(base << " + " << map);
+    const miner::Json doc{{"format", pipeline::kScenarioFormat}, {"map", map}};
+    CHECK(pipeline::self_contained_scenario(doc, base)["map"].get<std::string>() == meant.lexically_normal().string());
+  }
+}
+
 TEST_CASE("flight::fly refuses a reference that does not start where the vehicle hovers", "[REQ-LIB-003][REQ-FLIGHT-007]") {
   // Tenth campaign recheck: a reference 42 m from the setup's start was flown (6 s, RMSE 42 m)
   // and came back as an ordinary flight.

@@ -4,6 +4,7 @@
 #include <cstring>
 #include <fstream>
 #include <iomanip>
+#include <limits>
 #include <sstream>
 
 #include "miner/core/error.hpp"
@@ -337,4 +338,27 @@ TEST_CASE("Malformed point clouds are refused naming the fault, never crash", "[
     }
   }
   CHECK(refused > 0);
+}
+
+TEST_CASE("A cloud filled in code is integrated only with finite points and a range that is a range",
+          "[REQ-LIB-003][REQ-WORLD-018]") {
+  // Eleventh campaign L3: (3, 0, NaN) became some voxel (the layer grew), (NaN, 0, 1) was blamed
+  // on OctoMap's key range, and a NaN or negative max_range meant "no limit".
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  PointCloud cloud;
+  cloud.points = wall_points();
+  const std::size_t n = cloud.points.size();
+  for (const V& bad : {V(3, 0, nan), V(nan, 0, 1), V(3, std::numeric_limits<double>::infinity(), 1)}) {
+    PointCloud with = cloud;
+    with.points.push_back(bad);
+    CHECK_THROWS_WITH(integrate_clouds({{with, V(0, 0, 0.5), "scan.pcd"}}, 0.1, 0.0),
+                      Contains("scan.pcd: point " + std::to_string(n)) && Contains("is not finite"));
+  }
+  for (const double range : {nan, -1.0, -std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()})
+    CHECK_THROWS_WITH(integrate_clouds({{cloud, V(0, 0, 0.5), ""}}, 0.1, range), Contains("max_range"));
+  // 0 is "no limit", as documented: the same layer as a range beyond every point.
+  const auto none = integrate_clouds({{cloud, V(0, 0, 0.5), ""}}, 0.1, 0.0);
+  const auto far = integrate_clouds({{cloud, V(0, 0, 0.5), ""}}, 0.1, 1000.0);
+  CHECK(none->count(VoxelState::kOccupied) == far->count(VoxelState::kOccupied));
+  CHECK(none->count(VoxelState::kOccupied) > 0);
 }

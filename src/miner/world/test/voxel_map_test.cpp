@@ -234,6 +234,29 @@ TEST_CASE("Tenth campaign: the map API refuses what it cannot answer by name and
                         Eigen::Vector3i(std::numeric_limits<int>::max(), 0, 0), 1.0) == 4294967295.0);
 }
 
+TEST_CASE("A ray's direction is a unit vector and a clearance is asked within a map's range", "[REQ-LIB-003][REQ-WORLD-013]") {
+  // Eleventh campaign L2: a direction of length 10 answered a tenth of the distance, a zero one
+  // "nothing within range"; P3: a clearance at 1e155 m overflowed to +infinity.
+  const Map voxels = Map::from_voxels({small_layer(), UnknownPolicy::kOccupied, "", ""});
+  const Map boxes(Box{{0, 0, 0}, {10, 10, 10}}, 0.5, {Box{{4, 0, 0}, {6, 10, 10}}});
+  for (const Map* m : {&voxels, &boxes}) {
+    const auto unit = m->raycast(V(0.5, 2.5, 2.5), V(1, 0, 0), 50.0);
+    REQUIRE(unit.has_value());
+    for (const V& dir : {V(10, 0, 0), V(0, 0, 0), V(1e-300, 0, 0), V(0.5, 0, 0)})
+      CHECK_THROWS_WITH(m->raycast(V(0.5, 2.5, 2.5), dir, 50.0), Contains("raycast: dir: must be a unit vector"));
+    const auto rounded = m->raycast(V(0.5, 2.5, 2.5), V(1 + 1e-9, 0, 0), 50.0);  // a normalised vector's rounding
+    REQUIRE(rounded.has_value());
+    CHECK(*rounded == Approx(*unit).epsilon(1e-8));
+    for (const double far : {-1e155, 1e7, -1e6 - 1.0})
+      CHECK_THROWS_WITH(m->clearance(V(far, 1, 1)), Contains("clearance: p") && Contains("farther than"));
+    CHECK(std::isfinite(m->clearance(V(-1e6, 1, 1))));
+    CHECK(m->clearance(V(-1e6, 1, 1)) > 9e5);
+  }
+  const VoxelObstacles& direct = *voxels.voxels();
+  CHECK_THROWS_WITH(direct.raycast(V(0.5, 2.5, 2.5), V(0, 0, 0), 5.0), Contains("raycast: dir: must be a unit vector"));
+  CHECK_THROWS_WITH(direct.clearance(V(1e155, 1, 1)), Contains("farther than"));
+}
+
 TEST_CASE("A* refuses a grid built from another map: its path would ignore this map's obstacles",
           "[REQ-LIB-003][REQ-WORLD-008]") {
   // Tenth campaign L7: a grid of the empty map, same bounds and resolution, walked A* through

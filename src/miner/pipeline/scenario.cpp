@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <iomanip>
 #include <sstream>
 
 #include "miner/core/error.hpp"
@@ -38,9 +39,15 @@ std::string resolve(const std::string& base_dir, const std::string& path) {
 int ticks_per(const JsonField& where, double loop_rate, double rate, const char* what) {
   const double ratio = loop_rate / rate;
   const double rounded = std::round(ratio);
-  if (rounded < 1.0 || std::abs(ratio - rounded) > 1e-9 * ratio)
-    where.fail(std::string(what) + " " + short_number(rate) + " Hz must divide the N3 loop rate " +
-               short_number(loop_rate) + " Hz (all sensors and loops run on its ticks)");
+  // Exact up to the rounding of a decimal rate (400/3 Hz written with 12 digits): 400.0000004 Hz
+  // was taken as 400 (eleventh campaign C2), and the message rounded 49.9999999 to "50".
+  constexpr double kRateRounding = 1e-12;
+  if (rounded < 1.0 || std::abs(ratio - rounded) > kRateRounding * ratio) {
+    std::ostringstream os;
+    os << std::setprecision(15) << what << " " << rate << " Hz must divide the N3 loop rate " << loop_rate
+       << " Hz (all sensors and loops run on its ticks)";
+    where.fail(os.str());
+  }
   return static_cast<int>(rounded);
 }
 

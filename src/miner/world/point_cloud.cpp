@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <cctype>
 #include <cstring>
+#include <limits>
 #include <sstream>
 #include <tuple>
 
@@ -161,8 +162,21 @@ std::size_t read_records(PointCloud& cloud, const std::string& bytes, std::size_
         os << "point " << i << " has " << w.size() << " values, the header declares " << fields.size();
         fail(origin, os.str());
       }
-      add_point(cloud, {parse_number(w[xyz[0]], origin, i), parse_number(w[xyz[1]], origin, i),
-                        parse_number(w[xyz[2]], origin, i)});
+      Eigen::Vector3d p;
+      for (int a = 0; a < 3; ++a) {
+        const Field& f = fields[static_cast<std::size_t>(xyz[static_cast<std::size_t>(a)])];
+        p[a] = parse_number(w[static_cast<std::size_t>(xyz[static_cast<std::size_t>(a)])], origin, i);
+        // A value its declared type cannot hold (1e39 in a float) is no point of the cloud: the
+        // binary encoding could not carry it (eleventh campaign I3).
+        if (f.kind == 'f' && f.size == 4 && std::isfinite(p[a]) &&
+            std::abs(p[a]) > static_cast<double>(std::numeric_limits<float>::max())) {
+          std::ostringstream os;
+          os << "point " << i << ": " << w[static_cast<std::size_t>(xyz[static_cast<std::size_t>(a)])] << " is beyond the range of its "
+             << "4-byte float field \"" << f.name << "\"";
+          fail(origin, os.str());
+        }
+      }
+      add_point(cloud, p);
     }
     // Nothing but blank space may follow the declared points (issue 20: extra lines were dropped).
     if (exact_end && line_start < bytes.size() &&
@@ -369,7 +383,7 @@ PointCloud parse_pcd(const std::string& bytes, const std::string& origin) {
   Lines lines{bytes, origin};
   std::vector<std::string> names, sizes, types, counts;
   std::size_t points = 0, width = 0, height = 1;
-  bool have_points = false, have_width = false;
+  bool have_points = false, have_width = false, have_version = false;
   std::vector<std::string> seen;  // header keys, each at most once
   std::optional<Eigen::Vector3d> viewpoint;
   std::string data;
@@ -385,6 +399,7 @@ PointCloud parse_pcd(const std::string& bytes, const std::string& origin) {
       // PCL writes 0.7 (".7" in older files); other versions lay their header out differently.
       if (rest.size() != 1 || (rest[0] != "0.7" && rest[0] != ".7"))
         fail(origin, "PCD VERSION \"" + (rest.empty() ? std::string() : rest[0]) + "\" (MINER reads version 0.7)");
+      have_version = true;
       continue;
     }
     if (w[0] == "FIELDS") names = rest;
@@ -409,6 +424,12 @@ PointCloud parse_pcd(const std::string& bytes, const std::string& origin) {
       constexpr double kUnitTolerance = 1e-3;
       if (!q.allFinite() || std::abs(q.norm() - 1.0) > kUnitTolerance)
         fail(origin, "VIEWPOINT orientation is not a unit quaternion");
+      // Only the translation is used (the sensor origin); a rotation would say the points are in
+      // a turned sensor frame, which the import does not apply: refused, not ignored (eleventh
+      // campaign I2). q and -q are the same rotation.
+      if ((q - Eigen::Vector4d(1, 0, 0, 0)).norm() > kUnitTolerance && (q + Eigen::Vector4d(1, 0, 0, 0)).norm() > kUnitTolerance)
+        fail(origin, "VIEWPOINT orientation " + rest[3] + " " + rest[4] + " " + rest[5] + " " + rest[6] +
+                         " is not the identity: MINER takes the points in the map frame (rotate them first)");
       viewpoint = t;
     } else if (w[0] == "DATA" && rest.size() == 1) {
       data = rest[0];
@@ -417,6 +438,10 @@ PointCloud parse_pcd(const std::string& bytes, const std::string& origin) {
       fail(origin, "unknown or malformed header line \"" + line + "\"");
     }
   }
+  // PCD 0.7 names its version and point count in every header PCL writes (eleventh campaign I3:
+  // a header without either was read).
+  if (!have_version) fail(origin, "the header has no VERSION line (PCD 0.7)");
+  if (!have_points) fail(origin, "the header has no POINTS line");
   if (names.empty()) fail(origin, "the header has no FIELDS line");
   if (sizes.size() != names.size() || types.size() != names.size() || (!counts.empty() && counts.size() != names.size()))
     fail(origin, "FIELDS, SIZE, TYPE and COUNT list different numbers of fields");
@@ -550,7 +575,22 @@ std::shared_ptr<const VoxelLayer> integrate_clouds(const std::vector<CloudScan>&
     std::ostringstream os;
     os << "the clouds and their sensor origins span " << format_point(lo) << " - " << format_point(hi) << ", "
        << cells.x() << " x " << cells.y() << " x " << cells.z() << " voxels at " << resolution << " m, more than the "
-       << kMaxGridCells << " a map may have; use --range, a coarser --resolution or drop the far points";
+       << kMaxGridCells << " a map may have";
+    // Name the outliers: a few returns kilometres away (eleventh campaign I1) cannot be helped by
+    // --range, whose truncated rays still free space up to it in their direction.
+    std::vector<double> ranges;
+    for (const CloudScan& scan : scans)
+      for (const Eigen::Vector3d& p : scan.cloud.points) ranges.push_back((p - scan.origin).norm());
+    std::vector<double> sorted = ranges;
+    std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
+    const double median = sorted[sorted.size() / 2];
+    constexpr double kOutlierFactor = 10.0;  // returns 10 times farther than the median one
+    const auto far = std::count_if(ranges.begin(), ranges.end(), [&](double r) { return r > kOutlierFactor * median; });
+    if (far > 0)
+      os << "; " << far << " of the " << ranges.size() << " points lie farther than " << kOutlierFactor
+         << " x the median range (" << median << " m) from their sensor: drop such outliers before importing (--range "
+         << "truncates their rays but still frees space up to it in their direction)";
+    os << "; use a coarser --resolution" << (far > 0 ? "" : ", --range") << " or drop the far points";
     throw Error(os.str());
   }
   for (std::size_t s = 0; s < scans.size(); ++s) {

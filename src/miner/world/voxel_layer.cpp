@@ -166,6 +166,8 @@ Eigen::Vector3i VoxelLayer::clamped_cell(const Eigen::Vector3d& p) const {
 }
 
 std::vector<Box> decimated_occupied_boxes(const VoxelLayer& layer, std::size_t max_boxes, int* block) {
+  // No picture fits in 0 boxes: the coarsest blocks came back, more than asked (eleventh campaign L4).
+  if (max_boxes < 1) throw Error("decimated_occupied_boxes: max_boxes must be at least 1");
   const Eigen::Vector3i& n = layer.dims();
   for (int f = 1;; f *= 2) {
     const Eigen::Vector3i m = (n.array() + f - 1) / f;

@@ -669,6 +669,23 @@ TEST_CASE("A Scenario changed in C++ after reading is checked by the reader's ow
   CHECK_NOTHROW(pipeline::check_scenario(fine));
 }
 
+TEST_CASE("A rate that does not divide the N3's loop rate is refused as written, however close", "[REQ-FLIGHT-007]") {
+  // Eleventh campaign C2: 400.0000004 Hz was flown as 400 Hz, and 49.9999999 Hz was refused as
+  // "50 Hz must divide 400 Hz".
+  miner::Json doc = miner::read_json_file(kScenarios + "/default.json");
+  const auto with = [&](const char* section, double rate) {
+    miner::Json d = doc;
+    d[section]["rate_hz"] = rate;
+    return d;
+  };
+  CHECK_THROWS_WITH(pipeline::scenario_from_json(with("controller", 400.0000004), "c.json", kScenarios),
+                    Contains("controller rate 400.0000004 Hz must divide the N3 loop rate 400 Hz"));
+  CHECK_THROWS_WITH(pipeline::scenario_from_json(with("pose", 49.9999999), "p.json", kScenarios),
+                    Contains("pose rate 49.9999999 Hz must divide"));
+  CHECK_NOTHROW(pipeline::scenario_from_json(with("pose", 50.0), "p.json", kScenarios));
+  CHECK_NOTHROW(pipeline::scenario_from_json(with("controller", 400.0 / 3.0), "c.json", kScenarios));
+}
+
 TEST_CASE("A run folder's scenario names an OctoMap map by the absolute path the scenario meant", "[REQ-REPORT-001]") {
   // Eleventh campaign C1: a scenario scen/x.json with "map": "../out/m.bt" was recorded as
   // <cwd>/scen/out/m.bt (the path resolved against scen/ twice), so its replay failed or loaded

@@ -362,3 +362,45 @@ TEST_CASE("A cloud filled in code is integrated only with finite points and a ra
   CHECK(none->count(VoxelState::kOccupied) == far->count(VoxelState::kOccupied));
   CHECK(none->count(VoxelState::kOccupied) > 0);
 }
+
+TEST_CASE("A PCD header names its version and point count, a viewpoint is a translation, a float field holds floats",
+          "[REQ-WORLD-018]") {
+  // Eleventh campaign I3: a PCD without VERSION and POINTS lines was read; 1e39 in a PLY float
+  // field was taken (the binary encoding cannot carry it); I2: a VIEWPOINT rotation was checked,
+  // then ignored.
+  const std::vector<V> pts{V(3, 0, 0.5), V(3, 0.5, 0.5)};
+  const std::string good = pcd(pts, false);
+  CHECK(parse_point_cloud(good, false, "c.pcd").points.size() == 2);
+  const auto without = [&](const std::string& line) {
+    std::string s = good;
+    const std::size_t at = s.find(line);
+    REQUIRE(at != std::string::npos);
+    return s.erase(at, s.find('\n', at) + 1 - at);
+  };
+  CHECK_THROWS_WITH(parse_point_cloud(without("VERSION"), false, "c.pcd"), Contains("c.pcd") && Contains("no VERSION line"));
+  CHECK_THROWS_WITH(parse_point_cloud(without("POINTS"), false, "c.pcd"), Contains("no POINTS line"));
+  std::string turned = good;
+  turned.replace(turned.find("VIEWPOINT 0 0 0.5 1 0 0 0"), 25, "VIEWPOINT 0 0 0.5 0.7071 0 0 0.7071");
+  CHECK_THROWS_WITH(parse_point_cloud(turned, false, "c.pcd"), Contains("VIEWPOINT orientation 0.7071 0 0 0.7071 is not the identity"));
+  std::string flipped = good;  // -q is the identity rotation too
+  flipped.replace(flipped.find("VIEWPOINT 0 0 0.5 1 0 0 0"), 25, "VIEWPOINT 0 0 0.5 -1 0 0 0");
+  CHECK(parse_point_cloud(flipped, false, "c.pcd").viewpoint == V(0, 0, 0.5));
+  std::string big = ply(pts, "ascii");
+  big.replace(big.find("\n3 0 0.5 7\n") + 1, 1, "1e39");
+  CHECK_THROWS_WITH(parse_point_cloud(big, true, "c.ply"), Contains("point 0: 1e39 is beyond the range of its 4-byte float field \"x\""));
+  std::string fits = ply(pts, "ascii");
+  fits.replace(fits.find("\n3 0 0.5 7\n") + 1, 1, "3e38");
+  CHECK(parse_point_cloud(fits, true, "c.ply").points[0].x() == 3e38);
+}
+
+TEST_CASE("An import too large for a map names the outlier returns --range cannot help", "[REQ-WORLD-018]") {
+  // Eleventh campaign I1: five returns kilometres away made an office scan too large at 5 cm, and
+  // the message pointed at --range, whose truncated rays still free space up to it.
+  PointCloud cloud;
+  cloud.points = wall_points();
+  cloud.points.push_back(V(2500, 800, 900));
+  cloud.points.push_back(V(-1400, -1300, -1200));
+  CHECK_THROWS_WITH(integrate_clouds({{cloud, V(0, 0, 0.5), "office.pcd"}}, 0.05, 40.0),
+                    Contains("2 of the 863 points lie farther than 10 x the median range") &&
+                        Contains("drop such outliers before importing"));
+}

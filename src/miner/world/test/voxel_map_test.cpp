@@ -254,6 +254,9 @@ TEST_CASE("A ray's direction is a unit vector and a clearance is asked within a 
   }
   const VoxelObstacles& direct = *voxels.voxels();
   CHECK_THROWS_WITH(direct.raycast(V(0.5, 2.5, 2.5), V(0, 0, 0), 5.0), Contains("raycast: dir: must be a unit vector"));
+  // L4: a picture in 0 boxes came back as the coarsest block, more than asked.
+  CHECK_THROWS_WITH(decimated_occupied_boxes(*small_layer(), 0), Contains("max_boxes must be at least 1"));
+  CHECK(decimated_occupied_boxes(*small_layer(), 1).size() == 1);
   CHECK_THROWS_WITH(direct.clearance(V(1e155, 1, 1)), Contains("farther than"));
 }
 

@@ -2033,8 +2033,21 @@ TEST_CASE("fly --seed takes every 64-bit seed and the run folder keeps it: flyin
           "[REQ-FLIGHT-009][REQ-CLI-002]") {
   // Issue 20, eighth campaign W1: seeds from 2^63 on were clamped to 2^63 - 1; W2: the run
   // folder's scenario.json kept the file's seed, so its replay flew another flight.
+  // A short flight (the default scenario's sensors and vehicle, a 2 m route in an empty room
+  // with waypoints, no planner): the property is the seed's round trip, not the flight, and six
+  // default flights cost a minute of the sanitizer build.
+  miner::Json doc = miner::read_json_file(std::string(MINER_SOURCE_DIR) + "/fixtures/scenarios/default.json");
+  doc.erase("planner");
+  doc["map"] = miner::Json::parse(R"({"format": "miner-map-v1", "bounds": {"min": [0, 0, 0], "max": [6, 5, 3]},
+                                     "resolution": 0.5, "obstacles": []})");
+  doc["vehicle"] = std::string(MINER_SOURCE_DIR) + "/fixtures/vehicles/n3-1500g.json";
+  doc["start"] = {2.0, 2.0, 1.5};
+  doc["goal"] = {4.0, 2.0, 1.5};
+  doc["waypoints"] = miner::Json::array({miner::Json::array({3.0, 2.3, 1.5})});
+  doc["hover_after_s"] = 1.0;
+  const std::string short_flight = write("short-flight.json", doc.dump());
   const std::string run = dir() + "/seed-max", again = dir() + "/seed-max-again";
-  const Run r = miner_cli({"fly", "--seed", "18446744073709551615", "--out", run});
+  const Run r = miner_cli({"fly", "--scenario", short_flight, "--seed", "18446744073709551615", "--out", run});
   REQUIRE(r.code == 0);
   CHECK_THAT(r.out, Contains("(seed 18446744073709551615,"));
   CHECK(miner::read_json_file(run + "/scenario.json")["seed"].get<std::uint64_t>() == 18446744073709551615ULL);
@@ -2043,7 +2056,8 @@ TEST_CASE("fly --seed takes every 64-bit seed and the run folder keeps it: flyin
   CHECK(read(again + "/flight_log.csv") == read(run + "/flight_log.csv"));
   // --ground-truth is recorded too: the replay flies on the truth again (recheck of W2).
   const std::string truth = dir() + "/truth-run", truth_again = dir() + "/truth-again";
-  REQUIRE(miner_cli({"fly", "--ground-truth", "--out", truth, "--quiet"}).code == 0);
+  REQUIRE(miner_cli({"fly", "--scenario", short_flight, "--seed", "18446744073709551615", "--ground-truth", "--out", truth,
+                     "--quiet"}).code == 0);
   CHECK(miner::read_json_file(truth + "/scenario.json")["controller_reads"] == "ground-truth");
   CHECK(miner::read_json_file(truth + "/summary.json")["controller_reads"] == "ground-truth");
   REQUIRE(miner_cli({"fly", "--scenario", truth + "/scenario.json", "--out", truth_again, "--quiet"}).code == 0);
@@ -2051,8 +2065,10 @@ TEST_CASE("fly --seed takes every 64-bit seed and the run folder keeps it: flyin
   CHECK(read(truth_again + "/flight_log.csv") == read(truth + "/flight_log.csv"));
   CHECK(read(truth + "/flight_log.csv") != read(run + "/flight_log.csv"));
   // 2^63 and 2^63 - 1 are two seeds, two flights.
-  REQUIRE(miner_cli({"fly", "--seed", "9223372036854775808", "--out", dir() + "/seed-263", "--quiet"}).code == 0);
-  REQUIRE(miner_cli({"fly", "--seed", "9223372036854775807", "--out", dir() + "/seed-263-1", "--quiet"}).code == 0);
+  REQUIRE(miner_cli({"fly", "--scenario", short_flight, "--seed", "9223372036854775808", "--out", dir() + "/seed-263",
+                     "--quiet"}).code == 0);
+  REQUIRE(miner_cli({"fly", "--scenario", short_flight, "--seed", "9223372036854775807", "--out", dir() + "/seed-263-1",
+                     "--quiet"}).code == 0);
   CHECK(read(dir() + "/seed-263/flight_log.csv") != read(dir() + "/seed-263-1/flight_log.csv"));
 }
 

@@ -735,3 +735,124 @@ TEST_CASE("A collision is counted once per entry into an obstacle, not once per 
   setup.collides = [](const Eigen::Vector3d& p) { return (p.y() > 6.5 && p.y() < 7.0) || (p.y() > 8.0 && p.y() < 8.5); };
   CHECK(flight::fly(setup, r).collisions == 2);
 }
+
+TEST_CASE("A trajectory file at zero velocity but nonzero acceleration at its ends is refused as not at rest",
+          "[REQ-FLIGHT-007]") {
+  // Held-out audit 9, h9-flight-01: the rest check covered the velocity only, so a file that starts and
+  // ends with zero velocity but 0.375 m/s^2 of acceleration was accepted and flown.
+  Eigen::MatrixX3d points(2, 3);
+  points << 5, 5, 3, 6, 5, 3;
+  auto s = miner::testing::open_room_scenario(points, 0.8, 0.5);
+  const auto one_segment = [](double c2, double c3, double c4, double c5) {
+    // x(t) = 5 + c2 t^2 + c3 t^3 + c4 t^4 + c5 t^5 over 4 s, y = 5, z = 3.
+    return miner::traj::trajectory_from_answer_json(
+        miner::Json{{"order", 3},
+                    {"durations", {4.0}},
+                    {"coefficients", {{{5, 5, 3}, {0, 0, 0}, {c2, 0, 0}, {c3, 0, 0}, {c4, 0, 0}, {c5, 0, 0}}}}},
+        "t.json");
+  };
+  // 5 + 0.1875 t^2 - 0.03125 t^3: velocity 0 at t = 0 and 4 s, acceleration +-0.375 m/s^2 there.
+  s.trajectory_file = one_segment(0.1875, -0.03125, 0, 0);
+  CHECK_THROWS_WITH(pipeline::build_reference(s), Contains("must start and end at rest"));
+  // The rest-to-rest quintic through the same ends (zero velocity and acceleration) is kept.
+  s.trajectory_file = one_segment(0, 0.15625, -0.05859375, 0.005859375);
+  const auto ref = pipeline::build_reference(s);
+  CHECK(ref.source == "file");
+  CHECK(ref.trajectory.evaluate(0.0, 2).norm() < 1e-9);
+}
+
+TEST_CASE("A trajectory file within v_max but over a_max is refused and one within both is kept", "[REQ-FLIGHT-007]") {
+  // Held-out audit 9, h9-flight-02: a trajectory file was checked against v_max only, so a file within
+  // v_max whose acceleration exceeded a_max was accepted and flown.
+  Eigen::MatrixX3d points(2, 3);
+  points << 5, 5, 3, 6, 5, 3;
+  // Rest to rest over 4 s, 1 m: peak speed 0.46875 m/s, peak acceleration 0.3608 m/s^2.
+  const auto quintic = miner::traj::trajectory_from_answer_json(
+      miner::Json{{"order", 3},
+                  {"durations", {4.0}},
+                  {"coefficients", {{{5, 5, 3}, {0, 0, 0}, {0, 0, 0}, {0.15625, 0, 0}, {-0.05859375, 0, 0}, {0.005859375, 0, 0}}}}},
+      "t.json");
+  auto s = miner::testing::open_room_scenario(points, 0.8, 0.3);
+  s.trajectory_file = quintic;
+  CHECK_THROWS_WITH(pipeline::build_reference(s), Contains("trajectory file: maximum speed") &&
+                                                      Contains("exceed the limits v_max 0.800000, a_max 0.300000"));
+  s.limits = {0.4, 0.8};  // over v_max only
+  CHECK_THROWS_WITH(pipeline::build_reference(s), Contains("exceed the limits"));
+  s.limits = {0.8, 0.37};  // within both
+  const auto ref = pipeline::build_reference(s);
+  CHECK(ref.max_acceleration == Approx(0.360844).epsilon(1e-4));
+  CHECK(ref.max_speed == Approx(0.46875).epsilon(1e-4));
+}
+
+TEST_CASE("flight::fly refuses a non-finite goal in a setup filled by hand and names the goal",
+          "[REQ-FLIGHT-009][REQ-LIB-003]") {
+  // Held-out audit 9, h9-flight-03: fly checked the start twice (copy-paste) and never the goal, so a
+  // NaN goal was flown and reported as a missed goal.
+  Eigen::MatrixX3d points(2, 3);
+  points << 5, 5, 3, 6, 5, 3;
+  const pipeline::Scenario s = miner::testing::open_room_scenario(points, 1.0, 1.0);
+  const pipeline::ReferencePlan r = pipeline::build_reference(s);
+  flight::FlightSetup setup = s;
+  setup.hover_after_s = 0.1;
+  setup.collides = [](const Eigen::Vector3d&) { return false; };
+  for (int axis = 0; axis < 3; ++axis) {
+    setup.goal = s.goal;
+    setup.goal[axis] = std::nan("");
+    CHECK_THROWS_WITH(flight::fly(setup, r), Contains("flight: goal[" + std::to_string(axis) + "]") && Contains("finite"));
+    setup.goal[axis] = std::numeric_limits<double>::infinity();
+    CHECK_THROWS_WITH(flight::fly(setup, r), Contains("flight: goal"));
+  }
+  setup.goal = s.goal;
+  setup.start = Eigen::Vector3d(std::nan(""), 5, 3);
+  CHECK_THROWS_WITH(flight::fly(setup, r), Contains("flight: start[0]"));
+}
+
+TEST_CASE("The log's est_sigma columns are the EKF's position standard deviations in metres", "[REQ-FLIGHT-009][REQ-REPORT-011]") {
+  // Held-out audit 9, h9-flight-04: the est_sigma_x/y/z columns held the position variance (m^2), not
+  // its square root, so the report's +-3 sigma band shrank (0.005 m logged as 3e-5).
+  Eigen::MatrixX3d points(2, 3);
+  points << 5, 5, 3, 6, 5, 3;
+  pipeline::Scenario s = miner::testing::open_room_scenario(points, 1.0, 1.0);
+  s.hover_after_s = 0.5;
+  const pipeline::ReferencePlan r = pipeline::build_reference(s);
+  const flight::FlightResult f = pipeline::fly(s, r);
+  const auto& cols = flight::flight_log_columns();
+  const auto col = [&](const std::string& name) {
+    const auto it = std::find(cols.begin(), cols.end(), name);
+    REQUIRE(it != cols.end());
+    return static_cast<std::size_t>(it - cols.begin());
+  };
+  REQUIRE(f.log.size() > 10);
+  // The last row's sigma is the flight's final sqrt(diag P) (the EKF barely moves in a tick).
+  for (int a = 0; a < 3; ++a) {
+    const double logged = f.log.back()[col(std::string("est_sigma_") + "xyz"[a])];
+    CAPTURE(a, logged, f.final_sigma[a]);
+    CHECK(logged == Approx(f.final_sigma[a]).epsilon(0.05));
+  }
+  // The first row's is near the initial position sigma (0.05 m), not its square.
+  CHECK(f.log.front()[col("est_sigma_x")] == Approx(s.ekf.initial_position_sigma).epsilon(0.2));
+  // And the estimate's error lies within 3 sigma on most rows (a variance is far too small for that).
+  const std::size_t est_x = col("est_x"), true_x = col("true_x"), sigma_x = col("est_sigma_x");
+  std::size_t within = 0;
+  for (const auto& row : f.log)
+    if (std::abs(row[est_x] - row[true_x]) <= 3.0 * row[sigma_x]) ++within;
+  CAPTURE(within, f.log.size());
+  CHECK(within >= f.log.size() * 8 / 10);
+}
+
+TEST_CASE("A reference stretched for a_max reaches a_max: acceleration scales with 1 / k^2", "[REQ-FLIGHT-007][REQ-TRAJ-005]") {
+  // Held-out audit 9, h9-traj-06: the stretch factor was a / a_max instead of sqrt(a / a_max), so a
+  // reference over a_max was stretched too far and ended below its limits (slower than allowed).
+  for (const double a_max : {0.5, 1.0}) {
+    Eigen::MatrixX3d points(3, 3);
+    points << 5, 5, 3, 8, 9, 4, 12, 6, 3;
+    const pipeline::Scenario s = miner::testing::open_room_scenario(points, 3.0, a_max);
+    const pipeline::ReferencePlan r = pipeline::build_reference(s);
+    CAPTURE(a_max, r.time_scale, r.max_speed, r.max_acceleration);
+    REQUIRE(r.time_scale > 1.0 + 1e-3);  // MINCO overshot a limit, so the reference was stretched
+    CHECK(r.max_acceleration <= a_max * (1 + 1e-5));
+    CHECK(r.max_speed <= s.limits.v_max * (1 + 1e-5));
+    // Stretched onto the binding limit, not below it.
+    CHECK(std::max(r.max_speed / s.limits.v_max, r.max_acceleration / a_max) == Approx(1.0).epsilon(1e-3));
+  }
+}

@@ -598,3 +598,68 @@ TEST_CASE("The validation split is the fraction rounded to whole samples, not tr
   CHECK(doc["splits"]["val"]["count"] == 2);
   CHECK(doc["splits"]["train"]["count"] == 1);
 }
+
+TEST_CASE("Any two 26-neighbour cells connect wherever they lie in the grid including its faces edges and corners",
+          "[REQ-HEUR-004][REQ-HEUR-007]") {
+  // Held-out audit 9, h9-heuristic-03: on cells of the grid's border, component_of never stepped down
+  // from z = 1 to z = 0, so a region chain along a face through z = 0 was reported as not connected.
+  for (const Eigen::Vector3i d : {Eigen::Vector3i(4, 4, 4), Eigen::Vector3i(3, 5, 4)}) {
+    int pairs = 0, failures = 0;
+    for (int z = 0; z < d.z(); ++z)
+      for (int y = 0; y < d.y(); ++y)
+        for (int x = 0; x < d.x(); ++x)
+          for (int dz = -1; dz <= 1; ++dz)
+            for (int dy = -1; dy <= 1; ++dy)
+              for (int dx = -1; dx <= 1; ++dx) {
+                const Eigen::Vector3i a(x, y, z), b(x + dx, y + dy, z + dz);
+                if ((a == b) || (b.array() < 0).any() || (b.array() >= d.array()).any()) continue;
+                std::vector<std::uint8_t> m(static_cast<std::size_t>(d.prod()), 0);
+                m[heuristic::cell_index(d, a.x(), a.y(), a.z())] = 1;
+                m[heuristic::cell_index(d, b.x(), b.y(), b.z())] = 1;
+                ++pairs;
+                if (!heuristic::connects(m, d, a, b)) {
+                  ++failures;
+                  UNSCOPED_INFO("(" << a.transpose() << ") -> (" << b.transpose() << ") not connected");
+                }
+              }
+    CHECK(pairs > 0);
+    CHECK(failures == 0);
+  }
+  // The audit's input: only (0,0,0) and (0,0,1) of a 4^3 grid, both ways.
+  const Eigen::Vector3i d(4, 4, 4);
+  std::vector<std::uint8_t> m(64, 0);
+  m[heuristic::cell_index(d, 0, 0, 0)] = m[heuristic::cell_index(d, 0, 0, 1)] = 1;
+  CHECK(heuristic::connects(m, d, {0, 0, 1}, {0, 0, 0}));
+  CHECK(heuristic::connects(m, d, {0, 0, 0}, {0, 0, 1}));
+}
+
+TEST_CASE("A dataset part whose index equals its part count is refused naming the part", "[REQ-REPORT-006][REQ-HEUR-001]") {
+  // Held-out audit 9, h9-heuristic-06: dataset.json's part {index, count} was checked with index > count,
+  // so a part {index: 2, count: 2} was read and merged instead of refused.
+  namespace fs = std::filesystem;
+  auto o = small_options();
+  o.dims = Eigen::Vector3i(8, 8, 4);
+  o.shard_count = 2;
+  const std::string root = temp_dir() + "/part-index";
+  fs::remove_all(root);
+  const std::string p0 = root + "/p0", p1 = root + "/p1";
+  o.shard_index = 0;
+  heuristic::write_dataset(o, p0, nullptr);
+  o.shard_index = 1;
+  heuristic::write_dataset(o, p1, nullptr);
+  REQUIRE(miner::read_json_file(p1 + "/dataset.json")["part"]["index"] == 1);  // the last index, kept
+  heuristic::merge_dataset_parts({p0, p1}, root + "/honest");
+  for (const int index : {2, 3, -1}) {
+    const std::string q1 = root + "/q1-" + std::to_string(index + 1), out = root + "/out-" + std::to_string(index + 1);
+    fs::copy(p1, q1);
+    miner::Json d = miner::read_json_file(q1 + "/dataset.json");
+    d["part"]["index"] = index;
+    miner::write_file_atomic(q1 + "/dataset.json", miner::dump_json(d));
+    INFO("part.index " << index);
+    // Read alone (split_samples_held reads dataset.json as read_split does) and merged: the field is named.
+    CHECK_THROWS_WITH(heuristic::split_samples_held(q1, "train"), Contains(q1 + "/dataset.json: part: needs 0 <= index < count"));
+    CHECK_THROWS_WITH(heuristic::merge_dataset_parts({p0, q1}, out),
+                      Contains("dataset.json") && Contains("part: needs 0 <= index < count"));
+    CHECK_FALSE(fs::exists(out));
+  }
+}

@@ -543,3 +543,32 @@ TEST_CASE("predict() reads the encoded E, S and P alike on both input paths, eac
     CHECK(worst <= 1e-5);
   }
 }
+
+TEST_CASE("A query feeds the network the dataset's 3x3x3 state cubes around start and goal", "[REQ-HEUR-008][REQ-HEUR-002]") {
+  // Held-out audit 9, h9-heuristic-04: query_region gave the network single start and goal cells
+  // (dilation 0) instead of the 3x3x3 cubes it was trained with, so every region differed.
+  const heuristic::Sgan g = heuristic::Sgan::builtin();
+  const auto map = miner::world::Map::load(std::string(MINER_SOURCE_DIR) + "/fixtures/maps/indoor-1.json");
+  REQUIRE(map.query());
+  const Eigen::Vector3d start = map.query()->start, goal = map.query()->goal;
+  const double radius = map.query()->robot_radius;
+  const heuristic::HeuristicQuery q = heuristic::query_region(g, map, start, goal, radius, 1, false);
+  // The same network run by hand on the encodings: E (and P when the network reads it), S with
+  // dilation 1 (the dataset's), the query's noise stream.
+  const Eigen::Vector3i dims = g.architecture().dims;
+  heuristic::Encoding encoded;
+  if (g.architecture().passability_channels != 0)
+    encoded = heuristic::encode_environment_passability(map, dims, radius);
+  else
+    encoded.environment = heuristic::encode_environment(map, dims, radius);
+  CHECK(q.environment == encoded.environment);
+  const auto predicted = [&](int dilation) {
+    miner::Rng rng(1, miner::streams::kSganNoise);
+    return g.predict(encoded.environment, heuristic::encode_state(map.bounds(), dims, start, goal, dilation),
+                     encoded.passability, map.bounds(), radius, rng);
+  };
+  const std::vector<std::uint8_t> cubes = heuristic::encode_state(map.bounds(), dims, start, goal, 1);
+  CHECK(std::count(cubes.begin(), cubes.end(), 1) > 2);  // cubes, not single cells
+  CHECK(q.probabilities == predicted(1));
+  CHECK(q.probabilities != predicted(0));
+}

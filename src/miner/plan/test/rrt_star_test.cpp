@@ -519,3 +519,75 @@ TEST_CASE("A start within the goal radius is joined to the goal only by a free s
   }
   CHECK(solved >= 1);  // the test sees a path, not only refusals
 }
+
+TEST_CASE("add_setup_time adds the setup time to the total and to the first-solution and target stages",
+          "[REQ-PLAN-010][REQ-HEUR-009]") {
+  // Held-out audit 9, h9-plan-03: the region's build time was added to the total and the first solution
+  // but not to the time to the target, so MINER's target time left out the region time.
+  PlanResult r;
+  r.time_ms = 3.0;
+  r.first = miner::plan::StageRecord{};
+  r.first->time_ms = 1.0;
+  r.target = miner::plan::StageRecord{};
+  r.target->time_ms = 2.0;
+  miner::plan::add_setup_time(r, 5.0);
+  CHECK(r.time_ms == 8.0);
+  REQUIRE(r.first);
+  CHECK(r.first->time_ms == 6.0);
+  REQUIRE(r.target);
+  CHECK(r.target->time_ms == 7.0);
+  // A result that reached neither stage keeps them unset and gains the time in its total.
+  PlanResult unsolved;
+  miner::plan::add_setup_time(unsolved, 5.0);
+  CHECK(unsolved.time_ms == 5.0);
+  CHECK_FALSE(unsolved.first);
+  CHECK_FALSE(unsolved.target);
+  // On a real plan stopped at a target cost: every stage moves by the same setup time.
+  const miner::world::Map map(miner::world::Box{{0, 0, 0}, {10, 10, 4}}, 0.5, {});
+  PlannerOptions o;
+  o.max_iterations = 2000;
+  o.seed = 3;
+  o.target_cost = 20.0;  // any path reaches it
+  PlanResult planned = miner::plan::plan(PlanningProblem::make(map, V(1, 1, 2), V(9, 9, 2), 0.1), o);
+  REQUIRE(planned.target);
+  REQUIRE(planned.first);
+  const double first = planned.first->time_ms, target = planned.target->time_ms, total = planned.time_ms;
+  miner::plan::add_setup_time(planned, 250.0);
+  CHECK(planned.first->time_ms == Approx(first + 250.0));
+  CHECK(planned.target->time_ms == Approx(target + 250.0));
+  CHECK(planned.time_ms == Approx(total + 250.0));
+}
+
+TEST_CASE("The A*-dilated region dilates the reference path by the dilation asked for", "[REQ-PLAN-005]") {
+  // Held-out audit 9, h9-plan-04: astar_dilated_region ignored its dilation and always dilated by 1 cell,
+  // so `miner region astar --dilation 0` or `2` wrote the 3x3x3-dilated region.
+  const miner::world::Map map(miner::world::Box{{0, 0, 0}, {10, 10, 10}}, 0.5, {});
+  const PlanningProblem problem = PlanningProblem::make(map, V(1, 1, 1), V(9, 1, 1), 0.1);
+  const auto reference = miner::plan::astar_reference(problem);
+  std::size_t previous = 0;
+  for (const int dilation : {0, 1, 2}) {
+    CAPTURE(dilation);
+    const HeuristicRegion r = miner::plan::astar_dilated_region(problem, reference, I(32, 32, 32), dilation);
+    const HeuristicRegion expected = HeuristicRegion::from_path(map.bounds(), I(32, 32, 32), reference.points, dilation, "x");
+    CHECK(r.cells() == expected.cells());
+    CHECK(r.cells().size() > previous);  // each dilation strictly grows the region
+    previous = r.cells().size();
+  }
+  // Dilation 0 is the path's own cells: a cell one row off the path is outside it, inside with 1.
+  const V beside(5.0, 1.0 + 10.0 / 32.0, 1.0);
+  CHECK_FALSE(miner::plan::astar_dilated_region(problem, reference, I(32, 32, 32), 0).contains(beside));
+  CHECK(miner::plan::astar_dilated_region(problem, reference, I(32, 32, 32), 1).contains(beside));
+}
+
+TEST_CASE("The default steering step is a tenth of the map's diagonal and a set one is kept", "[REQ-PLAN-001][REQ-PLAN-007]") {
+  // Held-out audit 9, h9-plan-05: the default eta was 0.1 x the longest side (10 m on a 100 x 100 x 40 m
+  // map) instead of 0.1 x the diagonal (14.7 m).
+  const miner::world::Map sim(miner::world::Box{{0, 0, 0}, {100, 100, 40}}, 0.5, {});
+  CHECK(miner::plan::resolved_steer_step(PlannerOptions{}, sim) == Approx(0.1 * std::sqrt(100.0 * 100 + 100 * 100 + 40 * 40)));
+  CHECK(miner::plan::resolved_steer_step(PlannerOptions{}, sim) == Approx(14.6969).epsilon(1e-5));
+  const miner::world::Map offset(miner::world::Box{{-3, 2, 1}, {5, 8, 5}}, 0.5, {});  // 8 x 6 x 4 m
+  CHECK(miner::plan::resolved_steer_step(PlannerOptions{}, offset) == Approx(0.1 * std::sqrt(64.0 + 36 + 16)));
+  PlannerOptions set;
+  set.steer_step = 2.5;
+  CHECK(miner::plan::resolved_steer_step(set, sim) == 2.5);
+}

@@ -177,3 +177,36 @@ TEST_CASE("the report plots every axis, attitude, EKF error, rotors: optional co
   // The same flight, the same bytes.
   CHECK(html == report::render_flight_report({f.scenario, f.reference, f.result, {}}));
 }
+
+TEST_CASE("the per-axis tracking error is plotted as truth minus reference with its sign", "[REQ-REPORT-011]") {
+  // Held-out audit 9, h9-flight-05: the per-axis tracking error plot showed reference - truth, the curve
+  // mirrored about zero.
+  const auto& f = fixture();
+  // The flown x is set to the reference's x plus 0.5 m + 0.1 m/s * t; y and z to the reference's:
+  // truth - reference on x runs from +0.5 m upwards and is 0 on y and z.
+  auto shifted = f.result;
+  const auto col = [](const char* name) { return static_cast<std::size_t>(column_index(name)); };
+  for (auto& row : shifted.log) {
+    row[col("true_x")] = row[col("ref_x")] + 0.5 + 0.1 * row[col("t")];
+    row[col("true_y")] = row[col("ref_y")];
+    row[col("true_z")] = row[col("ref_z")];
+  }
+  const std::string html = report::render_flight_report({f.scenario, f.reference, shifted, {}});
+  const auto at = html.find("id=\"plot-tracking-axes\"");
+  REQUIRE(at != std::string::npos);
+  const std::string svg = html.substr(at, html.find("</svg>", at) - at);
+  // The y axis' tick labels: from 0 (y and z) up past +0.5 m, none negative.
+  std::vector<double> ticks;
+  const std::regex tick("text-anchor=\"end\">([^<]*)</text>");
+  for (auto it = std::sregex_iterator(svg.begin(), svg.end(), tick); it != std::sregex_iterator(); ++it)
+    ticks.push_back(std::stod((*it)[1].str()));
+  REQUIRE(ticks.size() >= 2);
+  CAPTURE(ticks);
+  CHECK(*std::min_element(ticks.begin(), ticks.end()) >= 0.0);
+  CHECK(*std::max_element(ticks.begin(), ticks.end()) >= 0.5);
+  // The x curve (the first path) rises: its last point is drawn above (smaller SVG y than) its first.
+  const std::regex first_path("<path d=\"M[0-9.]+ ([0-9.]+)[^\"]*L[0-9.]+ ([0-9.]+)\"");
+  std::smatch m;
+  REQUIRE(std::regex_search(svg, m, first_path));
+  CHECK(std::stod(m[2].str()) < std::stod(m[1].str()));
+}

@@ -157,3 +157,47 @@ TEST_CASE("A segment is reported wherever along it the curve meets an obstacle, 
       CHECK(std::find(hits.begin(), hits.end(), i) != hits.end());
     }
 }
+
+TEST_CASE("Every point of a segment lies within a quarter of the step of its sampled chords", "[REQ-TRAJ-008]") {
+  // Held-out audit 9, h9-traj-01: colliding_segments sampled about one step of arc apart instead of
+  // half a step, so the curve between samples could lie up to half a step (not a quarter) from its
+  // chord, and an obstacle touching the curve went unreported at a radius of a quarter step.
+  // One order-4 segment through a full circle of radius 1 m about (5, 6, 5) at unit speed
+  // (interpolated at 8 Chebyshev nodes of the normalised time u, then scaled to t = 2 pi u).
+  const double T = 2.0 * M_PI;
+  Eigen::Matrix<double, 8, 11> a;  // [Vandermonde in u | x y z]
+  for (int j = 0; j < 8; ++j) {
+    const double u = 0.5 * (1.0 - std::cos((2 * j + 1) * M_PI / 16.0));
+    for (int k = 0; k < 8; ++k) a(j, k) = std::pow(u, k);
+    a(j, 8) = 5.0 + std::sin(u * T), a(j, 9) = 6.0 - std::cos(u * T), a(j, 10) = 5.0;
+  }
+  for (int c = 0; c < 8; ++c) {  // Gauss-Jordan elimination with partial pivoting
+    int p = c;
+    for (int r = c + 1; r < 8; ++r)
+      if (std::abs(a(r, c)) > std::abs(a(p, c))) p = r;
+    a.row(c).swap(a.row(p));
+    a.row(c) /= a(c, c);
+    for (int r = 0; r < 8; ++r)
+      if (r != c) a.row(r) -= a(r, c) * a.row(c);
+  }
+  Eigen::MatrixX3d coefficients(8, 3);
+  for (int k = 0; k < 8; ++k) coefficients.row(k) = a.block<1, 3>(k, 8) / std::pow(T, k);
+  const PolynomialTrajectory circle(4, {T}, coefficients);
+  for (int i = 0; i <= 100; ++i) {  // the fit: on the circle to 5 mm, speed 1 to 2 %
+    const double t = T * i / 100;
+    REQUIRE(std::abs((circle.evaluate_segment(0, t) - Eigen::Vector3d(5, 6, 5)).norm() - 1.0) < 5e-3);
+    REQUIRE(std::abs(circle.evaluate_segment(0, t, 1).norm() - 1.0) < 0.02);
+  }
+  // Steps of 1/1.9, 1/1.7 and 1/1.6 of the circle's length: samples half a step apart (4 chords)
+  // stay within a quarter step of the curve; one step apart (2 chords, a diameter) they do not.
+  for (const double step : {T / 1.9, T / 1.7, T / 1.6}) {
+    int missed = 0;
+    for (int j = 0; j < 64; ++j) {
+      const Eigen::Vector3d q = circle.evaluate_segment(0, T * (j + 0.5) / 64);
+      const Map map(Box{{0, 0, 0}, {10, 10, 10}}, 0.5, {Box{q.array() - 1e-3, q.array() + 1e-3}});
+      if (colliding_segments(circle, map, step / 4, step).empty()) ++missed;
+    }
+    CAPTURE(step);
+    CHECK(missed == 0);
+  }
+}

@@ -143,3 +143,37 @@ TEST_CASE("A trajectory answer file is read strictly: junctions meet, the cost i
   tiny["coefficients"][1][0][0] = tiny["coefficients"][1][0][0].get<double>() + 1e-9;
   CHECK_NOTHROW(trajectory_from_answer_json(tiny, "a.json"));
 }
+
+TEST_CASE("A trajectory answer's segment needs exactly 2s coefficient rows: one more or one fewer is refused",
+          "[REQ-TRAJ-007][REQ-FLIGHT-007]") {
+  // Held-out audit 9, h9-traj-04: only too few rows were refused; a segment with 2s + 1 rows was read
+  // with the extra row silently dropped.
+  for (const int order : {3, 4}) {
+    INFO("order " << order);
+    miner::Json doc = problem();
+    doc["order"] = order;
+    if (order == 4) {
+      doc["head"].push_back({0, 0, 0});
+      doc["tail"].push_back({0, 0, 0});
+    }
+    const miner::Json answer = answer_to_json(solve_minco(problem_from_json(doc, "p.json")));
+    REQUIRE(answer["coefficients"][0].size() == static_cast<std::size_t>(2 * order));
+    CHECK_NOTHROW(trajectory_from_answer_json(answer, "a.json"));
+    const std::string needs = "needs 2s = " + std::to_string(2 * order) + " rows";
+    for (const int segment : {0, 1}) {
+      miner::Json more = answer;
+      more["coefficients"][segment].push_back({5, 5, 5});
+      CHECK_THROWS_WITH(trajectory_from_answer_json(more, "a.json"),
+                        Contains("a.json: coefficients[" + std::to_string(segment) + "]") && Contains(needs));
+      miner::Json fewer = answer;
+      fewer["coefficients"][segment].erase(fewer["coefficients"][segment].size() - 1);
+      CHECK_THROWS_WITH(trajectory_from_answer_json(fewer, "a.json"),
+                        Contains("a.json: coefficients[" + std::to_string(segment) + "]") && Contains(needs));
+    }
+  }
+  // Order 4 with 9 rows of zeros and a last row of 5s (the input of the audit).
+  const miner::Json nine = miner::parse_json(
+      R"({"order":4,"durations":[1],"coefficients":[[[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[5,5,5]]]})",
+      "a.json");
+  CHECK_THROWS_WITH(trajectory_from_answer_json(nine, "a.json"), Contains("coefficients[0]: needs 2s = 8 rows"));
+}

@@ -153,3 +153,17 @@ TEST_CASE("Collision checks of a trajectory take a robot radius and a positive s
   CHECK(collision_sample_step(map, 0.1) == 0.1);
   CHECK(collision_sample_step(map, 0.4) == 0.25);
 }
+
+TEST_CASE("The dense solvers take exactly kMaxDenseSegments segments and refuse one more", "[REQ-TRAJ-009][REQ-LIB-003]") {
+  // Held-out audit 9, h9-traj-05: validate_dense refused a problem of exactly kMaxDenseSegments (500)
+  // segments, which the documented bound allows, with a message that contradicted itself.
+  const auto straight = [](int segments) {
+    Eigen::MatrixX3d points(segments + 1, 3);
+    for (int i = 0; i <= segments; ++i) points.row(i) << static_cast<double>(i), 0.0, 0.0;
+    return rest_to_rest(3, points, std::vector<double>(static_cast<std::size_t>(segments), 1.0));
+  };
+  CHECK_NOTHROW(validate_dense(straight(kMaxDenseSegments)));
+  CHECK_NOTHROW(validate_dense(straight(kMaxDenseSegments - 1)));
+  CHECK_THROWS_WITH(validate_dense(straight(kMaxDenseSegments + 1)),
+                    Contains("durations: 501 segments, more than the 500 a dense solver takes"));
+}

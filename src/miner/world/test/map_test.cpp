@@ -216,3 +216,21 @@ TEST_CASE("A map's metric range holds at its ends: each end kept, a step past it
   CHECK_THAT(error_of(query_doc(V(0, 0, -1e-9), b, 1.0)), Contains("query.start:") && Contains("lies outside the map bounds"));
   CHECK_THAT(error_of(query_doc(a, V(100, 100 + 1e-7, 100), 1.0)), Contains("query.goal:") && Contains("lies outside the map bounds"));
 }
+
+TEST_CASE("An obstacle is refused when either of its corners lies past 1e6 m including the max corner alone",
+          "[REQ-WORLD-002][REQ-LIB-003]") {
+  // Held-out audit 9, h9-world-02: only the min corner of an obstacle was range-checked, so a box
+  // [0,0,0]-[2e6,1,1] in a 10 m map was accepted.
+  const Box bounds{{0, 0, 0}, {10, 10, 10}};
+  CHECK_THROWS_WITH(Map(bounds, 0.5, {Box{{0, 0, 0}, {2e6, 1, 1}}}),
+                    Contains("obstacles[0]:") && Contains("reaches farther than 1e+06 m"));
+  CHECK_THROWS_WITH(Map(bounds, 0.5, {Box{{1, 1, 1}, {2, 2, 2}}, Box{{0, 0, -1}, {1, 1e6 * (1 + 1e-9), 1}}}),
+                    Contains("obstacles[1]:") && Contains("reaches farther than 1e+06 m"));
+  CHECK_THROWS_WITH(Map(bounds, 0.5, {Box{{-2e6, 0, 0}, {1, 1, 1}}}), Contains("reaches farther than 1e+06 m"));
+  // From a file too, naming the obstacle; a box reaching exactly 1e6 m is kept.
+  Json d = valid_doc();
+  d["obstacles"][0]["max"] = {20, 2e6, 40};
+  CHECK_THAT(error_of(d), Contains("m.json: obstacles[0]:") && Contains("reaches farther than 1e+06 m"));
+  d["obstacles"][0]["max"] = {20, 1e6, 40};
+  CHECK(error_of(d) == "(no error)");
+}

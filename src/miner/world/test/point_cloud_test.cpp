@@ -404,3 +404,22 @@ TEST_CASE("An import too large for a map names the outlier returns --range canno
                     Contains("2 of the 863 points lie farther than 10 x the median range") &&
                         Contains("drop such outliers before importing"));
 }
+
+TEST_CASE("With a range the ray bound charges each point its distance up to the range and not the range itself",
+          "[REQ-WORLD-018]") {
+  // Held-out audit 9, h9-world-05: the ray budget charged every point at least the range (max instead of
+  // min), so an import of near points with a large range was refused as walking more than 2e9 voxels.
+  PointCloud near;
+  near.points.assign(3000, V(1, 0, 0));  // 3000 rays of 100 voxels at 0.01 m = 3e5 steps
+  const auto layer = integrate_clouds({{near, V(0, 0, 0), ""}}, 0.01, 1e4);  // range 1e4 m: 1e6 voxels per ray
+  CHECK(layer->count(VoxelState::kOccupied) == 1);
+  CHECK(layer->count(VoxelState::kFree) > 0);
+  // The same points without a range walk the same rays.
+  CHECK(integrate_clouds({{near, V(0, 0, 0), ""}}, 0.01, 0.0)->count(VoxelState::kOccupied) == 1);
+  // Points beyond the range are charged only the range: 10^4 points 300 m away walk 3e9 voxels at
+  // 1 mm without a range, 1e6 at 1 cm with a 1 m range.
+  PointCloud far;
+  far.points.assign(10000, V(300, 0, 0));
+  CHECK_THROWS_WITH(integrate_clouds({{far, V(0, 0, 0), ""}}, 1e-3, 0.0), Contains("would walk"));
+  CHECK_NOTHROW(integrate_clouds({{far, V(0, 0, 0), ""}}, 0.01, 1.0));
+}

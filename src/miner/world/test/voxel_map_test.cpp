@@ -304,3 +304,25 @@ TEST_CASE("Tenth campaign: grid helpers refuse sizes and leaves they cannot hold
   for (const double budget : {nan, std::numeric_limits<double>::infinity(), 0.0})
     CHECK_THROWS_WITH(layer_from_leaves({ok}, 0.1, "t", budget), Contains("cell budget"));
 }
+
+TEST_CASE("A map's fingerprint changes with every coordinate of every obstacle corner including a box's top",
+          "[REQ-LIB-003][REQ-WORLD-008]") {
+  // Held-out audit 9, h9-world-01: the fingerprint hashed only x and y of an obstacle's max corner, so a
+  // grid of a 2 m wall was accepted for a map with a 4 m wall and A* planned through the wall.
+  const Box bounds{{0, 0, 0}, {10, 10, 10}};
+  const Map low(bounds, 0.5, {Box{{4, 0, 0}, {5, 10, 2}}});
+  const Map high(bounds, 0.5, {Box{{4, 0, 0}, {5, 10, 4}}});
+  CHECK(low.fingerprint() != high.fingerprint());
+  const VoxelGrid of_low(low, 0.0);
+  CHECK_THROWS_WITH(astar(high, of_low, V(1, 5, 3), V(9, 5, 3)), Contains("the grid was built from another map"));
+  // Each of the six coordinates of the box, moved alone by 1 mm, gives another map.
+  const Box base{{4, 3, 1}, {5, 6, 4}};
+  const Map reference(bounds, 0.5, {base});
+  for (int corner = 0; corner < 2; ++corner)
+    for (int axis = 0; axis < 3; ++axis) {
+      Box moved = base;
+      (corner == 0 ? moved.min : moved.max)[axis] += 1e-3;
+      CAPTURE(corner, axis);
+      CHECK(Map(bounds, 0.5, {moved}).fingerprint() != reference.fingerprint());
+    }
+}

@@ -14,6 +14,17 @@ const char* kProblem = R"({"order": 3,
   "head": [[0,0,0],[0,0,0],[0,0,0]], "tail": [[3,3,1],[0,0,0],[0,0,0]],
   "limits": {"v_max": 2.0, "a_max": 1.0}})";
 miner::Json problem() { return miner::parse_json(kProblem, "p.json"); }
+
+/// The answer file of problem() solved at `order` (3 jerk, 4 snap: one more boundary row).
+miner::Json solved_answer(int order) {
+  miner::Json doc = problem();
+  doc["order"] = order;
+  if (order == 4) {
+    doc["head"].push_back({0, 0, 0});
+    doc["tail"].push_back({0, 0, 0});
+  }
+  return answer_to_json(solve_minco(problem_from_json(doc, "p.json")));
+}
 }  // namespace
 
 TEST_CASE("A problem without durations gets trapezoidal ones: the answer has the contract's fields", "[REQ-TRAJ-006][REQ-TRAJ-001]") {
@@ -113,13 +124,7 @@ TEST_CASE("A trajectory answer file is read strictly: junctions meet, the cost i
   // h6-traj-04: the last one went unchecked). Row k of a segment is t^k's coefficient: the
   // k-th derivative at its start is k! times it.
   for (const int order : {3, 4}) {
-    miner::Json doc = problem();
-    doc["order"] = order;
-    if (order == 4) {
-      doc["head"].push_back({0, 0, 0});
-      doc["tail"].push_back({0, 0, 0});
-    }
-    const miner::Json answer = answer_to_json(solve_minco(problem_from_json(doc, "p.json")));
+    const miner::Json answer = solved_answer(order);
     REQUIRE_NOTHROW(trajectory_from_answer_json(answer, "a.json"));
     const char* const names[] = {"position", "velocity", "acceleration", "jerk"};
     for (int k = 0; k < order; ++k) {
@@ -150,13 +155,7 @@ TEST_CASE("A trajectory answer's segment needs exactly 2s coefficient rows: one 
   // with the extra row silently dropped.
   for (const int order : {3, 4}) {
     INFO("order " << order);
-    miner::Json doc = problem();
-    doc["order"] = order;
-    if (order == 4) {
-      doc["head"].push_back({0, 0, 0});
-      doc["tail"].push_back({0, 0, 0});
-    }
-    const miner::Json answer = answer_to_json(solve_minco(problem_from_json(doc, "p.json")));
+    const miner::Json answer = solved_answer(order);
     REQUIRE(answer["coefficients"][0].size() == static_cast<std::size_t>(2 * order));
     CHECK_NOTHROW(trajectory_from_answer_json(answer, "a.json"));
     const std::string needs = "needs 2s = " + std::to_string(2 * order) + " rows";

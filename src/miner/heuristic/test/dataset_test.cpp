@@ -603,7 +603,7 @@ TEST_CASE("Any two 26-neighbour cells connect wherever they lie in the grid incl
           "[REQ-HEUR-004][REQ-HEUR-007]") {
   // Held-out audit 9, h9-heuristic-03: on cells of the grid's border, component_of never stepped down
   // from z = 1 to z = 0, so a region chain along a face through z = 0 was reported as not connected.
-  for (const Eigen::Vector3i d : {Eigen::Vector3i(4, 4, 4), Eigen::Vector3i(3, 5, 4)}) {
+  for (const Eigen::Vector3i& d : {Eigen::Vector3i(4, 4, 4), Eigen::Vector3i(3, 5, 4)}) {
     int pairs = 0, failures = 0;
     for (int z = 0; z < d.z(); ++z)
       for (int y = 0; y < d.y(); ++y)

@@ -437,8 +437,9 @@ PYBIND11_MODULE(_miner, m) {
       }, py::arg("map"), py::arg("start") = py::none(), py::arg("goal") = py::none(), py::arg("radius") = py::none(),
       py::arg("planner") = "miner", py::arg("region") = py::none(), py::arg("seed") = 1, py::arg("iterations") = 20000,
       py::arg("target_cost") = py::none(), py::arg("first") = false, py::arg("safeguard") = true,
-      "One run of rrtstar, informed, guided or miner (which samples `region`); the same seed gives the same path. "
-      "Raises miner.NoSolution when the budget ends without a path.");
+      "One run of rrtstar, informed, guided or miner (which samples `region`; `region` and safeguard=False are "
+      "refused for the others); the same seed gives the same path. Raises miner.NoSolution when the budget ends "
+      "without a path; Ctrl-C raises KeyboardInterrupt within ~1024 iterations.");
 
   // ------------------------------------------------------------------ trajectories
   using miner::traj::PolynomialTrajectory;
@@ -558,5 +559,6 @@ PYBIND11_MODULE(_miner, m) {
         return miner::pipeline::fly(s, reference, o);
       }, py::arg("scenario"), py::arg("reference"), py::arg("log") = true,
       "Flies the reference with the scenario's vehicle, sensors, N3, EKF and controller (same seed, same bytes); "
-      "the reference must be this scenario's (miner.build_reference(scenario)).");
+      "the reference must be this scenario's (miner.build_reference(scenario)). Ctrl-C raises KeyboardInterrupt "
+      "within 4000 N3 ticks (10 s of flight).");
 }

@@ -98,7 +98,11 @@ def sync_tree(root: pathlib.Path, tree: pathlib.Path) -> None:
         if dst.is_file() and dst.read_bytes() == src.read_bytes():
             continue
         dst.parent.mkdir(parents=True, exist_ok=True)
-        shutil.copy2(src, dst)
+        # The copy gets the time of now, not the checkout's: with copy2's older time, objects the
+        # scratch build made later from other bytes looked up to date to ninja (session 31: a
+        # stale grid.cpp.o failed the new tests unmutated, "unusable").
+        shutil.copyfile(src, dst)
+        shutil.copymode(src, dst)
 
 
 def sh(cmd: list[str], timeout: float | None = None, cwd: pathlib.Path | None = None,

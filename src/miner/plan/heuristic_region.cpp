@@ -7,7 +7,6 @@
 
 #include "miner/core/error.hpp"
 #include "miner/core/rng.hpp"
-#include "miner/core/text.hpp"
 #include "miner/world/map.hpp"
 
 namespace miner::plan {
@@ -49,10 +48,8 @@ HeuristicRegion::HeuristicRegion(world::Box bounds, Eigen::Vector3i dims,
   require_finite(bounds_.max, "region bounds.max");
   // A map's range (REQ-WORLD-002): a region of +-1e300 m has cells of 1e300 m and a volume of
   // 1e302 m^3 that sampling and Lemma 2's radius cannot use (tenth campaign recheck).
-  for (const auto& [corner, name] : {std::pair{&bounds_.min, "min"}, std::pair{&bounds_.max, "max"}})
-    if (corner->cwiseAbs().maxCoeff() > world::kMaxCoordinate)
-      throw Error(std::string("region bounds.") + name + ": " + format_point(*corner) + " lies farther than " +
-                  short_number(world::kMaxCoordinate) + " m from the origin (a map's range)");
+  world::require_within_range(bounds_.min, "region bounds.min", " (a map's range)");
+  world::require_within_range(bounds_.max, "region bounds.max", " (a map's range)");
   if (!(bounds_.max.array() > bounds_.min.array()).all()) {
     throw Error("region bounds: max " + format_point(bounds_.max) + " must exceed min " +
                 format_point(bounds_.min) + " on every axis");

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <array>
+#include <sstream>
 #include <string>
 
 #include "miner/core/error.hpp"
@@ -100,10 +101,11 @@ void check_query_direction(const Eigen::Vector3d& dir, const char* field) {
                 short_number(n));
 }
 
-void check_clearance_range(const Eigen::Vector3d& p) {
-  if (!(p.cwiseAbs().maxCoeff() <= kMaxCoordinate))
-    throw Error("clearance: p " + format_point(p) + " lies farther than " + short_number(kMaxCoordinate) +
-                " m from the origin (a map's range): no distance is asked that far");
+void require_within_range(const Eigen::Vector3d& p, const char* what, const char* why) {
+  if (p.cwiseAbs().maxCoeff() <= kMaxCoordinate) return;
+  std::ostringstream os;
+  os << what << ": " << format_point(p) << " lies farther than " << kMaxCoordinate << " m from the origin" << why;
+  throw Error(os.str());
 }
 
 void check_query_radius(double radius, const char* field) {

@@ -64,9 +64,10 @@ void check_query_radius(double radius, const char* field);
 /// answers is measured along it (eleventh campaign L2: a direction of length 10 answered a
 /// tenth of the distance, a zero one "nothing within range").
 void check_query_direction(const Eigen::Vector3d& dir, const char* field);
-/// A clearance is asked within 10^6 m (kMaxCoordinate, a map's range) of the origin on every
-/// axis: at 1e155 m the squared distance overflowed and the answer was +infinity (eleventh
-/// campaign P3), and a voxel map walked every cell for it.
-void check_clearance_range(const Eigen::Vector3d& p);
+/// Refuses a point farther than kMaxCoordinate from the origin on some axis, naming it:
+/// "<what>: (x, y, z) lies farther than 1e+06 m from the origin<why>". Map bounds, region bounds
+/// and clearance queries (at 1e155 m its square overflowed to +infinity: eleventh campaign P3)
+/// share it; cheap when the point is within range.
+void require_within_range(const Eigen::Vector3d& p, const char* what, const char* why);
 
 }  // namespace miner::world

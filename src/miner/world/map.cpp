@@ -102,13 +102,8 @@ Map::Map(Box bounds, double resolution, std::vector<Box> obstacles, std::optiona
       query_(std::move(query)),
       source_(std::move(voxels)) {
   validate_box(bounds_, "bounds");
-  for (const auto& [corner, name] : {std::pair{&bounds_.min, "bounds.min"}, std::pair{&bounds_.max, "bounds.max"}})
-    if (corner->cwiseAbs().maxCoeff() > kMaxCoordinate) {
-      std::ostringstream os;
-      os << name << ": " << format_point(*corner) << " lies farther than " << kMaxCoordinate
-         << " m from the origin (use a local frame)";
-      throw Error(os.str());
-    }
+  require_within_range(bounds_.min, "bounds.min", " (use a local frame)");
+  require_within_range(bounds_.max, "bounds.max", " (use a local frame)");
   check_resolution(resolution_, "resolution");
   (void)grid_dims(bounds_, resolution_);  // a grid A* and the voxel grid can hold
   for (std::size_t i = 0; i < obstacles_.size(); ++i) {
@@ -592,7 +587,7 @@ std::optional<std::size_t> Map::segment_collision(const Eigen::Vector3d& a, cons
 
 double Map::clearance(const Eigen::Vector3d& p) const {
   check_query_point(p, "clearance: p");
-  check_clearance_range(p);
+  require_within_range(p, "clearance: p", " (a map's range): no distance is asked that far");
   double best = std::numeric_limits<double>::infinity();
   for (const Box& b : obstacles_) best = std::min(best, squared_distance(p, b));
   best = std::sqrt(best);

@@ -322,7 +322,7 @@ std::optional<std::size_t> VoxelObstacles::segment_hit(const Eigen::Vector3d& a,
 
 double VoxelObstacles::clearance(const Eigen::Vector3d& p) const {
   check_query_point(p, "clearance: p");
-  check_clearance_range(p);
+  require_within_range(p, "clearance: p", " (a map's range): no distance is asked that far");
   if (blocked_count_ == 0) return kInf;
   // The nearest blocked cube lies within upper = d_c + |p - centre_c| + half diagonal of p:
   // test the cubes of that ball's box exactly.

@@ -79,7 +79,7 @@ YawParams yaw_params_from_json(const JsonField& f) {
   }
   if (f.has("fixed_deg")) y.fixed = deg2rad(f.at("fixed_deg").number_in(-180.0, 180.0, "deg"));
   if (f.has("rate_limit_deg_s")) {
-    y.rate_limit = deg2rad(f.at("rate_limit_deg_s").number_in(0.0, 3600.0, "deg/s"));
+    y.rate_limit = deg2rad(f.at("rate_limit_deg_s").number_in(0.0, kMaxYawRateLimitDeg, "deg/s"));
     if (!(y.rate_limit > 0.0)) f.at("rate_limit_deg_s").fail("must be positive");
   }
   if (f.has("min_speed_m_s")) y.min_speed = f.at("min_speed_m_s").number_in(0.0, 100.0, "m/s");
@@ -92,11 +92,27 @@ YawParams yaw_params_from_json(const JsonField& f) {
   return y;
 }
 
+namespace {
+
+/// An angle for a reader that takes degrees within [-limit, limit]: the struct's radians
+/// converted back, a rounding past the limit (rad2deg(deg2rad(180)) is 180 + 3e-14) taken as
+/// the limit.
+double degrees_within(double radians, double limit) {
+  const double d = rad2deg(radians);
+  constexpr double kRounding = 1e-12;  // relative: far below any angle a scenario means
+  if (std::abs(d) > limit && std::abs(d) <= limit * (1.0 + kRounding)) return std::copysign(limit, d);
+  return d;
+}
+
+}  // namespace
+
 Json to_json(const YawParams& y) {
-  return Json{{"mode", y.mode == YawParams::Mode::kFixed ? "fixed" : "velocity"},
-              {"fixed_deg", rad2deg(y.fixed)},
-              {"rate_limit_deg_s", rad2deg(y.rate_limit)},
-              {"min_speed_m_s", y.min_speed}};
+  // Only the chosen mode's keys: yaw_params_from_json refuses the other mode's as unused.
+  Json doc{{"mode", y.mode == YawParams::Mode::kFixed ? "fixed" : "velocity"},
+           {"rate_limit_deg_s", degrees_within(y.rate_limit, kMaxYawRateLimitDeg)}};
+  if (y.mode == YawParams::Mode::kFixed) doc["fixed_deg"] = degrees_within(y.fixed, 180.0);
+  else doc["min_speed_m_s"] = y.min_speed;
+  return doc;
 }
 
 std::pair<double, double> YawReference::step(const Eigen::Vector3d& v_ref, double dt) {

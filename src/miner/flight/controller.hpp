@@ -77,7 +77,10 @@ struct YawParams {
   double rate_limit = deg2rad(45.0);    ///< rad/s
   double min_speed = 0.1;               ///< m/s, below it the heading is held
 };
+/// The fastest yaw rate limit a file may give (deg/s): ten turns a second.
+inline constexpr double kMaxYawRateLimitDeg = 3600.0;
 YawParams yaw_params_from_json(const JsonField& f);
+/// The section as yaw_params_from_json reads it: the mode's own keys only.
 Json to_json(const YawParams& y);
 
 class YawReference {

@@ -155,7 +155,9 @@ Json to_json(const PoseParams& p) {
     doc["yaw_drift_random_walk"] = p.yaw_drift_random_walk;
     doc["delay_jitter_s"] = p.delay_jitter_s;
     doc["dropout_rate_hz"] = p.dropout_rate_hz;
-    doc["dropout_mean_s"] = p.dropout_mean_s;
+    // pose_params_from_json refuses a loss's length without losses as unused: left out when
+    // it is the default 0 (a stray non-zero length is written, and refused by the reader).
+    if (p.dropout_rate_hz > 0.0 || p.dropout_mean_s != 0.0) doc["dropout_mean_s"] = p.dropout_mean_s;
   }
   return doc;
 }

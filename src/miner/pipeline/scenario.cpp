@@ -320,19 +320,6 @@ Scenario scenario_from_json(const Json& doc, const std::string& origin, const st
   return s;
 }
 
-namespace {
-
-/// An angle for a reader that takes degrees within [-limit, limit]: the struct's radians
-/// converted back, a rounding past the limit (rad2deg(deg2rad(180)) may be 180 + 3e-14) taken
-/// as the limit.
-double degrees_within(double radians, double limit) {
-  const double d = rad2deg(radians);
-  constexpr double kRounding = 1e-12;  // relative: far below any angle a scenario means
-  if (std::abs(d) > limit && std::abs(d) <= limit * (1.0 + kRounding)) return std::copysign(limit, d);
-  return d;
-}
-
-}  // namespace
 
 Json scenario_document(const Scenario& s) {
   Json d{{"format", kScenarioFormat},
@@ -354,17 +341,8 @@ Json scenario_document(const Scenario& s) {
            {"initial_attitude_sigma", s.ekf.initial_attitude_sigma}}},
          {"mismatch", to_json(s.mismatch)},
          {"controller_reads", s.controller_reads_truth ? "ground-truth" : "ekf"}};
-  // Keys a file may give only in some modes are written only then (the reader refuses them as
-  // unused otherwise): a pose's dropout length without dropouts, the yaw of the other mode.
-  Json pose = to_json(s.pose);
-  if (pose.contains("dropout_mean_s") && s.pose.dropout_rate_hz == 0.0 && s.pose.dropout_mean_s == 0.0)
-    pose.erase("dropout_mean_s");
-  d["pose"] = pose;
-  Json yaw{{"mode", s.yaw.mode == YawParams::Mode::kFixed ? "fixed" : "velocity"},
-           {"rate_limit_deg_s", degrees_within(s.yaw.rate_limit, 3600.0)}};
-  if (s.yaw.mode == YawParams::Mode::kFixed) yaw["fixed_deg"] = degrees_within(s.yaw.fixed, 180.0);
-  else yaw["min_speed_m_s"] = s.yaw.min_speed;
-  d["yaw"] = yaw;
+  d["pose"] = to_json(s.pose);
+  d["yaw"] = to_json(s.yaw);
   if (s.wind.enabled) d["wind"] = to_json(s.wind);
   if (s.battery.enabled) d["battery"] = to_json(s.battery);
   // A struct's empty waypoint list is the straight leg from start to goal (a file says that

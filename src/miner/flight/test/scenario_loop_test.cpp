@@ -15,6 +15,9 @@
 
 #include "miner/core/error.hpp"
 #include "miner/flight/closed_loop.hpp"
+#include "miner/flight/disturbances.hpp"
+#include "miner/flight/n3.hpp"
+#include "miner/flight/sensors.hpp"
 #include "miner/pipeline/run_folder.hpp"
 #include "miner/pipeline/scenario.hpp"
 #include "miner/traj/problem_io.hpp"
@@ -855,4 +858,73 @@ TEST_CASE("A reference stretched for a_max reaches a_max: acceleration scales wi
     // Stretched onto the binding limit, not below it.
     CHECK(std::max(r.max_speed / s.limits.v_max, r.max_acceleration / a_max) == Approx(1.0).epsilon(1e-3));
   }
+}
+
+namespace {
+/// to_json(x), read back by the section's own reader, written again: the same document.
+template <class T, class Reader>
+void check_section_round_trip(const T& x, Reader read, const std::string& what) {
+  INFO(what);
+  using flight::to_json;  // n3::Config's is found by its namespace
+  const miner::Json doc = to_json(x);
+  INFO(doc.dump());
+  miner::Json again;
+  REQUIRE_NOTHROW(again = to_json(read(miner::JsonField(doc, what, "round trip"))));
+  CHECK(again == doc);
+}
+}  // namespace
+
+TEST_CASE("Every flight section's to_json reads back by its own reader as the same section", "[REQ-FLIGHT-007]") {
+  // A C++ user writes a section with to_json and gives it to a scenario: the reader must take
+  // it (session 32: to_json(YawParams) wrote the other mode's key, which the reader refuses as
+  // unused, and to_json(PoseParams) wrote a VIO stream's dropout_mean_s without dropouts).
+  flight::ControllerParams c;
+  check_section_round_trip(c, flight::controller_params_from_json, "controller, default");
+  c.yaw_mode = flight::ControllerParams::YawMode::kRate;
+  c.yaw_gain = 3.5;
+  c.max_speed = 1.25;
+  check_section_round_trip(c, flight::controller_params_from_json, "controller, yaw rate mode and a speed limit");
+
+  flight::YawParams y;
+  check_section_round_trip(y, flight::yaw_params_from_json, "yaw, default (fixed)");
+  y.fixed = miner::deg2rad(180.0);  // rad2deg(deg2rad(180)) rounds past the reader's 180
+  y.rate_limit = miner::deg2rad(3600.0);
+  check_section_round_trip(y, flight::yaw_params_from_json, "yaw, fixed at 180 deg, fastest rate");
+  y = flight::YawParams{};
+  y.mode = flight::YawParams::Mode::kVelocity;
+  y.min_speed = 0.3;
+  check_section_round_trip(y, flight::yaw_params_from_json, "yaw, velocity mode");
+
+  check_section_round_trip(flight::ImuParams{}, flight::imu_params_from_json, "imu, default");
+  flight::PoseParams p;
+  check_section_round_trip(p, flight::pose_params_from_json, "pose, default");
+  p.drift_random_walk = 0.01;
+  check_section_round_trip(p, flight::pose_params_from_json, "pose, VIO drift without tracking losses");
+  p.dropout_rate_hz = 0.2;
+  p.dropout_mean_s = 0.5;
+  check_section_round_trip(p, flight::pose_params_from_json, "pose, VIO with tracking losses");
+
+  flight::WindParams w;
+  check_section_round_trip(w, flight::wind_params_from_json, "wind, default (off)");
+  w.enabled = true;
+  w.mean = Eigen::Vector3d(1.0, -0.5, 0.0);
+  w.sigma_horizontal = 0.4;
+  w.sigma_vertical = 0.1;
+  w.gusts.push_back(flight::Gust{2.0, 1.5, Eigen::Vector3d(0.0, 2.0, 0.0)});
+  check_section_round_trip(w, flight::wind_params_from_json, "wind with a gust");
+  flight::MismatchParams m;
+  check_section_round_trip(m, flight::mismatch_params_from_json, "mismatch, none");
+  m.mass = 1.2;
+  m.drag = 0.5;
+  check_section_round_trip(m, flight::mismatch_params_from_json, "mismatch, mass and drag");
+  flight::BatteryParams b;
+  check_section_round_trip(b, flight::battery_params_from_json, "battery, default (off)");
+  b.enabled = true;
+  b.initial_charge = 0.8;
+  check_section_round_trip(b, flight::battery_params_from_json, "battery");
+  flight::n3::Config n;
+  check_section_round_trip(n, flight::n3::config_from_json, "n3, default");
+  n.failsafe = flight::n3::Failsafe::kLand;
+  n.land_speed = 0.8;
+  check_section_round_trip(n, flight::n3::config_from_json, "n3, land failsafe");
 }

@@ -378,6 +378,24 @@ void check_scenario(const Scenario& s) {
   Scenario copy;
   copy.map = s.map;
   read_scenario_fields(JsonField(doc, "", origin), origin, "", s.trajectory_file.has_value(), copy);
+  // The emulated N3's own constants are not scenario keys (a file sets only its rate, latency,
+  // timeout, failsafe, tilt and yaw-rate limits): a struct that changed one is not a scenario a
+  // file could say, and its run folder's scenario.json would fly another N3.
+  using N3 = flight::n3::Config;
+  for (const auto& [name, field] : {std::pair{"land_speed", &N3::land_speed},
+                                    std::pair{"max_horizontal_speed", &N3::max_horizontal_speed},
+                                    std::pair{"max_vertical_speed", &N3::max_vertical_speed},
+                                    std::pair{"horizontal_velocity_gain", &N3::horizontal_velocity_gain},
+                                    std::pair{"vertical_velocity_gain", &N3::vertical_velocity_gain},
+                                    std::pair{"horizontal_velocity_integral_gain", &N3::horizontal_velocity_integral_gain},
+                                    std::pair{"vertical_velocity_integral_gain", &N3::vertical_velocity_integral_gain},
+                                    std::pair{"velocity_integral_limit", &N3::velocity_integral_limit}})
+    if (!(s.n3.*field == copy.n3.*field))
+      throw Error(origin + ": n3." + name + ": " + short_number(s.n3.*field) + " is not the emulated N3's " +
+                  short_number(copy.n3.*field) + " (not a scenario key: a run folder could not fly it again)");
+  for (const auto& [name, field] : {std::pair{"attitude_gain", &N3::attitude_gain}, std::pair{"rate_gain", &N3::rate_gain}})
+    if (!(s.n3.*field == copy.n3.*field))
+      throw Error(origin + ": n3." + name + ": differs from the emulated N3's (not a scenario key: a run folder could not fly it again)");
   // What the reader copies: the EKF models the sensors it is given.
   if (to_json(s.ekf.imu) != to_json(s.imu) || to_json(s.ekf.pose) != to_json(s.pose))
     throw Error(origin + ": ekf.imu / ekf.pose differ from imu / pose: the EKF's noise model is the sensors' " +

@@ -659,6 +659,12 @@ TEST_CASE("A Scenario changed in C++ after reading is checked by the reader's ow
   refused([](pipeline::Scenario& c) { c.vehicle.mass = 0.0; }, "vehicle");
   refused([](pipeline::Scenario& c) { c.mismatch.mass = 5.0; }, "mismatch.mass");
   refused([](pipeline::Scenario& c) { c.name = "../x"; }, "name");
+  // The emulated N3's own constants are not scenario keys: a changed one would be flown but
+  // not written to the run folder (session 32: n3.land_speed 0.8 passed and replayed as 0.5).
+  refused([](pipeline::Scenario& c) { c.n3.land_speed = 0.8; }, "n3.land_speed: 0.8 is not the emulated N3's 0.5");
+  refused([](pipeline::Scenario& c) { c.n3.max_vertical_speed = 2.0; }, "n3.max_vertical_speed");
+  refused([](pipeline::Scenario& c) { c.n3.velocity_integral_limit = 1.0; }, "n3.velocity_integral_limit");
+  refused([](pipeline::Scenario& c) { c.n3.rate_gain.z() = 20.0; }, "n3.rate_gain");
   // What the checks leave alone still builds and flies: a struct's empty waypoint list is the
   // straight leg, a velocity-mode yaw keeps its unused fixed angle, a yaw of exactly 180 deg.
   pipeline::Scenario fine = s;

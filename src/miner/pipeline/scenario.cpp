@@ -55,6 +55,17 @@ int ticks_per(const JsonField& where, double loop_rate, double rate, const char*
 /// range and the cross-checks. scenario_from_json reads files with it, and check_scenario
 /// checks a struct by writing it back as a document, so one set of rules holds both.
 /// `trajectory_given`: the route is a trajectory already in s (a file's, or a struct's).
+/// The scenario's speed limit, kSpeedLimitHeadroom v_max, reaches the controller (the velocity
+/// its feedback may ask for, REQ-FLIGHT-016; only when no cap was set, i.e. it is infinite) and
+/// the N3's VELOCITY mode (its failsafe brake): what the reader does to a file's scenario and
+/// fly() to a struct built in C++, so both fly the N3 a run folder's scenario.json describes.
+void apply_speed_limit(flight::FlightSetup& f, const traj::Limits& limits) {
+  const double speed_limit = kSpeedLimitHeadroom * limits.v_max;
+  if (!std::isfinite(f.controller.max_speed)) f.controller.max_speed = speed_limit;
+  f.n3.max_horizontal_speed = std::min(f.n3.max_horizontal_speed, speed_limit);
+  f.n3.max_vertical_speed = std::min(f.n3.max_vertical_speed, speed_limit);
+}
+
 void read_scenario_fields(const JsonField& root, const std::string& origin, const std::string& base_dir,
                           bool trajectory_given, Scenario& s) {
   if (root.has("name")) {
@@ -245,12 +256,7 @@ void read_scenario_fields(const JsonField& root, const std::string& origin, cons
   }
   if (root.has("battery")) s.battery = battery_params_from_json(root.at("battery"));
   if (root.has("yaw")) s.yaw = yaw_params_from_json(root.at("yaw"));
-  // The scenario's speed limit reaches the controller (the velocity its feedback may ask
-  // for, REQ-FLIGHT-016) and the N3's VELOCITY mode (its failsafe brake), with headroom.
-  const double speed_limit = kSpeedLimitHeadroom * s.limits.v_max;
-  if (!(root.has("controller") && root.at("controller").has("max_speed_m_s"))) s.controller.max_speed = speed_limit;
-  s.n3.max_horizontal_speed = std::min(s.n3.max_horizontal_speed, speed_limit);
-  s.n3.max_vertical_speed = std::min(s.n3.max_vertical_speed, speed_limit);
+  apply_speed_limit(s, s.limits);  // the controller's cap is infinite unless the file gave one
   if (s.controller.max_tilt_deg > s.n3.max_tilt_deg)
     root.fail("controller.max_tilt_deg exceeds the N3's max_tilt_deg");
   // A controller capped below the reference's speed falls behind it and cuts corners into
@@ -379,8 +385,11 @@ void check_scenario(const Scenario& s) {
   copy.map = s.map;
   read_scenario_fields(JsonField(doc, "", origin), origin, "", s.trajectory_file.has_value(), copy);
   // The emulated N3's own constants are not scenario keys (a file sets only its rate, latency,
-  // timeout, failsafe, tilt and yaw-rate limits): a struct that changed one is not a scenario a
-  // file could say, and its run folder's scenario.json would fly another N3.
+  // timeout, failsafe, tilt and yaw-rate limits; its speed limits follow trajectory.v_max): a
+  // struct that changed one is not a scenario a file could say, and its run folder's
+  // scenario.json would fly another N3.
+  flight::FlightSetup flown = s;
+  apply_speed_limit(flown, s.limits);
   using N3 = flight::n3::Config;
   for (const auto& [name, field] : {std::pair{"land_speed", &N3::land_speed},
                                     std::pair{"max_horizontal_speed", &N3::max_horizontal_speed},
@@ -390,11 +399,11 @@ void check_scenario(const Scenario& s) {
                                     std::pair{"horizontal_velocity_integral_gain", &N3::horizontal_velocity_integral_gain},
                                     std::pair{"vertical_velocity_integral_gain", &N3::vertical_velocity_integral_gain},
                                     std::pair{"velocity_integral_limit", &N3::velocity_integral_limit}})
-    if (!(s.n3.*field == copy.n3.*field))
-      throw Error(origin + ": n3." + name + ": " + short_number(s.n3.*field) + " is not the emulated N3's " +
+    if (!(flown.n3.*field == copy.n3.*field))
+      throw Error(origin + ": n3." + name + ": " + short_number(flown.n3.*field) + " is not the emulated N3's " +
                   short_number(copy.n3.*field) + " (not a scenario key: a run folder could not fly it again)");
   for (const auto& [name, field] : {std::pair{"attitude_gain", &N3::attitude_gain}, std::pair{"rate_gain", &N3::rate_gain}})
-    if (!(s.n3.*field == copy.n3.*field))
+    if (!(flown.n3.*field == copy.n3.*field))
       throw Error(origin + ": n3." + name + ": differs from the emulated N3's (not a scenario key: a run folder could not fly it again)");
   // What the reader copies: the EKF models the sensors it is given.
   if (to_json(s.ekf.imu) != to_json(s.imu) || to_json(s.ekf.pose) != to_json(s.pose))
@@ -732,6 +741,7 @@ flight::FlightResult fly(const Scenario& scenario, const ReferencePlan& referenc
   check_scenario(scenario);
   check_reference(scenario, reference);
   flight::FlightSetup setup = scenario;
+  apply_speed_limit(setup, scenario.limits);  // a struct built in C++ flies what its file would
   const std::shared_ptr<const world::Map> map = scenario.map;
   const double radius = scenario.vehicle.radius;
   setup.collides = [map, radius](const Eigen::Vector3d& p) { return !map->is_free(p, radius); };

@@ -1,6 +1,9 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <functional>
+#include <limits>
+#include <string>
 
 #include "miner/core/rng.hpp"
 #include "miner/core/statistics.hpp"
@@ -10,6 +13,8 @@
 #include "miner/flight/ekf.hpp"
 #include "miner/flight/sensors.hpp"
 #include "miner/flight/flatness.hpp"
+#include "miner/flight/dynamics.hpp"
+#include "miner/flight/n3.hpp"
 #include "miner/testing/flight_scenarios.hpp"
 
 namespace flight = miner::flight;
@@ -237,4 +242,57 @@ TEST_CASE("One EKF prediction propagates the covariance as F P F^T + Q, F from t
   // Round-off of 15-term sums of products of O(1) entries: a few 1e-16 of ||P||.
   constexpr double kRoundOff = 1e-12;
   CHECK((ekf.covariance() - expected).norm() <= kRoundOff * expected.norm());
+}
+
+TEST_CASE("The flight components refuse bad construction and out-of-order input naming the argument",
+          "[REQ-LIB-003][REQ-FLIGHT-003][REQ-FLIGHT-005][REQ-FLIGHT-002]") {
+  // Reachable from C++ only (a scenario file cannot say them): each refusal names what is wrong.
+  const flight::VehicleParams vehicle;
+  const auto n3_refuses = [&](const std::function<void(flight::n3::Config&)>& change, const std::string& needle) {
+    flight::n3::Config c;
+    change(c);
+    CHECK_THROWS_WITH(flight::n3::FlightController(vehicle, c), Catch::Matchers::Contains(needle));
+  };
+  CHECK_NOTHROW(flight::n3::FlightController(vehicle, flight::n3::Config{}));
+  n3_refuses([](flight::n3::Config& c) { c.land_speed = 0.0; }, "land_speed, max_horizontal_speed and max_vertical_speed");
+  n3_refuses([](flight::n3::Config& c) { c.max_vertical_speed = -1.0; }, "max_vertical_speed must be positive");
+  n3_refuses([](flight::n3::Config& c) { c.rate_gain.y() = 0.0; }, "gains must be positive");
+  n3_refuses([](flight::n3::Config& c) { c.velocity_integral_limit = 0.0; }, "gains must be positive");
+  n3_refuses([](flight::n3::Config& c) { c.rate_hz = 399.0; }, "rate_hz must be in [400, 10000]");
+  n3_refuses([](flight::n3::Config& c) { c.max_tilt_deg = 90.0; }, "max_tilt_deg must be in (0, 90)");
+
+  flight::EkfParams params;
+  const flight::Matrix15 p0 = flight::initial_covariance(params);
+  for (const double gate : {0.0, 1.0, std::nan("")}) {
+    params.gate_probability = gate;
+    CHECK_THROWS_WITH(flight::Ekf(params, 0.0025, 0, flight::NavState{}, p0),
+                      Catch::Matchers::Contains("gate_probability must be in (0, 1)"));
+  }
+  params.gate_probability = 0.999;
+  CHECK_THROWS_WITH(flight::Ekf(params, 0.0, 0, flight::NavState{}, p0), Catch::Matchers::Contains("imu_dt > 0"));
+  flight::Ekf ekf(params, 0.0025, 0, flight::NavState{}, p0);
+  flight::ImuSample still;
+  still.accel = Eigen::Vector3d(0.0, 0.0, miner::kGravity);
+  ekf.push_imu(7, still);
+  ekf.push_imu(8, still);
+  // A skipped or repeated tick would integrate the wrong interval.
+  CHECK_THROWS_WITH(ekf.push_imu(10, still), Catch::Matchers::Contains("IMU tick 10 after 8"));
+  CHECK_THROWS_WITH(ekf.push_imu(8, still), Catch::Matchers::Contains("IMU tick 8 after 8"));
+  CHECK_NOTHROW(ekf.push_imu(9, still));
+
+  flight::IntegratorOptions o;
+  for (const double rtol : {0.0, -1e-6, std::numeric_limits<double>::infinity()}) {
+    o.relative_tolerance = rtol;
+    CHECK_THROWS_WITH(flight::Integrator(vehicle, o), Catch::Matchers::Contains("relative_tolerance must be positive and finite"));
+  }
+  flight::Integrator integrator(vehicle);
+  flight::QuadState state;
+  const Eigen::Vector4d hover = Eigen::Vector4d::Constant(vehicle.hover_rotor_speed());
+  CHECK_THROWS_WITH(integrator.advance(state, 0.0, 0.0025, Eigen::Vector4d(std::nan(""), 0, 0, 0)),
+                    Catch::Matchers::Contains("rotor command, disturbance or wind is not finite"));
+  CHECK_THROWS_WITH(integrator.advance(state, 0.0, 0.0025, hover, Eigen::Vector3d::Zero(),
+                                       Eigen::Vector3d(0, std::numeric_limits<double>::infinity(), 0)),
+                    Catch::Matchers::Contains("not finite"));
+  CHECK_THROWS_WITH(integrator.advance(state, 0.0025, 0.0025, hover), Catch::Matchers::Contains("t1 > t0"));
+  CHECK_NOTHROW(integrator.advance(state, 0.0, 0.0025, hover));
 }

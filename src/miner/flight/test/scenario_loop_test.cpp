@@ -91,6 +91,22 @@ TEST_CASE("Bad scenarios are refused before flight with the fault named", "[REQ-
   doc["vehicle"] = flight::to_json(flight::VehicleParams{});
   doc["vehicle"]["mass_kg"] = -2;
   expect_scenario_error(doc, "mass_kg");
+  // Start and goal come from the file or from the map's query; a map without one needs both.
+  doc = default_doc();
+  doc["map"] = miner::Json{{"format", "miner-map-v1"}, {"bounds", {{"min", {0, 0, 0}}, {"max", {20, 20, 10}}}},
+                           {"resolution", 0.5}, {"obstacles", miner::Json::array()}};
+  doc["start"] = {5, 5, 3};
+  doc["goal"] = {12, 9, 4};
+  CHECK(pipeline::scenario_from_json(doc, "s.json", kScenarios).goal == Eigen::Vector3d(12, 9, 4));
+  doc.erase("start");
+  expect_scenario_error(doc, "s.json: (top level): no \"start\" and the map stores no query");
+  doc["start"] = {5, 5, 3};
+  doc.erase("goal");
+  expect_scenario_error(doc, "s.json: (top level): no \"goal\" and the map stores no query");
+  // planner.weights is a path relative to the scenario's folder.
+  doc = default_doc();
+  doc["planner"] = {{"region", "sgan"}, {"weights", "w/sgan.bin"}};
+  CHECK(pipeline::scenario_from_json(doc, "s.json", kScenarios).weights == kScenarios + "/w/sgan.bin");
   doc = default_doc();
   doc["trajectory"]["a_max"] = 9.0;
   expect_scenario_error(doc, "deg of tilt");
@@ -432,6 +448,13 @@ TEST_CASE("A trajectory file that exceeds the limits or misses the start is refu
   expect_scenario_error(doc, "exceed the limits");
   doc["trajectory"] = {{"file", path}, {"v_max", 2.0}, {"a_max", 2.0}};
   CHECK(pipeline::build_reference(pipeline::scenario_from_json(doc, "s.json", kScenarios)).source == "file");
+  // The same file through a box on its way: refused naming the segment, its radius the
+  // vehicle's plus the planning margin (a wall 0.05 m thick across the straight leg).
+  {
+    miner::Json walled = doc;
+    walled["map"]["obstacles"] = {{{"type", "box"}, {"min", {8.0, 0.0, 0.0}}, {"max", {8.05, 20.0, 10.0}}}};
+    expect_scenario_error(walled, "trajectory file: segment 0 comes within the vehicle radius + planning margin (0.4");
+  }
   doc["start"] = {5, 6, 3};
   expect_scenario_error(doc, "must start at start");
   // A file whose durations make the flight too long is told to shorten them, not to raise the
@@ -662,7 +685,12 @@ TEST_CASE("A Scenario changed in C++ after reading is checked by the reader's ow
   // The emulated N3's own constants are not scenario keys: a changed one would be flown but
   // not written to the run folder (session 32: n3.land_speed 0.8 passed and replayed as 0.5).
   refused([](pipeline::Scenario& c) { c.n3.land_speed = 0.8; }, "n3.land_speed: 0.8 is not the emulated N3's 0.5");
-  refused([](pipeline::Scenario& c) { c.n3.max_vertical_speed = 2.0; }, "n3.max_vertical_speed");
+  // Its speed limits follow trajectory.v_max (min(10, 1.25 v_max) = 1 m/s here): a cap above that
+  // changes nothing and passes, one below it is refused.
+  pipeline::Scenario capped = s;
+  capped.n3.max_vertical_speed = 2.0;
+  CHECK_NOTHROW(pipeline::check_scenario(capped));
+  refused([](pipeline::Scenario& c) { c.n3.max_vertical_speed = 0.5; }, "n3.max_vertical_speed: 0.5 is not the emulated N3's 1");
   refused([](pipeline::Scenario& c) { c.n3.velocity_integral_limit = 1.0; }, "n3.velocity_integral_limit");
   refused([](pipeline::Scenario& c) { c.n3.rate_gain.z() = 20.0; }, "n3.rate_gain");
   // What the checks leave alone still builds and flies: a struct's empty waypoint list is the
@@ -933,4 +961,27 @@ TEST_CASE("Every flight section's to_json reads back by its own reader as the sa
   n.failsafe = flight::n3::Failsafe::kLand;
   n.land_speed = 0.8;
   check_section_round_trip(n, flight::n3::config_from_json, "n3, land failsafe");
+}
+
+TEST_CASE("A Scenario built in C++ flies what its scenario document flies once read back", "[REQ-FLIGHT-016][REQ-LIB-003]") {
+  // The reader derives the controller's speed cap and the N3's VELOCITY-mode limits from
+  // trajectory.v_max; a struct built in C++ left them at "none" (infinite, 10 m/s) and flew
+  // another N3 than its run folder's scenario.json (session 32). A 2 s command dropout leaves the
+  // vehicle behind the reference: catching up, the controller's feedback asks for more than its
+  // cap (the test fails when fly() does not apply the limit).
+  Eigen::MatrixX3d points(3, 3);
+  points << 3, 3, 2, 9, 6, 3, 15, 4, 2;
+  pipeline::Scenario s = miner::testing::open_room_scenario(points, 1.6, 1.0);
+  s.command_dropout = std::make_pair(6.0, 8.0);
+  REQUIRE(std::isinf(s.controller.max_speed));
+  const pipeline::ReferencePlan r = pipeline::build_reference(s);
+  const flight::FlightResult built = pipeline::fly(s, r);
+  miner::Json doc = pipeline::scenario_document(s);
+  doc["map"] = s.map->to_json();
+  const pipeline::Scenario read = pipeline::scenario_from_json(doc, "document", "");
+  CHECK(read.controller.max_speed == 2.0);  // 1.25 v_max
+  CHECK(read.n3.max_horizontal_speed == 2.0);
+  const flight::FlightResult replayed = pipeline::fly(read, pipeline::build_reference(read));
+  REQUIRE(replayed.log.size() == built.log.size());
+  CHECK(replayed.log == built.log);
 }

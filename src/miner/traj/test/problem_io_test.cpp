@@ -135,6 +135,15 @@ TEST_CASE("A trajectory answer file is read strictly: junctions meet, the cost i
                         Contains(std::string("the ") + names[k] + " at the start of segment 1"));
     }
   }
+  // As many coefficient blocks as durations: one more or one fewer is named.
+  miner::Json short_of = good;
+  short_of["coefficients"].erase(1);
+  CHECK_THROWS_WITH(trajectory_from_answer_json(short_of, "a.json"),
+                    Contains("a.json: coefficients: has 1 segments but durations has 2"));
+  miner::Json long_of = good;
+  long_of["durations"].push_back(1.0);
+  CHECK_THROWS_WITH(trajectory_from_answer_json(long_of, "a.json"),
+                    Contains("a.json: coefficients: has 2 segments but durations has 3"));
   miner::Json extra = good;
   extra["extra"] = 1;
   CHECK_THROWS_WITH(trajectory_from_answer_json(extra, "a.json"), Contains("a.json: extra: unknown key"));

@@ -194,6 +194,21 @@ TEST_CASE("Allocation requests in problem files are checked", "[REQ-TRAJ-011]") 
   bad["rho"] = -1;
   CHECK_THROWS_WITH(request_from_json(bad, "p.json"), Contains("rho: must be in [1e-09, 1e+09], got -1"));
   CHECK_THROWS_WITH(request_from_json(doc, "p.json", "", -2.0), Contains("--rho: must be positive"));
+  // A valid --rho replaces the file's rho; --allocate optimise without a file allocation uses
+  // the default rho 1 or the command line's.
+  const auto overridden = request_from_json(doc, "p.json", "", 0.25);
+  REQUIRE(overridden.optimise);
+  CHECK(overridden.optimise->rho == 0.25);
+  auto plain = doc;
+  plain.erase("allocation");
+  plain.erase("rho");
+  CHECK_FALSE(request_from_json(plain, "p.json").optimise);
+  const auto asked = request_from_json(plain, "p.json", "optimise");
+  REQUIRE(asked.optimise);
+  CHECK(asked.optimise->rho == 1.0);
+  CHECK(asked.optimise->limits.v_max == 2.0);
+  CHECK(asked.optimise->limits.a_max == 1.0);
+  CHECK(request_from_json(plain, "p.json", "optimise", 7.0).optimise->rho == 7.0);
 }
 
 TEST_CASE("sampled_extremes agrees with the trajectory's own derivatives", "[REQ-TRAJ-011]") {

@@ -298,6 +298,22 @@ TEST_CASE("Malformed point clouds are refused naming the fault, never crash", "[
     CHECK(parse_point_cloud(bin + face + face, true, "faces.ply").points.size() == 1);
     refuses(bin + face, true, "element face 1 of 2: the data ends inside it");
     refuses(bin + face + face + "x", true, "data continues after the elements the header declares (1 bytes)");
+    // Signed count types (char, short, int; little- and big-endian): a negative count is named,
+    // never read as a large unsigned one ("the data ends inside it").
+    for (const auto& [type, size] : {std::pair<std::string, int>{"char", 1}, {"short", 2}, {"int", 4}}) {
+      for (const bool big : {false, true}) {
+        INFO(type << (big ? " big-endian" : " little-endian"));
+        const std::string head = std::string("ply\nformat ") + (big ? "binary_big_endian" : "binary_little_endian") +
+                                 " 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+                                 "element face 1\nproperty list " + type + " uint vertex_indices\nend_header\n" +
+                                 std::string(12, '\0');
+        // The count in `size` bytes, two's complement: 3 and -1.
+        std::string three(static_cast<std::size_t>(size), '\0'), minus_one(static_cast<std::size_t>(size), '\xff');
+        three[big ? three.size() - 1 : 0] = '\3';
+        CHECK(parse_point_cloud(head + three + std::string(12, '\0'), true, "faces.ply").points.size() == 1);
+        refuses(head + minus_one + std::string(12, '\0'), true, "element face 0 of 1: a negative list length");
+      }
+    }
   }
   // Numbers are decimal (or nan / inf, which organised clouds use): strtod's hexadecimal
   // floats are refused, in PCD and PLY alike (third campaign: "0x1p3" read as 8).

@@ -121,6 +121,31 @@ TEST_CASE("A map file references its voxels by path and SHA-256", "[REQ-WORLD-01
   CHECK(both.point_collision(V(0.5, 3.5, 0.5)));
   CHECK(both.point_collision(V(2.5, 2.5, 2.5)));
   CHECK(both.point_collision(V(1.5, 1.5, 1.5)));  // unknown: occupied by default
+  // As one voxel layer (what .bt output writes): the boxes' cells occupied, every other cell the
+  // voxels' own state (unknown stays unknown), cells past the voxels free.
+  const auto state = [](const VoxelLayer& l, int x, int y, int z) { return static_cast<VoxelState>(l.states()[l.index(x, y, z)]); };
+  const VoxelLayer merged = both.to_voxel_layer();
+  REQUIRE(merged.dims() == Eigen::Vector3i(4, 4, 4));
+  CHECK(state(merged, 0, 3, 0) == VoxelState::kOccupied);
+  CHECK(state(merged, 2, 2, 2) == VoxelState::kOccupied);
+  CHECK(state(merged, 1, 1, 1) == VoxelState::kUnknown);
+  CHECK(state(merged, 3, 0, 0) == VoxelState::kFree);
+  CHECK(state(merged, 0, 3, 1) == VoxelState::kFree);
+  const Map wide_both = Map::load(write("wide-both.json", R"({"format": "miner-map-v1", "bounds": {"min": [0, 0, 0], "max": [6, 4, 4]},
+      "resolution": 1, "obstacles": [{"type": "box", "min": [5, 0, 0], "max": [6, 1, 1]}], "voxels": {"file": "small.bt", "unknown": "free"}})"));
+  const VoxelLayer wide_merged = wide_both.to_voxel_layer();
+  REQUIRE(wide_merged.dims() == Eigen::Vector3i(6, 4, 4));
+  CHECK(state(wide_merged, 5, 0, 0) == VoxelState::kOccupied);
+  CHECK(state(wide_merged, 4, 2, 2) == VoxelState::kFree);
+  CHECK(state(wide_merged, 2, 2, 2) == VoxelState::kOccupied);
+  CHECK(state(wide_merged, 1, 1, 1) == VoxelState::kUnknown);
+  // The map's resolution is the voxels': another one is named with both.
+  CHECK_THROWS_WITH(Map::load(write("res.json", R"({"format": "miner-map-v1", "bounds": {"min": [0, 0, 0], "max": [4, 4, 4]},
+                                                  "resolution": 0.5, "obstacles": [], "voxels": {"file": "small.bt"}})")),
+                    Contains("res.json") && Contains("resolution: 0.5 m differs from the voxels' 1 m"));
+  // MINER writes binary trees only.
+  CHECK_THROWS_WITH(both.save((dir / "both.ot").string()), Contains("both.ot: MINER writes OctoMaps as .bt"));
+  CHECK_FALSE(std::filesystem::exists(dir / "both.ot"));
 }
 
 TEST_CASE("Segments reaching far beyond a voxel map get the answer of their part over it", "[REQ-WORLD-005][REQ-WORLD-013]") {
@@ -325,4 +350,29 @@ TEST_CASE("A map's fingerprint changes with every coordinate of every obstacle c
       CAPTURE(corner, axis);
       CHECK(Map(bounds, 0.5, {moved}).fingerprint() != reference.fingerprint());
     }
+}
+
+TEST_CASE("A voxel layer built in code is refused by its resolution, size, origin and states, naming which",
+          "[REQ-LIB-003][REQ-WORLD-012]") {
+  const auto layer = [](double resolution, Eigen::Vector3i dims, std::size_t states, std::uint8_t fill = 0,
+                        Eigen::Vector3i origin = Eigen::Vector3i::Zero()) {
+    return VoxelLayer(origin, resolution, dims, std::vector<std::uint8_t>(states, fill));
+  };
+  CHECK_NOTHROW(layer(0.5, Eigen::Vector3i(2, 3, 4), 24));
+  for (const double bad : {0.0, -0.5, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()})
+    CHECK_THROWS_WITH(layer(bad, Eigen::Vector3i(2, 3, 4), 24), Contains("voxel resolution: must be positive and finite"));
+  CHECK_THROWS_WITH(layer(0.5, Eigen::Vector3i(2, 0, 4), 0), Contains("every dimension must hold at least one voxel"));
+  // One voxel past the bound is named with the dims and the bound, before the states are read.
+  const int side = static_cast<int>(std::cbrt(static_cast<double>(kMaxGridCells))) + 1;
+  CHECK_THROWS_WITH(layer(0.5, Eigen::Vector3i(side, side, side), 0), Contains("voxels, more than the") && Contains(std::to_string(side) + " x "));
+  // Exactly the bound (2^26 = 4096 x 4096 x 4) is a layer; one row more is not.
+  static_assert(kMaxGridCells == 4096.0 * 4096.0 * 4.0);
+  CHECK_NOTHROW(layer(0.5, Eigen::Vector3i(4096, 4096, 4), 4096u * 4096u * 4u));
+  CHECK_THROWS_WITH(layer(0.5, Eigen::Vector3i(4096, 4097, 4), 0), Contains("4096 x 4097 x 4 voxels, more than the"));
+  CHECK_THROWS_WITH(layer(0.5, Eigen::Vector3i(2, 3, 4), 23), Contains("state count does not match its dims"));
+  CHECK_THROWS_WITH(layer(0.5, Eigen::Vector3i(2, 3, 4), 25), Contains("state count does not match its dims"));
+  CHECK_THROWS_WITH(layer(0.5, Eigen::Vector3i(2, 3, 4), 24, 3), Contains("a state byte is not free, occupied or unknown"));
+  CHECK_NOTHROW(layer(0.5, Eigen::Vector3i(2, 3, 4), 24, static_cast<std::uint8_t>(VoxelState::kUnknown)));
+  CHECK_THROWS_WITH(layer(0.5, Eigen::Vector3i(2, 3, 4), 24, 0, Eigen::Vector3i(0, std::numeric_limits<int>::max() - 2, 0)),
+                    Contains("along axis 1 leaves the range of cell indices"));
 }

@@ -1,6 +1,8 @@
 #include <catch2/catch.hpp>
 
+#include <cstring>
 #include <filesystem>
+#include <limits>
 
 #include <fstream>
 #include <functional>
@@ -296,4 +298,44 @@ TEST_CASE("Malformed OctoMap files are refused naming the fault, never crash", "
     }
   }
   CHECK(refused > 0);
+}
+
+TEST_CASE("A full tree (.ot) of another tree type or with a non-finite log-odds is refused naming it; a map outside OctoMap's keys is not written",
+          "[REQ-WORLD-014][REQ-WORLD-003]") {
+  octomap::OcTree tree(0.1);
+  fill_tree(tree, 3);
+  const std::string path = miner::world::test::temp_path("full.ot");
+  REQUIRE(tree.write(path));
+  const std::string good = slurp(path);
+  REQUIRE_NOTHROW(Map::load(path));
+  const std::size_t data = good.find("data\n") + 5;
+  REQUIRE(data > 5);
+  const auto load_bytes = [&](const std::string& bytes, const std::string& name) {
+    const std::string p = miner::world::test::temp_path(name);
+    std::ofstream(p, std::ios::binary | std::ios::trunc) << bytes;
+    return Map::load(p);
+  };
+  // OctoMap's other full-tree types (stamped, counting) carry other node layouts.
+  for (const char* id : {"OcTreeStamped", "CountingOcTree"}) {
+    std::string other = good;
+    other.replace(other.find("id OcTree\n"), 10, std::string("id ") + id + "\n");
+    CHECK_THROWS_WITH(load_bytes(other, "other.ot"), Contains("other.ot") && Contains(std::string("tree id \"") + id + "\" is not one MINER reads"));
+  }
+  // The root's log-odds (the first 4 bytes of the data) NaN, then a leaf's +inf.
+  std::string nan_root = good;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  std::memcpy(&nan_root[data], &nan, sizeof nan);
+  CHECK_THROWS_WITH(load_bytes(nan_root, "nan.ot"), Contains("nan.ot") && Contains("node 1 has a non-finite log-odds value"));
+  std::string inf_node = good;
+  const float inf = std::numeric_limits<float>::infinity();
+  std::memcpy(&inf_node[data + 5], &inf, sizeof inf);  // the root's first child: 4 bytes + its child mask further on
+  CHECK_THROWS_WITH(load_bytes(inf_node, "inf.ot"), Contains("inf.ot") && Contains("has a non-finite log-odds value"));
+  // Writing: OctoMap keys reach 32768 voxels either side of the origin.
+  const VoxelLayer far(Eigen::Vector3i(-40000, 0, 0), 0.1, Eigen::Vector3i(2, 2, 2), std::vector<std::uint8_t>(8, 0));
+  const std::string out = miner::world::test::temp_path("far.bt");
+  CHECK_THROWS_WITH(miner::world::write_octree_bt(far, out), Contains("far.bt: the map lies outside OctoMap's key range"));
+  CHECK_FALSE(std::filesystem::exists(out));
+  const VoxelLayer unknown(Eigen::Vector3i::Zero(), 0.1, Eigen::Vector3i(2, 2, 2),
+                           std::vector<std::uint8_t>(8, static_cast<std::uint8_t>(VoxelState::kUnknown)));
+  CHECK_THROWS_WITH(miner::world::write_octree_bt(unknown, out), Contains("the map has no known voxel to write"));
 }

@@ -373,6 +373,14 @@ TEST_CASE("A dataset folder that contradicts itself is refused naming the file a
       },
       "train-00000.bin: its SHA-256 differs");
   CHECK_THROWS_WITH(heuristic::read_split(altered, "train"), Contains("SHA-256"));
+  // Two parts naming the same shard file (part 1's own bytes under part 0's name): the merged
+  // folder could hold only one of them.
+  refused(
+      [&](const std::string&, const std::string& q1) {
+        fs::rename(q1 + "/train-00001.bin", q1 + "/train-00000.bin");
+        edit_json(q1 + "/dataset.json", [](miner::Json& d) { d["splits"]["train"]["shards"][0]["file"] = "train-00000.bin"; });
+      },
+      "/dataset.json: splits.train.shards[0].file: \"train-00000.bin\" is named by another part or split too");
   // A misspelt key is not ignored.
   refused(
       [&](const std::string& q0, const std::string&) {

@@ -310,6 +310,20 @@ TEST_CASE("The network reading P (fixtures/sgan/passability) agrees with PyTorch
   for (std::size_t v = 0; v < n; ++v) moved = std::max(moved, static_cast<double>(std::fabs(as_given[v] - all_blocked[v])));
   CHECK(moved > 1e-3);
   CHECK_THROWS_WITH(g.forward(env, state, noise, scale), Contains("the network reads P"));
+  // Every input is the weights' grid: one cell short or long is named with the count.
+  std::vector<float> short_env(env.begin(), env.end() - 1), long_noise = noise;
+  long_noise.push_back(0.0F);
+  CHECK_THROWS_WITH(g.forward(short_env, state, noise, scale, blocked), Contains("sgan: inputs must have " + std::to_string(n) + " cells each"));
+  CHECK_THROWS_WITH(g.forward(env, state, long_noise, scale, blocked), Contains("sgan: inputs must have " + std::to_string(n) + " cells each"));
+  miner::Rng rng(3);
+  const miner::world::Box bounds{Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(8.0)};
+  const std::vector<std::uint8_t> e8(n, 0), s8(n, 0), p8(n, 0);
+  CHECK_NOTHROW(g.predict(e8, s8, p8, bounds, 0.3, rng));
+  CHECK_THROWS_WITH(g.predict(e8, std::vector<std::uint8_t>(n + 1, 0), p8, bounds, 0.3, rng),
+                    Contains("sgan: E and S must have " + std::to_string(n) + " cells each"));
+  CHECK_THROWS_WITH(g.predict(e8, s8, std::vector<std::uint8_t>(n - 1, 0), bounds, 0.3, rng),
+                    Contains("sgan: the network reads P: " + std::to_string(n) + " cells, given " + std::to_string(n - 1)));
+  CHECK_THROWS_WITH(g.predict(e8, s8, {}, bounds, 0.3, rng), Contains("the network reads P"));
   for (const char* f : {"sim", "indoor", "cluttered", "rooms", "forest", "multilevel", "scan"})
     CHECK(heuristic::Sgan::load(dir + "lofo/without-" + f + ".bin").architecture().passability_channels == 3);
 }

@@ -1,5 +1,7 @@
 #include <catch2/catch.hpp>
 
+#include <sys/stat.h>
+
 #include <filesystem>
 #include <functional>
 #include <limits>
@@ -224,6 +226,28 @@ TEST_CASE("Files written as one: a failure on any leaves every existing file as 
   miner::write_files_atomic({{a, "new a\n"}, {(dir / "c.json").string(), "c\n"}});
   CHECK(read_all(a) == "new a\n");
   CHECK(read_all((dir / "c.json").string()) == "c\n");
+}
+
+TEST_CASE("Atomic write refuses a FIFO in the file's place and writes through a symbolic link", "[REQ-CORE-004]") {
+  const auto dir = temp_dir("atomic_special");
+  const std::string fifo = (dir / "pipe.json").string();
+  REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
+  // A rename would replace the FIFO with a plain file (issue 20: /dev/null as root).
+  CHECK_THROWS_WITH(miner::write_file_atomic(fifo, "x\n"), Contains("pipe.json: exists and is not a regular file"));
+  CHECK(std::filesystem::is_fifo(fifo));
+  // A link to a FIFO is refused the same way; a link to a file replaces the file, the link kept.
+  const std::string to_fifo = (dir / "to-pipe.json").string(), target = (dir / "target.json").string(),
+                    link = (dir / "link.json").string();
+  std::filesystem::create_symlink(fifo, to_fifo);
+  CHECK_THROWS_WITH(miner::write_file_atomic(to_fifo, "x\n"), Contains("exists and is not a regular file"));
+  miner::write_file_atomic(target, "old\n");
+  std::filesystem::create_symlink(target, link);
+  miner::write_file_atomic(link, "new\n");
+  CHECK(std::filesystem::is_symlink(link));
+  CHECK(read_all(target) == "new\n");
+  std::size_t entries = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++entries;
+  CHECK(entries == 4);  // the FIFO, two links and the target: no temporary left
 }
 
 TEST_CASE("A folder write replaces only an earlier output of the same kind", "[REQ-CORE-004]") {

@@ -38,15 +38,6 @@ bool read_finite_decimal(const std::string& text, double& v) {
 }
 }  // namespace
 
-const CLI::Validator kFiniteNonNegative(
-    [](std::string& text) -> std::string {
-      double v = 0.0;
-      if (!read_finite_decimal(text, v) || v < 0.0) {
-        return "must be a finite decimal number >= 0, got " + text;
-      }
-      return {};
-    },
-    "NONNEGATIVE");
 
 const CLI::Validator kUnsigned64(
     [](std::string& text) -> std::string {

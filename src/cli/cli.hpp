@@ -86,9 +86,8 @@ void add_output_options(CLI::App* cmd, OutputOptions& o);
 /// Writes `doc` to o.out if set, then prints `doc` (with --json) or `human`.
 void emit(const OutputOptions& o, const Json& doc, const std::string& human, std::ostream& out);
 
-/// CLI11 validators: a finite number; a finite number >= 0.
+/// CLI11 validator: a finite number.
 extern const CLI::Validator kFinite;
-extern const CLI::Validator kFiniteNonNegative;
 /// An unsigned 64-bit integer written as decimal digits only: "-1" is refused (CLI11 would
 /// wrap it to 2^64 - 1) and so is anything above 2^64 - 1 (never clamped). REQ-CLI-002.
 extern const CLI::Validator kUnsigned64;

@@ -303,7 +303,15 @@ TEST_CASE("Options a run would not read, clamped values and mismatched suffixes 
   const std::string two_tests = dir() + "/two-tests";
   REQUIRE(miner_cli({"dataset", "--preset", "indoor", "--count", "1", "--test-count", "2", "--quiet", "--out", two_tests})
               .code == 0);
+  // The default scenario under another name (its files made absolute): the same flight.
+  const std::string scenarios = std::string(MINER_SOURCE_DIR) + "/fixtures/scenarios";
+  miner::Json renamed_doc = miner::pipeline::self_contained_scenario(miner::read_json_file(scenarios + "/default.json"), scenarios);
+  renamed_doc["name"] = "renamed";
+  const std::string renamed = write("renamed-4th.json", renamed_doc.dump());
   const std::vector<Refusal> cases = {
+      {{"bench", "paper", "--maps", std::string(MINER_SOURCE_DIR) + "/fixtures/maps/sim-1.json", "--scenarios",
+        scenarios + "/default.json", renamed, "--out", dir() + "/p4.md"}, 1,
+       "--scenarios: " + renamed + " is the same scenario as " + scenarios + "/default.json: each is run once"},
       {{"astar", "--map", map, "--unknown", "free"}, 2, "--unknown: " + map + " is a map of boxes, with no voxels"},
       {{"map", "info", "--map", map, "--unknown", "occupied"}, 2, "no unknown space"},
       {{"plan", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5", "--planner", "rrtstar", "--tree"}, 2,

@@ -302,3 +302,36 @@ def test_ctrl_c_stops_a_long_flight():
     interrupted = cpu() - t0
     timer.join()
     assert interrupted < whole, (interrupted, whole)
+
+
+def test_generated_maps_saved_regions_target_iterations_and_value_types(tmp_path):
+    # Map.generate is seeded: the same preset and seed give the same document, another seed another.
+    a = miner.Map.generate("indoor", 3)
+    assert a.to_json() == miner.Map.generate("indoor", 3).to_json()
+    assert a.to_json() != miner.Map.generate("indoor", 4).to_json()
+    with pytest.raises(miner.Error, match="preset"):
+        miner.Map.generate("nowhere", 1)
+    # A region written as JSON reads back with the same grid and cells.
+    m = miner.Map.from_json(WALL)
+    r = miner.astar_region(m, dims=[8, 8, 4])
+    r.save(tmp_path / "r.json")
+    back = miner.Region.load(str(tmp_path / "r.json"))
+    assert list(back.dims) == [8, 8, 4] and back.cell_count == r.cell_count and back.source == r.source
+    # target_iteration: None without a target; with one any path meets, the first solution's iteration.
+    plain = miner.plan(m, planner="rrtstar", iterations=3000, seed=2)
+    assert plain.solved and plain.target_iteration is None
+    met = miner.plan(m, planner="rrtstar", iterations=3000, seed=2, target_cost=1e6)
+    assert met.target_iteration == met.first_iteration == plain.first_iteration
+    # What a value must be, named: a number (not a str, not beyond a double), a path, finite points.
+    with pytest.raises(miner.Error, match="radius: expected a number, got str"):
+        miner.plan(m, planner="rrtstar", radius="0.1")
+    with pytest.raises(miner.Error, match="radius: 1" + "0" * 400 + " is beyond the largest double"):
+        miner.plan(m, planner="rrtstar", radius=10**400)
+    with pytest.raises(miner.Error, match="path: expected a path"):
+        miner.Map.load(3)
+    with pytest.raises(miner.Error, match=r"points\[1\]: must be finite, got nan"):
+        miner.minco([[0, 0, 0], [np.nan, 0, 0], [1, 1, 1]])
+    with pytest.raises(miner.Error, match=r"points: expected an array of numbers, got list of dtype <U"):
+        miner.minco([["a", "b", "c"], [1, 1, 1]])
+    with pytest.raises(miner.Error, match=r"points: expected an array of numbers, got list$"):  # ragged rows
+        miner.minco([[0, 0, 0], [1, 1]])

@@ -413,6 +413,12 @@ TEST_CASE("A missing, truncated, altered or mismatched weights file is refused n
   huge[8] = '\xff', huge[9] = '\xff', huge[10] = '\xff', huge[11] = '\x7f';
   CHECK_THROWS_WITH(heuristic::parse_tensor_file(huge, "huge.bin", "k"),
                     Contains("huge.bin: the header declares 2147483647 bytes, more than the"));
+  // A header whose bytes are not JSON (its first brace overwritten), or JSON but not an object.
+  std::string garbled = wrong;
+  REQUIRE(garbled[12] == '{');
+  garbled[12] = '#';
+  CHECK_THROWS_WITH(heuristic::parse_tensor_file(garbled, "garbled.bin", "k"), Contains("garbled.bin: the header is not valid JSON"));
+  CHECK_THROWS_WITH(heuristic::parse_tensor_file(wrong.substr(0, 11), "short.bin", "k"), Contains("short.bin: not a miner-tensors-v1 file"));
   // A tensor that runs past the data, and a count that disagrees with the shape.
   tensors[0]["count"] = 700;
   CHECK_THROWS_WITH(heuristic::parse_tensor_file(tensor_blob({{"kind", "k"}, {"tensors", tensors}}, std::vector<float>(648)),

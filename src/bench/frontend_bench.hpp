@@ -49,6 +49,21 @@ struct FrontendBenchOptions {
   int shard_count = 1;
 };
 
+/// The front-end options a campaign of campaigns (`bench paper`, `bench suite`) runs each map
+/// with: its planners, runs, seed, limits and weights; no throughput check (it is Table I's).
+template <class CampaignOptions>
+FrontendBenchOptions frontend_options_of(const CampaignOptions& o) {
+  FrontendBenchOptions fo;
+  fo.planners = o.planners;
+  fo.runs = o.runs;
+  fo.seed = o.seed;
+  fo.time_limit_s = o.time_limit_s;
+  fo.max_iterations = o.max_iterations;
+  fo.weights_file = o.weights;
+  fo.throughput_iterations = 0;
+  return fo;
+}
+
 /// MINER with the filtered sGAN region computed per run, its time included in every
 /// figure (the end-to-end front end); "miner" itself uses the A*-dilated oracle region.
 inline constexpr const char* kMinerSgan = "miner-sgan";

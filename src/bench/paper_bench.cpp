@@ -230,14 +230,7 @@ PaperBenchResult run_paper_bench(const PaperBenchOptions& o, const std::string& 
   // Table I and the box plots.
   for (std::size_t i = 0; i < maps.size(); ++i) {
     if (progress) *progress << "front end on " << o.maps[i] << "\n";
-    FrontendBenchOptions fo;
-    fo.planners = o.planners;
-    fo.runs = o.runs;
-    fo.seed = o.seed;
-    fo.time_limit_s = o.time_limit_s;
-    fo.max_iterations = o.max_iterations;
-    fo.weights_file = o.weights;
-    fo.throughput_iterations = 0;
+    const FrontendBenchOptions fo = frontend_options_of(o);
     const auto& q = *maps[i].query();
     out.grid_resolution.push_back(maps[i].resolution());
     out.frontend.push_back(

@@ -338,14 +338,7 @@ SuiteBenchResult run_suite_bench(const SuiteBenchOptions& o, const std::string& 
     const double diagonal = map.bounds().extent().norm();
     for (const double fraction : o.suite.step_fractions) {
       if (progress) *progress << "suite: " << o.suite.maps[i].name << ", eta = " << fraction << " x diagonal\n";
-      FrontendBenchOptions fo;
-      fo.planners = o.planners;
-      fo.runs = o.runs;
-      fo.seed = o.seed;
-      fo.time_limit_s = o.time_limit_s;
-      fo.max_iterations = o.max_iterations;
-      fo.weights_file = o.weights;
-      fo.throughput_iterations = 0;
+      FrontendBenchOptions fo = frontend_options_of(o);
       fo.planner_options.steer_step = fraction * diagonal;
       SuiteCell cell;
       cell.map = o.suite.maps[i].name;

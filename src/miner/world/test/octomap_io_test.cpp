@@ -300,7 +300,7 @@ TEST_CASE("Malformed OctoMap files are refused naming the fault, never crash", "
   CHECK(refused > 0);
 }
 
-TEST_CASE("A full tree (.ot) of another tree type or with a non-finite log-odds is refused naming it; a map outside OctoMap's keys is not written",
+TEST_CASE("A full tree (.ot) of another tree type or with a non-finite log-odds is refused naming it and a map outside OctoMap's keys is not written",
           "[REQ-WORLD-014][REQ-WORLD-003]") {
   octomap::OcTree tree(0.1);
   fill_tree(tree, 3);

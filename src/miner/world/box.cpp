@@ -82,6 +82,11 @@ double squared_distance(const Eigen::Vector3d& a, const Eigen::Vector3d& b, cons
     if (den > 0.0) {
       const double s = -num / den;
       if (s > lo && s < hi) best = std::min(best, f(s));
+    } else {
+      // Every axis inside its slab: the piece runs through the box, distance 0 at its middle.
+      // Its ends lie on faces up to rounding and may measure 1e-32 outside (twelfth campaign L4:
+      // at radius 0 a segment through a box was "free" one way and not the other).
+      best = std::min(best, f(0.5 * (lo + hi)));
     }
   }
   return best;

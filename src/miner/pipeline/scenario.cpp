@@ -51,10 +51,6 @@ int ticks_per(const JsonField& where, double loop_rate, double rate, const char*
   return static_cast<int>(rounded);
 }
 
-/// Everything of a scenario document but its format and map (s.map is set): every field's
-/// range and the cross-checks. scenario_from_json reads files with it, and check_scenario
-/// checks a struct by writing it back as a document, so one set of rules holds both.
-/// `trajectory_given`: the route is a trajectory already in s (a file's, or a struct's).
 /// The scenario's speed limit, kSpeedLimitHeadroom v_max, reaches the controller (the velocity
 /// its feedback may ask for, REQ-FLIGHT-016; only when no cap was set, i.e. it is infinite) and
 /// the N3's VELOCITY mode (its failsafe brake): what the reader does to a file's scenario and
@@ -66,6 +62,10 @@ void apply_speed_limit(flight::FlightSetup& f, const traj::Limits& limits) {
   f.n3.max_vertical_speed = std::min(f.n3.max_vertical_speed, speed_limit);
 }
 
+/// Everything of a scenario document but its format and map (s.map is set): every field's
+/// range and the cross-checks. scenario_from_json reads files with it, and check_scenario
+/// checks a struct by writing it back as a document, so one set of rules holds both.
+/// `trajectory_given`: the route is a trajectory already in s (a file's, or a struct's).
 void read_scenario_fields(const JsonField& root, const std::string& origin, const std::string& base_dir,
                           bool trajectory_given, Scenario& s) {
   if (root.has("name")) {
@@ -325,7 +325,6 @@ Scenario scenario_from_json(const Json& doc, const std::string& origin, const st
   read_scenario_fields(root, origin, base_dir, false, s);
   return s;
 }
-
 
 Json scenario_document(const Scenario& s) {
   Json d{{"format", kScenarioFormat},

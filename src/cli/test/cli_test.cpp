@@ -2095,3 +2095,51 @@ TEST_CASE("Eighth campaign: control bytes never reach stdout raw and a scan's fa
   CHECK(scan.code == 3);
   CHECK_THAT(scan.err, Contains("preset \"scan\", seed 1: its base map \"sim\" has no solvable draw"));
 }
+
+TEST_CASE("Each option reaches what it names and its default is the documented value", "[REQ-CLI-004][REQ-PLAN-004][REQ-PLAN-005][REQ-HEUR-001][REQ-HEUR-008]") {
+  // The tenth held-out audit's survivors in the CLI layer: --mu2 set mu_1, plan --json wrote
+  // the start as the goal, --radius 0 took the query's radius, the default --dilation and
+  // heuristic --seed changed, dataset --dims took x for y, dataset --json counted val as test.
+  const std::string map = std::string(MINER_SOURCE_DIR) + "/fixtures/maps/indoor-1.json";
+  const std::vector<std::string> plan{"plan", "--map", map, "--planner", "miner", "--iterations", "1500", "--json"};
+  const auto with = [&](std::vector<std::string> extra) {
+    std::vector<std::string> args = plan;
+    args.insert(args.end(), extra.begin(), extra.end());
+    const Run r = miner_cli(args);
+    INFO(r.err);
+    REQUIRE(r.code == 0);
+    return miner::parse_json(r.out, "stdout");
+  };
+  const miner::Json plain = with({});
+  // A default given explicitly is the same run; another value is another run.
+  CHECK(with({"--mu1", "0.5"}) == plain);
+  CHECK(with({"--mu2", "0.9"}) == plain);
+  CHECK(with({"--mu1", "0.5", "--mu2", "0.3"})["path"] != plain["path"]);
+  CHECK(with({"--mu1", "0.5", "--mu2", "0.3"}) == with({"--mu2", "0.3"}));
+  // Start and goal as the query gives them, and an explicit radius 0 is 0, not the query's 0.2.
+  const miner::Json query = miner::read_json_file(map)["query"];
+  CHECK(plain["start"] == query["start"]);
+  CHECK(plain["goal"] == query["goal"]);
+  CHECK(plain["robot_radius"] == query["robot_radius"]);
+  CHECK(with({"--radius", "0"})["robot_radius"] == 0.0);
+  // region astar's default dilation is 1, heuristic's default seed is 1: the same bytes.
+  const std::string d0 = dir() + "/dil-default.json", d1 = dir() + "/dil-1.json";
+  REQUIRE(miner_cli({"region", "astar", "--map", map, "--out", d0}).code == 0);
+  REQUIRE(miner_cli({"region", "astar", "--map", map, "--dilation", "1", "--out", d1}).code == 0);
+  CHECK(read(d0) == read(d1));
+  const std::string h0 = dir() + "/seed-default.json", h1 = dir() + "/seed-1.json";
+  REQUIRE(miner_cli({"heuristic", "--map", map, "--out", h0}).code == 0);
+  REQUIRE(miner_cli({"heuristic", "--map", map, "--seed", "1", "--out", h1}).code == 0);
+  CHECK(read(h0) == read(h1));
+  // dataset: the grid as given on every axis, and train / val / test counted each on its own.
+  const std::string data = dir() + "/dims-counts";
+  const Run ds = miner_cli({"dataset", "--preset", "indoor", "--count", "5", "--val-fraction", "0.4", "--test-count", "3",
+                            "--dims", "16", "8", "4", "--out", data, "--json", "--quiet"});
+  INFO(ds.err);
+  REQUIRE(ds.code == 0);
+  const miner::Json summary = miner::parse_json(ds.out, "stdout");
+  CHECK(summary["train"] == 3);
+  CHECK(summary["val"] == 2);
+  CHECK(summary["test"] == 3);
+  CHECK(miner::read_json_file(data + "/dataset.json")["dims"] == miner::Json{16, 8, 4});
+}

@@ -2,6 +2,9 @@
 #include <CLI/CLI.hpp>
 
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
 #include <cstdlib>
 #include <filesystem>
 #include <functional>
@@ -16,6 +19,7 @@
 #include "bench/ompl_planners.hpp"
 #include "cli/cli.hpp"
 #include "miner/core/json_io.hpp"
+#include "miner/core/sha256.hpp"
 #include "miner/heuristic/sgan.hpp"
 #include "miner/pipeline/scenario.hpp"
 #include "miner/plan/heuristic_region.hpp"
@@ -1702,6 +1706,42 @@ TEST_CASE("miner sgan check compares C++ inference with PyTorch's reference tens
   const Run bad = miner_cli({"sgan", "check", "--reference", dir() + "/missing.bin"});
   CHECK(bad.code == 1);
   CHECK_THAT(bad.err, Contains("missing.bin"));
+  // One sample's output moved by 0.05, the other left agreeing (checksum redone): the check
+  // judges the worst sample (tenth held-out set h10-heuristic-02: the best one passed every test).
+  const std::string bytes = read(ref);
+  const std::uint32_t header_length = static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[8])) |
+                                      static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[9])) << 8 |
+                                      static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[10])) << 16 |
+                                      static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[11])) << 24;
+  const std::size_t data = 12 + header_length;
+  const miner::Json header = miner::parse_json(bytes.substr(12, header_length), "header");
+  for (const std::string& sample : std::vector<std::string>{"0", "1"}) {
+    INFO("sample " << sample << " moved");
+    std::size_t offset = 0;
+    for (const auto& t : header["tensors"])
+      if (t["name"] == sample + ".output") offset = t["offset"].get<std::size_t>();
+    REQUIRE(offset > 0);
+    std::string moved = bytes;
+    float x = 0.0F;
+    std::memcpy(&x, moved.data() + data + offset, sizeof x);
+    x += 0.05F;
+    std::memcpy(moved.data() + data + offset, &x, sizeof x);
+    char hex[17];
+    std::snprintf(hex, sizeof hex, "%016llx",
+                  static_cast<unsigned long long>(miner::fnv1a64(moved.data() + data, moved.size() - data)));
+    const std::size_t at = moved.find(header["data_fnv1a64"].get<std::string>());
+    REQUIRE(at < data);
+    moved.replace(at, 16, hex);
+    const Run one = miner_cli({"sgan", "check", "--reference", write("one-off-" + sample + ".bin", moved), "--json"});
+    CHECK(one.code == 1);
+    CHECK_THAT(one.err, Contains("disagree by 0.05"));
+    const miner::Json answer = miner::parse_json(one.out, "stdout");
+    CHECK(answer["agrees"] == false);
+    REQUIRE(answer["max_abs_error"].size() == 2);
+    const std::size_t k = sample == "0" ? 0 : 1;
+    CHECK(answer["max_abs_error"][k].get<double>() == Approx(0.05).margin(1e-3));
+    CHECK(answer["max_abs_error"][1 - k].get<double>() <= miner::heuristic::kReferenceTolerance);
+  }
 }
 
 TEST_CASE("miner heuristic --strict-bridge adds filter step 5 and reports its checked polyline", "[REQ-HEUR-014]") {

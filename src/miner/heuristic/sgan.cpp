@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <mutex>
 #include <utility>
 
 #include <omp.h>
@@ -233,6 +234,10 @@ constexpr std::size_t kFirstDecoder = 6;  // dec3, dec2, dec1 read an up-sampled
 }  // namespace
 
 struct Sgan::Impl {
+  /// Held by forward() while it fills the shared buffers below: calls on one Sgan from several
+  /// threads run one at a time (twelfth campaign L6: two threads on one const Sgan gave 7 of
+  /// 16 regions wrong, silently).
+  std::mutex busy;
   std::string path;
   Json meta;
   SganArchitecture arch;
@@ -665,6 +670,7 @@ std::vector<float> Sgan::forward(const std::vector<float>& env, const std::vecto
                                  const std::vector<float>& noise, const std::vector<float>& scale,
                                  const std::vector<float>& passability) const {
   Impl& g = live();
+  const std::lock_guard<std::mutex> one_query(g.busy);
   const std::size_t n = g.cond1.voxels();
   if (env.size() != n || state.size() != n || noise.size() != n)
     throw Error("sgan: inputs must have " + std::to_string(n) + " cells each (the weights' grid)");
@@ -785,6 +791,7 @@ std::vector<float> Sgan::predict(const std::vector<std::uint8_t>& environment, c
                                  const std::vector<std::uint8_t>& passability, const world::Box& bounds,
                                  double robot_radius, Rng& rng) const {
   Impl& g = live();
+  const std::lock_guard<std::mutex> one_query(g.busy);
   const std::size_t n = g.cond1.voxels();
   if (environment.size() != n || state.size() != n)
     throw Error("sgan: E and S must have " + std::to_string(n) + " cells each (the weights' grid)");

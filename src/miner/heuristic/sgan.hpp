@@ -87,8 +87,9 @@ class Sgan {
   /// Whether MINER's own kernels run enc1 and dec1 (see Kernels).
   bool own_kernels() const;
 
-  /// R = G(N | E, S[, B]) on the grid. One query at a time per object (the buffers are
-  /// reused). Inputs of dims.prod() floats each (x fastest): the environment already scaled,
+  /// R = G(N | E, S[, B]) on the grid. Safe from several threads: the object's buffers are
+  /// reused, so concurrent calls on one Sgan run one at a time (a mutex); for parallel
+  /// inference give each thread its own Sgan. Inputs of dims.prod() floats each (x fastest): the environment already scaled,
   /// the state, the noise; dims.prod() probabilities out.
   /// `scale` is sigma (ignored, and may be empty, when the network has no scale channels);
   /// `passability` the network's P input, the blocked bits 1 - P_a for a = x, y, z as 0/1,

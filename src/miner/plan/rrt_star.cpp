@@ -405,6 +405,11 @@ std::vector<PlannerKind> all_planners() {
 
 void validate(const PlanningProblem& p) {
   if (p.map == nullptr) throw Error("plan: the problem has no map");
+  // Twelfth campaign L5: a map moved into a container left an empty map behind (its bounds,
+  // no obstacles), and the problem planned on it straight through a box.
+  if (p.map->fingerprint() == 0) throw Error("plan: the problem's map was moved from (it has no obstacles left)");
+  if (p.map_fingerprint != 0 && p.map_fingerprint != p.map->fingerprint())
+    throw Error("plan: the problem's map changed since PlanningProblem::make (another map was assigned to it)");
   require_finite(p.start, "start");
   require_finite(p.goal, "goal");
   // The map format's range (REQ-WORLD-002): a radius above it is no quadrotor (issue 20,
@@ -426,6 +431,7 @@ PlanningProblem PlanningProblem::make(const world::Map& map, const Eigen::Vector
   p.goal = goal;
   p.robot_radius = robot_radius;
   p.sampled_volume = map.bounds().volume();
+  p.map_fingerprint = map.fingerprint();
   validate(p);
   return p;
 }

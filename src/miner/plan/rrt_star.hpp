@@ -115,9 +115,13 @@ struct PlanningProblem {
   /// M(X) of the rewiring radius: the volume of the map's bounds, the set every planner
   /// samples (REQ-PLAN-021).
   double sampled_volume = 0.0;
+  /// map->fingerprint() when make() built the problem (0 for one filled by hand): plan()
+  /// refuses a map that has since been moved from or assigned another map.
+  std::uint64_t map_fingerprint = 0;
 
   /// Throws miner::Error naming the fault (start/goal out of bounds or in collision). The
-  /// problem refers to `map`, which the caller keeps alive while the problem is used.
+  /// problem refers to `map`, which the caller keeps alive and unchanged while the problem is
+  /// used.
   static PlanningProblem make(const world::Map& map, const Eigen::Vector3d& start,
                               const Eigen::Vector3d& goal, double robot_radius);
   /// A temporary map would dangle: `make(Map::load(path), ...)` does not compile.

@@ -45,6 +45,22 @@ PolynomialTrajectory::PolynomialTrajectory(int order, std::vector<double> durati
   }
 }
 
+void PolynomialTrajectory::set_order(int order) {
+  check_order(order, "trajectory");
+  order_ = order;
+}
+
+void PolynomialTrajectory::check_consistent(const std::string& who) const {
+  check_order(order_, who);
+  for (std::size_t i = 0; i < durations_.size(); ++i)
+    if (!(std::isfinite(durations_[i]) && durations_[i] > 0.0))
+      throw Error(who + ": durations[" + std::to_string(i) + "] must be a positive finite time in s, got " + short_number(durations_[i]));
+  if (coefficients_.rows() != 2 * order_ * static_cast<Eigen::Index>(durations_.size()))
+    throw Error(who + ": the trajectory has " + std::to_string(durations_.size()) + " durations and " +
+                std::to_string(coefficients_.rows()) + " coefficient rows, not 2s = " + std::to_string(2 * order_) +
+                " per duration (changed through its mutable accessors)");
+}
+
 double PolynomialTrajectory::total_duration() const {
   return std::accumulate(durations_.begin(), durations_.end(), 0.0);
 }
@@ -86,6 +102,11 @@ Eigen::Vector3d PolynomialTrajectory::evaluate(double t, int k) const {
   const int last = segments() - 1;
   t = std::max(0.0, t);
   while (i < last && t >= durations_[i]) t -= durations_[i++];
+  // The walk trusts the durations it passed and the one it stops in (L7: a negative or NaN
+  // duration set through mutable_durations() was evaluated).
+  for (int j = 0; j <= i; ++j)
+    if (!(durations_[j] > 0.0 && std::isfinite(durations_[j])))
+      throw Error("trajectory: durations[" + std::to_string(j) + "] must be a positive finite time in s, got " + short_number(durations_[j]));
   return evaluate_segment(i, std::min(t, durations_[i]), k);
 }
 
@@ -105,6 +126,7 @@ Eigen::MatrixXd monomial_cost_matrix(int order, double duration) {
 }
 
 double PolynomialTrajectory::cost() const {
+  check_consistent("trajectory cost");
   double j = 0.0;
   for (int i = 0; i < segments(); ++i) {
     const auto c = segment_coefficients(i);
@@ -114,6 +136,7 @@ double PolynomialTrajectory::cost() const {
 }
 
 Eigen::MatrixX3d PolynomialTrajectory::cost_gradient_coefficients() const {
+  check_consistent("trajectory cost gradient");
   Eigen::MatrixX3d g(coefficients_.rows(), 3);
   for (int i = 0; i < segments(); ++i) {
     g.middleRows(2 * order_ * i, 2 * order_) =

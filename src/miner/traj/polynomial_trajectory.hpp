@@ -36,10 +36,18 @@ class PolynomialTrajectory {
   Eigen::Block<const Eigen::MatrixX3d, Eigen::Dynamic, 3> segment_coefficients(int i) const {
     return coefficients_.middleRows(2 * order_ * i, 2 * order_);
   }
+  /// For solvers refilling a trajectory in place (keeps the allocations). What they leave is
+  /// checked where it is read: cost(), cost_gradient_coefficients(), evaluate() and the peak
+  /// finders call check_consistent() (twelfth campaign L7: a duration pushed without its
+  /// coefficients made cost() read past the matrix, a negative one was evaluated).
   Eigen::MatrixX3d& mutable_coefficients() { return coefficients_; }
-  /// For solvers refilling a trajectory in place (keeps the allocations).
-  void set_order(int order) { order_ = order; }
+  /// Throws miner::Error for an order outside [1, kMaxCoefficientRows / 2].
+  void set_order(int order);
   std::vector<double>& mutable_durations() { return durations_; }
+  /// The constructor's checks on the object as it is now (durations positive and finite, 2s
+  /// coefficient rows per duration, the order in range; coefficients not rescanned for NaN):
+  /// throws miner::Error naming `who` and the fault.
+  void check_consistent(const std::string& who) const;
 
   /// The k-th derivative (k = 0 position ... 4 snap, any k >= 0) of segment i at local
   /// time tau (Horner's rule on the differentiated coefficients). Throws miner::Error for a

@@ -125,7 +125,6 @@ Json answer_to_json(const AllocationResult& a, const AllocationOptions& o) {
                      {"max_acceleration", a.max_acceleration},
                      {"v_max", o.limits.v_max},
                      {"a_max", o.limits.a_max},
-                     {"samples_per_segment", o.samples_per_segment},
                      {"iterations", a.iterations},
                      {"polish_evaluations", a.polish_evaluations},
                      {"termination", a.termination}};
@@ -154,7 +153,7 @@ PolynomialTrajectory trajectory_from_answer_json(const Json& doc, const std::str
   if (root.has("allocation"))
     root.at("allocation").only_keys({"method", "rho", "objective", "trapezoid_objective", "trapezoid_stretch", "cost",
                                      "total_time", "max_speed", "max_acceleration", "v_max", "a_max",
-                                     "samples_per_segment", "iterations", "polish_evaluations", "termination",
+                                     "iterations", "polish_evaluations", "termination",
                                      "solve_ms"});
   const JsonField order_field = root.at("order");
   const int order = order_field.integer();

@@ -40,7 +40,7 @@ TrajectoryRequest request_from_json(const Json& doc, const std::string& origin,
 
 Json answer_to_json(const PolynomialTrajectory& trajectory);
 /// The answer with an "allocation" block: method, rho, objective J + rho sum T, the
-/// trapezoid's (made feasible) and the stretch it needed, cost, total time, sampled peaks
+/// trapezoid's (made feasible) and the stretch it needed, cost, total time, exact peaks
 /// and limits, Ceres iterations and message, solve time.
 Json answer_to_json(const AllocationResult& result, const AllocationOptions& options);
 

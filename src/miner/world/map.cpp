@@ -186,7 +186,7 @@ void Map::compute_fingerprint() {
     h = fnv1a64(&r, sizeof r, h);
     h = fnv1a64(layer.states().data(), layer.states().size(), h);
   }
-  fingerprint_ = h;
+  fingerprint_.value = h == 0 ? 1 : h;  // 0 marks a moved-from map
 }
 
 Map Map::from_voxels(VoxelSource voxels) {

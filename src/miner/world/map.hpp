@@ -22,6 +22,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -140,7 +141,10 @@ class Map {
   /// resolution, obstacles, the voxels' states and the unknown-space policy. Two maps with the
   /// same fingerprint answer every query alike; a VoxelGrid keeps its map's, so A* refuses a grid
   /// built for another map (issue 20, tenth campaign L7).
-  std::uint64_t fingerprint() const { return fingerprint_; }
+  /// A moved-from Map's is 0, which no constructed map has: its obstacles went with the move,
+  /// so a PlanningProblem or grid still pointing at it can tell (twelfth campaign L5: a
+  /// problem planned straight through a box on a map moved into a vector).
+  std::uint64_t fingerprint() const { return fingerprint_.value; }
 
   bool in_bounds(const Eigen::Vector3d& p) const { return bounds_.contains(p); }
 
@@ -180,7 +184,20 @@ class Map {
   std::optional<Query> query_;
   std::optional<VoxelSource> source_;
   std::shared_ptr<const VoxelObstacles> voxels_;
-  std::uint64_t fingerprint_ = 0;
+  /// The digest, left 0 in the object a move (construction or assignment) takes it from.
+  struct MovedFingerprint {
+    std::uint64_t value = 0;
+    MovedFingerprint() = default;
+    MovedFingerprint(const MovedFingerprint&) = default;
+    MovedFingerprint& operator=(const MovedFingerprint&) = default;
+    MovedFingerprint(MovedFingerprint&& o) noexcept : value(std::exchange(o.value, 0)) {}
+    MovedFingerprint& operator=(MovedFingerprint&& o) noexcept {
+      value = std::exchange(o.value, 0);
+      return *this;
+    }
+    ~MovedFingerprint() = default;
+  };
+  MovedFingerprint fingerprint_;
   void compute_fingerprint();
 
   /// Broad phase: a uniform grid of buckets over the bounds, each listing the obstacles

@@ -643,11 +643,16 @@ TEST_CASE("A flight stops the first tick the vehicle is outside its world and sa
   CHECK(r.left_world_position.x() < kWallX + 5.0 * n3_dt);
   // Every earlier tick of the whole flight is the same (the world does not change the flight
   // before it is left), and nothing after it was simulated.
-  REQUIRE(!r.log.empty());
-  CHECK(r.log.back()[0] < r.left_world_time_s);
+  // The log's last row is the state where the vehicle left (C5: the log ends with the final
+  // state); the control-tick rows before it are the whole flight's.
+  REQUIRE(r.log.size() >= 2);
+  CHECK(r.log.back()[0] == r.left_world_time_s);
+  CHECK(r.log.back()[7] == r.left_world_position.x());
   CHECK(r.log.size() < whole.log.size());
-  for (std::size_t i = 0; i < r.log.size(); ++i) REQUIRE(r.log[i] == whole.log[i]);
-  const double true_x_at_stop = whole.log[r.log.size()][7];
+  const std::size_t before = r.log.size() - 1;
+  for (std::size_t i = 0; i < before; ++i) REQUIRE(r.log[i] == whole.log[i]);
+  CHECK(r.log[before - 1][0] < r.left_world_time_s);
+  const double true_x_at_stop = whole.log[before][7];
   CHECK(true_x_at_stop > kWallX - 1e-9);  // the first logged row at or after the stop is out
   CHECK(r.flight_time == Approx(r.left_world_time_s));
   CHECK(static_cast<double>(r.ticks) * n3_dt == Approx(r.left_world_time_s));
@@ -1106,4 +1111,26 @@ TEST_CASE("FlyOptions::poll is called every kPollTicks N3 ticks and a throw from
   };
   CHECK_THROWS_AS(pipeline::fly(s, r, interrupting), Interrupted);
   CHECK(before_throw == 2);
+}
+
+TEST_CASE("The flight log ends with the final state the summary judges", "[REQ-FLIGHT-009][REQ-REPORT-011]") {
+  // Twelfth campaign C5: the flight ended an N3 tick after the last 100 Hz row, so the summary's
+  // final_position_error and goal_reached came from a state the log did not hold.
+  const pipeline::Scenario s = pipeline::default_scenario();
+  const flight::FlightResult r = pipeline::fly(s, pipeline::build_reference(s));
+  const auto& columns = flight::flight_log_columns();
+  const auto column = [&](const char* name) {
+    const auto at = std::find(columns.begin(), columns.end(), name);
+    REQUIRE(at != columns.end());
+    return static_cast<std::size_t>(at - columns.begin());
+  };
+  REQUIRE(r.log.size() >= 2);
+  const std::vector<double>& final_row = r.log.back();
+  CHECK(final_row[column("t")] == r.flight_time);
+  const Eigen::Vector3d p(final_row[column("true_x")], final_row[column("true_y")], final_row[column("true_z")]);
+  const Eigen::Vector3d v(final_row[column("true_vx")], final_row[column("true_vy")], final_row[column("true_vz")]);
+  CHECK((p - s.goal).norm() == r.final_position_error);
+  CHECK(v.norm() == r.final_speed);
+  // The rows before it are the 100 Hz control ticks, in order.
+  for (std::size_t i = 1; i < r.log.size(); ++i) CHECK(r.log[i][0] > r.log[i - 1][0]);
 }

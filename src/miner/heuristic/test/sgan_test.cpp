@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <thread>
 
 #include <unistd.h>
 
@@ -343,6 +344,38 @@ TEST_CASE("The same inputs and seed give the same region bytes", "[REQ-HEUR-005]
   CHECK(a != c);  // the noise enters the network
   for (float v : a) REQUIRE((v >= 0.0f && v <= 1.0f));
   CHECK_THROWS_WITH(g.predict(std::vector<std::uint8_t>(10, 0), s, {}, bounds, 0.5, r1), Contains("cells"));
+}
+
+TEST_CASE("One const Sgan queried from two threads gives each query its sequential answer", "[REQ-HEUR-005][REQ-LIB-003]") {
+  // Twelfth campaign L6: two threads sharing one const Sgan overwrote each other's buffers and
+  // 7 of 16 regions came out wrong, without an error.
+  const heuristic::Sgan g = heuristic::Sgan::builtin();
+  const auto n = static_cast<std::size_t>(g.architecture().dims.prod());
+  std::vector<std::uint8_t> e(n, 0), s(n, 0);
+  for (std::size_t i = 0; i < n; i += 5) e[i] = static_cast<std::uint8_t>(i % 3);
+  s[11] = s[n - 4] = 1;
+  const miner::world::Box bounds{Eigen::Vector3d::Zero(), Eigen::Vector3d(60, 60, 20)};
+  const std::vector<std::uint8_t> p = passability_for(g, e, heuristic::kPassX);
+  constexpr int kQueries = 4;  // per thread, each with its own noise stream
+  std::vector<std::vector<float>> sequential(2 * kQueries), threaded(2 * kQueries);
+  for (int q = 0; q < 2 * kQueries; ++q) {
+    miner::Rng rng(9, static_cast<std::uint64_t>(q));
+    sequential[static_cast<std::size_t>(q)] = g.predict(e, s, p, bounds, 0.4, rng);
+  }
+  const auto worker = [&](int first) {
+    for (int q = first; q < 2 * kQueries; q += 2) {
+      miner::Rng rng(9, static_cast<std::uint64_t>(q));
+      threaded[static_cast<std::size_t>(q)] = g.predict(e, s, p, bounds, 0.4, rng);
+    }
+  };
+  std::thread other(worker, 1);
+  worker(0);
+  other.join();
+  for (int q = 0; q < 2 * kQueries; ++q) {
+    INFO("query " << q);
+    CHECK(threaded[static_cast<std::size_t>(q)] == sequential[static_cast<std::size_t>(q)]);
+  }
+  CHECK(sequential[0] != sequential[1]);  // the queries differ: a mix-up would show
 }
 
 TEST_CASE("The network is told its cells' metric size: sigma = log2(cell / radius) / divisor", "[REQ-HEUR-013]") {

@@ -448,6 +448,30 @@ TEST_CASE("A planning problem cannot be made from a temporary map", "[REQ-PLAN-0
   STATIC_REQUIRE_FALSE(can_make<miner::world::Map>::value);
 }
 
+TEST_CASE("A problem whose map was moved from or replaced is refused, never planned on", "[REQ-PLAN-008][REQ-LIB-003]") {
+  // Twelfth campaign L5: a map moved into a vector after make() left an empty map (its bounds,
+  // no obstacles) behind, and RRT* answered a straight line through the wall.
+  auto map = miner::testing::wall_with_door_map();
+  const auto problem = PlanningProblem::make(map, V(1, 1, 0.5), V(9, 1, 0.5), 0.1);
+  PlannerOptions o;
+  o.max_iterations = 200;
+  const auto intact = miner::plan::plan(problem, o);
+  std::vector<miner::world::Map> store;
+  store.push_back(std::move(map));
+  CHECK(map.fingerprint() == 0);  // NOLINT(bugprone-use-after-move): what the check reads
+  CHECK(store.front().fingerprint() == problem.map_fingerprint);
+  CHECK_THROWS_WITH(miner::plan::plan(problem, o), Contains("map was moved from"));
+  // Moved back, the same map plans as before; another map assigned in its place is refused.
+  map = std::move(store.front());
+  CHECK(miner::plan::plan(problem, o).path == intact.path);
+  map = miner::testing::closed_wall_map();
+  CHECK_THROWS_WITH(miner::plan::plan(problem, o), Contains("map changed since PlanningProblem::make"));
+  // A problem filled by hand (no fingerprint recorded) is planned on the map it points at.
+  PlanningProblem by_hand = problem;
+  by_hand.map_fingerprint = 0;
+  CHECK_NOTHROW(miner::plan::plan(by_hand, o));
+}
+
 TEST_CASE("Tenth campaign: plan() checks a problem however it was filled, and a region's path points first",
           "[REQ-LIB-003][REQ-PLAN-001][REQ-PLAN-005]") {
   const double nan = std::numeric_limits<double>::quiet_NaN();

@@ -74,19 +74,13 @@ TEST_CASE("Tenth campaign: the trajectory API refuses what would give NaN, garba
   Eigen::MatrixX3d c = Eigen::MatrixX3d::Zero(6, 3);
   c(2, 1) = nan;
   CHECK_THROWS_WITH(PolynomialTrajectory(3, {1.0}, c), Contains("coefficients must be finite"));
-  // L13: sample counts and steps are bounded and checked; the answer for a valid count stays.
-  CHECK_THROWS_WITH(sampled_extremes(t, 0), Contains("samples"));
-  CHECK_THROWS_WITH(sampled_extremes(t, -1), Contains("samples"));
-  CHECK_THROWS_WITH(sampled_extremes(t, std::numeric_limits<int>::max()), Contains("samples"));
-  const auto [v, a] = sampled_extremes(t, 32);
+  // L13: steps are bounded and checked; the exact peaks agree with a dense sampling.
+  const auto [v, a] = exact_extremes(t);
   const auto [v_dense, a_dense] = trajectory_extremes(t, 1e-3);
   CHECK(v == Approx(v_dense).epsilon(1e-4));
   CHECK(a == Approx(a_dense).epsilon(1e-4));
   for (const double step : {0.0, -1.0, nan, inf, 1e-300})
     CHECK_THROWS_WITH(trajectory_extremes(t, step), Contains("step"));
-  AllocationOptions too_many;
-  too_many.samples_per_segment = 100000000;
-  CHECK_THROWS_WITH(optimise_allocation(rest_to_rest(4, pts, {2.0, 2.0}), too_many), Contains("samples per segment"));
   // Recheck: INT_MAX Ceres iterations were bounded only by convergence.
   AllocationOptions endless;
   endless.max_iterations = kMaxAllocationIterations + 1;
@@ -166,4 +160,34 @@ TEST_CASE("The dense solvers take exactly kMaxDenseSegments segments and refuse 
   CHECK_NOTHROW(validate_dense(straight(kMaxDenseSegments - 1)));
   CHECK_THROWS_WITH(validate_dense(straight(kMaxDenseSegments + 1)),
                     Contains("durations: 501 segments, more than the 500 a dense solver takes"));
+}
+
+TEST_CASE("A trajectory changed through its mutable accessors is checked where it is read", "[REQ-TRAJ-004][REQ-LIB-003]") {
+  // Twelfth campaign L7: a duration pushed without its coefficients made cost() read past the
+  // matrix (NaN in Release, another number under ASan); a negative or NaN duration was
+  // evaluated as if it were a time.
+  Eigen::MatrixX3d pts(3, 3);
+  pts << 0, 0, 0, 1, 0, 0, 1, 1, 0;
+  const PolynomialTrajectory t = solve_minco(rest_to_rest(3, pts, {1.0, 1.0}));
+  auto longer = t;
+  longer.mutable_durations().push_back(1.0);
+  CHECK_THROWS_WITH(longer.cost(), Contains("trajectory cost: the trajectory has 3 durations and 12 coefficient rows"));
+  CHECK_THROWS_WITH(longer.cost_gradient_coefficients(), Contains("3 durations and 12 coefficient rows"));
+  CHECK_THROWS_WITH(exact_extremes(longer), Contains("exact_extremes: the trajectory has 3 durations"));
+  CHECK_THROWS_WITH(trajectory_extremes(longer, 0.01), Contains("trajectory_extremes: the trajectory has 3 durations"));
+  for (const double bad : {-1.0, 0.0, std::nan("")}) {
+    INFO("durations[0] = " << bad);
+    auto changed = t;
+    changed.mutable_durations()[0] = bad;
+    CHECK_THROWS_WITH(changed.evaluate(0.5), Contains("durations[0] must be a positive finite time"));
+    CHECK_THROWS_WITH(changed.cost(), Contains("durations[0]"));
+    CHECK_THROWS_WITH(exact_extremes(changed), Contains("durations[0]"));
+  }
+  auto reordered = t;
+  CHECK_THROWS_WITH(reordered.set_order(0), Contains("order must be in [1, 4], got 0"));
+  CHECK(reordered.order() == 3);
+  // Changed consistently, the object is a trajectory again: scale_time's edit is such a change.
+  auto slower = t;
+  scale_time(slower, 2.0);
+  CHECK(slower.cost() == Approx(t.cost() / 32.0));  // jerk: J scales as k^-(2s-1) = k^-5
 }

@@ -102,6 +102,7 @@ void isolate_roots(const PeakPolynomial& g, const PeakPolynomial& b, double lo, 
 
 std::pair<double, double> exact_extremes(const PolynomialTrajectory& t) {
   t.check_consistent("exact_extremes");
+  if (!t.coefficients().allFinite()) throw Error("exact_extremes: the trajectory's coefficients must be finite numbers");
   const int n = 2 * t.order();
   double v2 = 0.0, a2 = 0.0;
   std::vector<double> roots;
@@ -450,6 +451,7 @@ std::pair<double, double> trajectory_extremes(const traj::PolynomialTrajectory& 
   // segment; the count is bounded before any evaluation.
   if (!(std::isfinite(step) && step > 0.0)) throw Error("step: must be a positive finite time in s, got " + short_number(step));
   t.check_consistent("trajectory_extremes");
+  if (!t.coefficients().allFinite()) throw Error("trajectory_extremes: the trajectory's coefficients must be finite numbers");
   double count = 0.0;
   for (const double T : t.durations()) count += std::ceil(T / step) + 1.0;
   if (!(count <= kMaxExtremeSamples))

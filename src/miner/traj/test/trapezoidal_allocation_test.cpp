@@ -183,6 +183,10 @@ TEST_CASE("A trajectory changed through its mutable accessors is checked where i
     CHECK_THROWS_WITH(changed.cost(), Contains("durations[0]"));
     CHECK_THROWS_WITH(exact_extremes(changed), Contains("durations[0]"));
   }
+  auto poisoned = t;
+  poisoned.mutable_coefficients()(4, 1) = std::nan("");
+  CHECK_THROWS_WITH(exact_extremes(poisoned), Contains("exact_extremes: the trajectory's coefficients must be finite"));
+  CHECK_THROWS_WITH(trajectory_extremes(poisoned, 0.01), Contains("trajectory_extremes: the trajectory's coefficients must be finite"));
   auto reordered = t;
   CHECK_THROWS_WITH(reordered.set_order(0), Contains("order must be in [1, 4], got 0"));
   CHECK(reordered.order() == 3);

@@ -18,13 +18,24 @@ void scale_time(PolynomialTrajectory& t, double k) {
   if (!(k > 0.0) || !std::isfinite(k)) throw Error("scale_time: k must be positive and finite");
   // The scaled durations stay finite (tenth campaign L17: k = 1e300 made infinite ones).
   for (const double d : t.durations())
-    if (!std::isfinite(d * k)) throw Error("scale_time: k = " + short_number(k) + " makes a duration infinite");
-  auto& c = t.mutable_coefficients();
+    if (!(std::isfinite(d * k) && d * k > 0.0)) throw Error("scale_time: k = " + short_number(k) + " makes a duration infinite or zero");
+  // Every coefficient must survive its division by k^j: k = 1e300 underflowed them to 0 (peaks
+  // of 0, a NaN cost) and 1e-300 overflowed them (thirteenth campaign L2).
+  auto c = t.coefficients();
   const int n = 2 * t.order();
   for (int i = 0; i < t.segments(); ++i) {
     double kj = 1.0;
-    for (int j = 0; j < n; ++j, kj *= k) c.row(n * i + j) /= kj;
+    for (int j = 0; j < n; ++j, kj *= k)
+      for (int a = 0; a < 3; ++a) {
+        double& x = c(n * i + j, a);
+        const double scaled = x / kj;
+        if (!std::isfinite(scaled) || (x != 0.0 && scaled == 0.0) || !std::isfinite(kj) || kj == 0.0)
+          throw Error("scale_time: k = " + short_number(k) + " puts coefficient " + std::to_string(j) + " of segment " +
+                      std::to_string(i) + " outside double precision");
+        x = scaled;
+      }
   }
+  t.mutable_coefficients() = c;
   for (double& d : t.mutable_durations()) d *= k;
 }
 
@@ -71,7 +82,8 @@ double bracketed_root(const PeakPolynomial& g, double lo, double hi) {
 
 /// Every root of g in [lo, hi], given g's Bernstein coefficients b on that interval: none where
 /// b has no sign change, the one root where it has one, else the two halves (de Casteljau at
-/// the midpoint), down to kMaxPeakBisections halvings (a double root there: its midpoint).
+/// the midpoint, which is itself a candidate), down to kMaxPeakBisections halvings (a double
+/// root there: its midpoint). A candidate that is no root only adds a value below the peak.
 void isolate_roots(const PeakPolynomial& g, const PeakPolynomial& b, double lo, double hi, int depth,
                    std::vector<double>& roots) {
   const int changes = sign_variations(b);
@@ -93,7 +105,11 @@ void isolate_roots(const PeakPolynomial& g, const PeakPolynomial& b, double lo, 
     right[n - 1 - r] = work[n - 1 - r];
     for (Eigen::Index i = 0; i + 1 < n - r; ++i) work[i] = 0.5 * (work[i] + work[i + 1]);
   }
+  // The split point itself: a root exactly there (the speed peak of a symmetric segment at
+  // u = 1/2) is an exact zero at the end of both halves, which sign_variations skips
+  // (thirteenth campaign L1: a straight rest-to-rest leg's peak was missed, 1e-14 reported).
   const double mid = 0.5 * (lo + hi);
+  roots.push_back(mid);
   isolate_roots(g, left, lo, mid, depth + 1, roots);
   isolate_roots(g, right, mid, hi, depth + 1, roots);
 }
@@ -367,30 +383,19 @@ AllocationResult optimise_allocation(const MincoProblem& problem, const Allocati
     log_of(best);
     ceres::Solve(options, gp, tau.data(), &summary);
     ceres_iterations += static_cast<int>(summary.iterations.size());
-    // The objective or its gradient not finite where Ceres starts: the problem lies outside
-    // what double precision can optimise (issue 20, fifth campaign: rho 1e9 with limits 1e6
-    // gave an 81 s segment, "Initial cost and jacobian evaluation failed", and exit 0).
-    // The legs' lengths are named too: a 1e6 m leg was blamed on rho and the limits alone
-    // (seventh campaign C9).
+    // Ceres cannot start where its objective declines the point: a best answer whose stretched
+    // durations lie past kMaxDurationRatio of the trapezoid, or a start whose forward-difference
+    // gradient fails at a huge stretch (thirteenth campaign C3: a 1 m leg then a 1 km leg,
+    // stretch 7441, was refused as "beyond double precision"). The start itself evaluated (else
+    // the refusal above), so the pattern search, which needs no gradient, goes on from the best
+    // point; nothing is refused here.
     const bool no_start = summary.termination_type == ceres::FAILURE &&
                           summary.message.rfind("Initial cost and jacobian evaluation failed", 0) == 0;
-    // A later round starts from the best answer's stretched durations, which may lie past
-    // kMaxDurationRatio of the trapezoid where the objective is not evaluated: the rounds end
-    // there with that answer (session 32: the error below was thrown for ordinary problems).
-    if (no_start && round > 0) break;
-    if (no_start) {
-      double longest = 0.0;
-      for (Eigen::Index i = 0; i + 1 < problem.points.rows(); ++i)
-        longest = std::max(longest, (problem.points.row(i + 1) - problem.points.row(i)).norm());
-      throw Error("allocation: the optimiser could not evaluate the objective J + rho sum T or its gradient at the "
-                  "start (Ceres: " + summary.message + "): rho " + short_number(o.rho) + ", the limits (v_max " +
-                  short_number(o.limits.v_max) + ", a_max " + short_number(o.limits.a_max) + ") and legs up to " +
-                  short_number(longest) + " m long put it beyond double precision; use a smaller rho, tighter limits "
-                  "or shorter legs, or give durations");
+    if (!no_start) {
+      for (std::size_t i = 0; i < M; ++i) T[i] = std::exp(tau[i]);
+      Evaluation e;
+      if (evaluate(base, T, o, solver, e) && e.F < best.F) best = std::move(e);  // never worse than before
     }
-    for (std::size_t i = 0; i < M; ++i) T[i] = std::exp(tau[i]);
-    Evaluation e;
-    if (evaluate(base, T, o, solver, e) && e.F < best.F) best = std::move(e);  // never worse than before
     // Pattern search (see kPolishSteps) over the feasible durations themselves: after each
     // accepted step tau is the log of the stretched durations, so the answer is a point
     // where F's own coordinate steps were tried.
@@ -402,7 +407,11 @@ AllocationResult optimise_allocation(const MincoProblem& problem, const Allocati
           for (const double step : {h, -h}) {
             std::vector<double> trial = tau;
             trial[i] += step;
-            if (std::abs(trial[i] - std::log(base.durations[i])) > std::log(kMaxDurationRatio)) continue;
+            // Within kMaxDurationRatio of the trapezoid, or back toward it: a stretched answer
+            // may lie past the box, and a step inward is tried (thirteenth campaign C2: an
+            // answer 1193x its trapezoid was never shortened, and shortening lowered F).
+            const double out = std::abs(trial[i] - std::log(base.durations[i])) - std::log(kMaxDurationRatio);
+            if (out > 0.0 && out >= std::abs(tau[i] - std::log(base.durations[i])) - std::log(kMaxDurationRatio)) continue;
             for (std::size_t j = 0; j < M; ++j) T[j] = std::exp(trial[j]);
             Evaluation p;
             ++polish;

@@ -648,6 +648,19 @@ TEST_CASE("A flight stops the first tick the vehicle is outside its world and sa
   REQUIRE(r.log.size() >= 2);
   CHECK(r.log.back()[0] == r.left_world_time_s);
   CHECK(r.log.back()[7] == r.left_world_position.x());
+  // The summary counts what the log shows: a final row inside an obstacle or outside the map
+  // is an entry into the inflated map (thirteenth campaign C5: collision 1 in the last row, 0 in
+  // the summary), with or without a log.
+  const auto& columns = flight::flight_log_columns();
+  const auto collision = static_cast<std::size_t>(std::find(columns.begin(), columns.end(), "collision") - columns.begin());
+  REQUIRE(collision < columns.size());
+  int entries = 0;
+  for (std::size_t i = 0; i < r.log.size(); ++i)
+    entries += (r.log[i][collision] == 1.0 && (i == 0 || r.log[i - 1][collision] == 0.0)) ? 1 : 0;
+  CHECK(r.collisions == entries);
+  flight::FlyOptions no_log;
+  no_log.record_log = false;
+  CHECK(flight::fly(setup, ref, no_log).collisions == r.collisions);
   CHECK(r.log.size() < whole.log.size());
   const std::size_t before = r.log.size() - 1;
   for (std::size_t i = 0; i < before; ++i) REQUIRE(r.log[i] == whole.log[i]);

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "miner/core/error.hpp"
@@ -285,6 +286,18 @@ TEST_CASE("exact_extremes finds every peak: interior, narrow, at a segment's end
   c(3, 0) = -4.0 / 3.0;
   const PolynomialTrajectory bump(3, {1.0}, c);
   CHECK(exact_extremes(bump).first == Approx(2.0).epsilon(1e-14));
+  // A straight rest-to-rest segment peaks exactly at u = 1/2, where root isolation splits
+  // [0, 1] (thirteenth campaign L1: 77 of 1 050 such segments came out at an end value or a
+  // quarter point). Minimum jerk peaks at 15/8 d/T, minimum snap at 35/16 d/T.
+  for (const int order : {3, 4})
+    for (const double d : {1e-3, 0.316228, 100.0, 562.341})
+      for (const double T : {0.1, 0.316228, 10.0, 3.16228}) {
+        Eigen::MatrixX3d leg(2, 3);
+        leg << 0, 0, 1, d, 0, 1;
+        const auto straight = solve_minco(rest_to_rest(order, leg, {T}));
+        INFO("order " << order << ", d " << d << ", T " << T);
+        CHECK(exact_extremes(straight).first == Approx((order == 3 ? 15.0 / 8.0 : 35.0 / 16.0) * d / T).epsilon(1e-9));
+      }
   // Moving ends: order 3 from rest to a tail velocity of -6 m/s (tenth held-out set h10-traj-03:
   // the end instant unsampled gave 4.84) and of -3 m/s (an interior peak of 3.3222 above the
   // end's 3, which the sampled search reported as 3.0).
@@ -326,10 +339,16 @@ TEST_CASE("Twelfth campaign: optimised answers hold the limits at their exact pe
   // L1: answers exceeded v_max / a_max by up to 0.07 % between samples; L2: allocation.cost came
   // from MINCO's Hermite form, which cancelled to -7.0 for a true 0.075; L3: ordinary problems
   // were refused as "beyond double precision" when a later round started past the ratio box.
-  const std::string dir = std::string(MINER_SOURCE_DIR) + "/fixtures/traj/campaign12/";
-  for (const char* name : {"trajoptimise3.6.rand.s3.M20", "trajoptimise3.18.zigzag.s3.M5", "trajoptimise4.5.rand.s3.M3",
-                           "trajoptimise4.86.tiny.s4.M5", "trajoptimise4.71.collinear.s4.M10",
-                           "trajoptimise3.8.zigzag.s4.M10", "trajoptimise3.17.tiny.s3.M2"}) {
+  // Thirteenth campaign: C1 single straight legs answered 2.7x over v_max (the peak finder's
+  // L1), C2 an answer 1193x its trapezoid that a shorter duration improved, C3 a 1 m then a 1 km
+  // leg refused "at the start".
+  const std::string dir = std::string(MINER_SOURCE_DIR) + "/fixtures/traj/";
+  for (const char* name : {"campaign12/trajoptimise3.6.rand.s3.M20", "campaign12/trajoptimise3.18.zigzag.s3.M5",
+                           "campaign12/trajoptimise4.5.rand.s3.M3", "campaign12/trajoptimise4.86.tiny.s4.M5",
+                           "campaign12/trajoptimise4.71.collinear.s4.M10", "campaign12/trajoptimise3.8.zigzag.s4.M10",
+                           "campaign12/trajoptimise3.17.tiny.s3.M2", "campaign13/single_L50_s3_v2_a1_r1",
+                           "campaign13/single_L100_s4_v2_a1_r1", "campaign13/c3_1_1000_s4", "campaign13/p101",
+                           "campaign13/p068", "campaign13/p045"}) {
     INFO(name);
     const auto request = request_from_json(miner::read_json_file(dir + name + ".json"), name);
     REQUIRE(request.optimise);
@@ -347,7 +366,46 @@ TEST_CASE("Twelfth campaign: optimised answers hold the limits at their exact pe
     CHECK(r.cost == Approx(r.trajectory.cost()).epsilon(1e-12));
     CHECK(r.objective == Approx(r.cost + o.rho * r.total_time).epsilon(1e-12));
     CHECK(r.objective <= r.start_objective);
+    // No single duration scaled by exp(+-1e-3) lowers F, but a step further out past
+    // kMaxDurationRatio of the trapezoid (the optimiser's box), beyond F's own rounding noise:
+    // on ill-conditioned problems (campaign12's collinear snap with a 14 ms segment among 6 s
+    // ones) durations a few ulps apart give F 3e-5 apart, which no search can resolve.
+    const std::vector<double> trapezoid = trapezoidal_allocation(request.problem.points, o.limits);
+    const double F = feasible_objective(request.problem, r.durations, o).first;
+    double noise = 0.0;
+    for (std::size_t i = 0; i < r.durations.size(); ++i)
+      for (const double ulps : {4.0, -4.0}) {
+        auto T = r.durations;
+        T[i] *= 1.0 + ulps * std::numeric_limits<double>::epsilon();
+        noise = std::max(noise, std::abs(feasible_objective(request.problem, T, o).first - F));
+      }
+    for (std::size_t i = 0; i < r.durations.size(); ++i)
+      for (const double h : {1e-3, -1e-3}) {
+        auto T = r.durations;
+        T[i] *= std::exp(h);
+        const double out = std::abs(std::log(T[i] / trapezoid[i])) - std::log(1e3);
+        if (out > 0.0 && out >= std::abs(std::log(r.durations[i] / trapezoid[i])) - std::log(1e3)) continue;
+        INFO("duration " << i << " scaled by exp(" << h << ")");
+        INFO("F's rounding noise " << noise);
+        CHECK(feasible_objective(request.problem, T, o).first >= F * (1.0 - 1e-9) - 2.0 * noise);
+      }
   }
+}
+
+TEST_CASE("scale_time refuses a k that puts a coefficient outside double precision", "[REQ-TRAJ-005][REQ-LIB-003]") {
+  // Thirteenth campaign L2: k = 1e300 underflowed the coefficients to 0 (peaks 0, cost NaN) and
+  // 1e-300 overflowed them.
+  const auto t = solve_minco(rest_to_rest(3, zigzag(), trapezoidal_allocation(zigzag(), Limits{2, 1})));
+  for (const double k : {1e300, 1e-300, 1e100, 1e-100}) {
+    INFO("k " << k);
+    auto scaled = t;
+    CHECK_THROWS_WITH(scale_time(scaled, k), Contains("scale_time: k = ") && Contains("outside double precision"));
+    CHECK(scaled.coefficients() == t.coefficients());  // left as it was
+  }
+  auto fine = t;
+  scale_time(fine, 1e3);
+  CHECK(std::isfinite(fine.cost()));
+  CHECK(exact_extremes(fine).first == Approx(exact_extremes(t).first / 1e3).epsilon(1e-12));
 }
 
 TEST_CASE("Where a limit is active, the feasible time scale lands on it: k = max(v/v_max, sqrt(a/a_max))",
@@ -388,3 +446,4 @@ TEST_CASE("Where a limit is active, the feasible time scale lands on it: k = max
     }
   }
 }
+

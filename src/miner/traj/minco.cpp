@@ -151,6 +151,10 @@ struct OrderWorkspace {
 struct MincoSolver::Workspace {
   OrderWorkspace<3> jerk;
   OrderWorkspace<4> snap;
+  /// The problem the last solve() solved (copies reuse their storage): cost_and_gradients
+  /// answers only for it (thirteenth campaign L4: another problem of the same size got the
+  /// solved one's cost, 16 910 for a true 272.5).
+  MincoProblem last;
   template <int S>
   OrderWorkspace<S>& get() {
     if constexpr (S == 3) return jerk; else return snap;
@@ -484,12 +488,22 @@ void MincoSolver::solve(const MincoProblem& p, PolynomialTrajectory& out) {
   } else {
     throw Error("order: must be 3 (minimum jerk) or 4 (minimum snap), got " + std::to_string(p.order));
   }
+  ws_->last.order = p.order;
+  ws_->last.points = p.points;
+  ws_->last.durations = p.durations;
+  ws_->last.head = p.head;
+  ws_->last.tail = p.tail;
 }
 
 double MincoSolver::cost_and_gradients(const MincoProblem& p, MincoGradients* gradients) const {
   if (!ws_) throw Error("MincoSolver: used after being moved from");
   const int solved = p.order == 3 ? ws_->jerk.solved : ws_->snap.solved;
   if (solved != static_cast<int>(p.durations.size())) throw Error("MincoSolver: cost_and_gradients needs a solve() first");
+  const MincoProblem& last = ws_->last;
+  const auto same = [](const Eigen::MatrixX3d& a, const Eigen::MatrixX3d& b) { return a.rows() == b.rows() && a == b; };
+  if (last.order != p.order || last.durations != p.durations || !same(last.points, p.points) || !same(last.head, p.head) ||
+      !same(last.tail, p.tail))
+    throw Error("MincoSolver: cost_and_gradients is for the problem the last solve() solved, and this is another");
   return p.order == 3 ? cost_order<3>(p, ws_->jerk, gradients) : cost_order<4>(p, ws_->snap, gradients);
 }
 

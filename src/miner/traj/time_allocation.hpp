@@ -84,7 +84,9 @@ struct AllocationResult {
 
 /// The most segments optimise_allocation() takes: its pattern search costs O(M) MINCO solves
 /// of O(M) each per sweep, so work grows as M^2 (100 segments: ~7 s, 400: > 5 min here;
-/// issue 20). Planner paths have 10-30 segments; longer ones keep the trapezoid or are split.
+/// issue 20; with exact peaks and two passes, 24-64 segments take 3-15 s on a shared 2-core VM,
+/// thirteenth campaign C4). Planner paths have 10-30 segments; longer ones keep the trapezoid
+/// or are split.
 inline constexpr int kMaxOptimisedSegments = 64;
 
 /// Throws miner::Error for a bad problem (validate()), moving ends, bad limits, rho <= 0 or

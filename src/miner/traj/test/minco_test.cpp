@@ -117,6 +117,17 @@ TEST_CASE("Cost from the coefficients equals the solver's Hermite-form cost", "[
   CHECK(g.points.rows() == 4);
   CHECK(g.durations.size() == 3);
   CHECK_THROWS_WITH(MincoSolver().cost_and_gradients(p, nullptr), Contains("needs a solve() first"));
+  // Another problem of the same size (points, a duration, an end) is not the one solved
+  // (thirteenth campaign L4: it got the solved problem's cost).
+  auto moved = p;
+  moved.points(2, 1) += 0.5;
+  CHECK_THROWS_WITH(solver.cost_and_gradients(moved, nullptr), Contains("for the problem the last solve() solved"));
+  auto longer = p;
+  longer.durations[1] = 1.4;
+  CHECK_THROWS_WITH(solver.cost_and_gradients(longer, nullptr), Contains("another"));
+  solver.solve(longer, t);
+  CHECK(solver.cost_and_gradients(longer, nullptr) == Approx(t.cost()).epsilon(1e-12));
+  CHECK_THROWS_WITH(solver.cost_and_gradients(p, nullptr), Contains("another"));
 }
 
 TEST_CASE("Bad problems are refused with the field named", "[REQ-TRAJ-007]") {

@@ -105,9 +105,8 @@ TEST_CASE("The gradient handed to Ceres is dF/dlog T: central differences in log
   // limits far away, every component against a central difference of F in tau.
   miner::Rng rng(19);
   AllocationOptions o;
-  o.limits = Limits{1e3, 1e3};
-  for (int trial = 0; trial < 24; ++trial) {
-    const int s = 3 + trial % 2;
+  // A rest-to-rest problem of 1-5 random legs and its log durations; sets o.rho.
+  const auto draw = [&](int s) {
     const int M = 1 + static_cast<int>(rng.uniform_index(5));
     Eigen::MatrixX3d pts(M + 1, 3);
     for (int r = 0; r <= M; ++r)
@@ -116,6 +115,19 @@ TEST_CASE("The gradient handed to Ceres is dF/dlog T: central differences in log
     o.rho = rng.uniform(0.1, 10.0);
     std::vector<double> tau(static_cast<std::size_t>(M));
     for (double& x : tau) x = std::log(rng.uniform(0.4, 2.5));
+    return std::pair{p, tau};
+  };
+  // dF/dtau_i by a central difference of step h.
+  const auto central = [&](const MincoProblem& p, const std::vector<double>& tau, std::size_t i, double h) {
+    auto plus = tau, minus = tau;
+    plus[i] += h;
+    minus[i] -= h;
+    return (log_time_objective(p, plus, o).first - log_time_objective(p, minus, o).first) / (2 * h);
+  };
+  o.limits = Limits{1e3, 1e3};
+  for (int trial = 0; trial < 24; ++trial) {
+    const int s = 3 + trial % 2;
+    const auto [p, tau] = draw(s);
     const auto [F, gradient] = log_time_objective(p, tau, o);
     std::vector<double> T(tau.size());
     for (std::size_t i = 0; i < tau.size(); ++i) T[i] = std::exp(tau[i]);
@@ -124,12 +136,8 @@ TEST_CASE("The gradient handed to Ceres is dF/dlog T: central differences in log
     CHECK(F == Approx(F_direct).epsilon(1e-12));
     REQUIRE(gradient.size() == tau.size());
     for (std::size_t i = 0; i < tau.size(); ++i) {
-      const double h = 1e-5;
-      auto plus = tau, minus = tau;
-      plus[i] += h;
-      minus[i] -= h;
-      const double fd = (log_time_objective(p, plus, o).first - log_time_objective(p, minus, o).first) / (2 * h);
-      INFO("trial " << trial << ", s = " << s << ", M = " << M << ", component " << i << ", T = " << T[i]);
+      const double fd = central(p, tau, i, 1e-5);
+      INFO("trial " << trial << ", s = " << s << ", M = " << tau.size() << ", component " << i << ", T = " << T[i]);
       CHECK(gradient[i] == Approx(fd).epsilon(1e-6).margin(1e-8 * F));
     }
   }
@@ -141,26 +149,15 @@ TEST_CASE("The gradient handed to Ceres is dF/dlog T: central differences in log
   int active = 0;
   for (int trial = 0; trial < 24; ++trial) {
     const int s = 3 + trial % 2;
-    const int M = 1 + static_cast<int>(rng.uniform_index(5));
-    Eigen::MatrixX3d pts(M + 1, 3);
-    for (int r = 0; r <= M; ++r)
-      for (int c = 0; c < 3; ++c) pts(r, c) = rng.uniform(-3.0, 3.0);
-    const auto p = rest_to_rest(s, pts, {});
-    o.rho = rng.uniform(0.1, 10.0);
-    std::vector<double> tau(static_cast<std::size_t>(M));
-    for (double& x : tau) x = std::log(rng.uniform(0.4, 2.5));
+    const auto [p, tau] = draw(s);
     std::vector<double> T(tau.size());
     for (std::size_t i = 0; i < tau.size(); ++i) T[i] = std::exp(tau[i]);
     if (feasible_objective(p, T, o).second == 1.0) continue;
     ++active;
     const auto [F, gradient] = log_time_objective(p, tau, o);
     for (std::size_t i = 0; i < tau.size(); ++i) {
-      const double h = 1e-6;
-      auto plus = tau, minus = tau;
-      plus[i] += h;
-      minus[i] -= h;
-      const double fd = (log_time_objective(p, plus, o).first - log_time_objective(p, minus, o).first) / (2 * h);
-      INFO("limit active: trial " << trial << ", s = " << s << ", M = " << M << ", component " << i << ", T = " << T[i]);
+      const double fd = central(p, tau, i, 1e-6);
+      INFO("limit active: trial " << trial << ", s = " << s << ", M = " << tau.size() << ", component " << i << ", T = " << T[i]);
       CHECK(gradient[i] == Approx(fd).epsilon(1e-3).margin(1e-6 * F));
     }
   }

@@ -57,6 +57,13 @@ int sign_variations(const PeakPolynomial& b) {
   return changes;
 }
 
+/// A root located to within this in u is close enough: |p^(k)|^2 is flat at its extremum, so
+/// its value there is off by ~|d2/du2 |p^(k)|^2| kRootStep^2 / 2, far below a double's rounding.
+constexpr double kRootStep = 1e-12;
+/// The hull bound is computed with rounding (a few ulps of d's largest term); a segment is
+/// passed over only when its bound is below the peak found by more than that.
+constexpr double kHullRounding = 1e-12;
+
 /// The one root of g (power basis in u) in [lo, hi], where g changes sign: Newton steps kept
 /// inside the shrinking bracket, bisection where a step would leave it.
 double bracketed_root(const PeakPolynomial& g, double lo, double hi) {
@@ -74,7 +81,7 @@ double bracketed_root(const PeakPolynomial& g, double lo, double hi) {
     else hi = u;
     const double newton = u - v / dv;
     const double next = (dv != 0.0 && newton > lo && newton < hi) ? newton : 0.5 * (lo + hi);
-    if (next == u) break;
+    if (std::abs(next - u) <= kRootStep) return next;
     u = next;
   }
   return u;
@@ -120,27 +127,53 @@ std::pair<double, double> exact_extremes(const PolynomialTrajectory& t) {
   t.check_consistent("exact_extremes");
   if (!t.coefficients().allFinite()) throw Error("exact_extremes: the trajectory's coefficients must be finite numbers");
   const int n = 2 * t.order();
-  double v2 = 0.0, a2 = 0.0;
-  std::vector<double> roots;
-  for (int i = 0; i < t.segments(); ++i) {
+  // The k-th derivative of segment i at t = u T, u in [0, 1]: sum_j d_j u^j with
+  // d_j = (j+1)...(j+k) c_{j+k} T^j (m = 2s - k terms).
+  const auto derivative = [&](int i, int k, Eigen::Matrix<double, 8, 3>& d) {
     const auto c = t.segment_coefficients(i);
     const double T = t.durations()[static_cast<std::size_t>(i)];
+    const int m = n - k;
+    double Tj = 1.0;
+    for (int j = 0; j < m; ++j, Tj *= T) {
+      double f = 1.0;
+      for (int q = 1; q <= k; ++q) f *= j + q;
+      d.row(j) = f * Tj * c.row(j + k);
+    }
+    return m;
+  };
+  const auto norm2 = [](const Eigen::Matrix<double, 8, 3>& d, int m, double u) {
+    Eigen::RowVector3d x = d.row(m - 1);
+    for (int j = m - 2; j >= 0; --j) x = x * u + d.row(j);
+    return x.squaredNorm();
+  };
+  // First every segment's ends, so that the bound below can pass over segments whose interior
+  // cannot beat them.
+  double peak2[2] = {0.0, 0.0};  // squared peak speed, acceleration
+  Eigen::Matrix<double, 8, 3> d;
+  for (int i = 0; i < t.segments(); ++i)
     for (const int k : {1, 2}) {
-      // The k-th derivative at t = u T, u in [0, 1]: sum_j d_j u^j, d_j = (j+1)...(j+k) c_{j+k} T^j.
-      const int m = n - k;
-      Eigen::Matrix<double, 8, 3> d;
-      double Tj = 1.0;
-      for (int j = 0; j < m; ++j, Tj *= T) {
-        double f = 1.0;
-        for (int q = 1; q <= k; ++q) f *= j + q;
-        d.row(j) = f * Tj * c.row(j + k);
+      const int m = derivative(i, k, d);
+      peak2[k - 1] = std::max({peak2[k - 1], norm2(d, m, 0.0), norm2(d, m, 1.0)});
+    }
+  std::vector<double> roots;
+  for (int i = 0; i < t.segments(); ++i)
+    for (const int k : {1, 2}) {
+      const int m = derivative(i, k, d);
+      // A Bernstein polynomial lies in the convex hull of its coefficients, so |p^(k)| on the
+      // segment is at most the largest |b_r| of d's Bernstein coefficients on [0, 1]
+      // (b_r = sum_{j <= r} C(r, j) / C(m - 1, j) d_j): no root search where that is no higher
+      // than the peak already found.
+      double bound2 = 0.0;
+      for (int r = 0; r < m; ++r) {
+        Eigen::RowVector3d sum = Eigen::RowVector3d::Zero();
+        double ratio = 1.0;  // C(r, j) / C(m - 1, j), from j = 0
+        for (int j = 0; j <= r; ++j) {
+          sum += ratio * d.row(j);
+          ratio *= static_cast<double>(r - j) / static_cast<double>(m - 1 - j);
+        }
+        bound2 = std::max(bound2, sum.squaredNorm());
       }
-      const auto norm2 = [&](double u) {
-        Eigen::RowVector3d x = d.row(m - 1);
-        for (int j = m - 2; j >= 0; --j) x = x * u + d.row(j);
-        return x.squaredNorm();
-      };
-      double top = std::max(norm2(0.0), norm2(1.0));
+      if (bound2 * (1.0 + kHullRounding) <= peak2[k - 1]) continue;
       // |d(u)|^2 = sum_q f_q u^q (degree 2m - 2); its interior extrema are the roots of
       // g = d/du |d|^2 (degree 2m - 3 <= kMaxPeakDegree).
       Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxPeakDegree + 2, 1> f =
@@ -161,11 +194,9 @@ std::pair<double, double> exact_extremes(const PolynomialTrajectory& t) {
       }
       roots.clear();
       isolate_roots(g, b, 0.0, 1.0, 0, roots);
-      for (const double u : roots) top = std::max(top, norm2(u));
-      (k == 1 ? v2 : a2) = std::max(k == 1 ? v2 : a2, top);
+      for (const double u : roots) peak2[k - 1] = std::max(peak2[k - 1], norm2(d, m, u));
     }
-  }
-  return {std::sqrt(v2), std::sqrt(a2)};
+  return {std::sqrt(peak2[0]), std::sqrt(peak2[1])};
 }
 
 namespace {

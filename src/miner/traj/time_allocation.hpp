@@ -41,9 +41,12 @@ inline constexpr double kMaxExtremeSamples = 1e7;
 /// g(u) = d/du |p^(k)(u)|^2 (degree 2(2s - k) - 3 <= 11 for order s <= 4). The roots are
 /// isolated on g's Bernstein coefficients (their sign changes bound the roots in an interval:
 /// none, exactly one, or halve it by de Casteljau) and each found by Newton steps inside its
-/// bracket. The optimiser's limit check: samples step over narrow peaks (twelfth campaign L1:
-/// 2.0009 m/s under v_max 2 between two of 33 samples) and a search around the largest sample
-/// misses an interior peak above an end sample (tenth held-out audit: 3.0 for a true 3.322).
+/// bracket (to 1e-12 in u, where the value is flat). Every segment's ends are read first, and
+/// a segment whose Bernstein hull bound (the largest |b_r| of p^(k)'s Bernstein coefficients)
+/// is not above the peak found so far is passed over. The optimiser's limit check: samples
+/// step over narrow peaks (twelfth campaign L1: 2.0009 m/s under v_max 2 between two of 33
+/// samples) and a search around the largest sample misses an interior peak above an end sample
+/// (tenth held-out audit: 3.0 for a true 3.322).
 std::pair<double, double> exact_extremes(const PolynomialTrajectory& t);
 /// Degree of g above for order 4 and k = 1: 2 * 7 - 3.
 inline constexpr int kMaxPeakDegree = 11;

@@ -1432,6 +1432,18 @@ TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[RE
   const miner::Json a = miner::parse_json(full.out, "full"), b = miner::parse_json(merged.out, "merged");
   CHECK(b["run_records"].size() == (miner::bench::ompl_available() ? 15u : 9u));
   CHECK(without_clock(a) == without_clock(b));
+  // The per-campaign blocks that only shard 0 measures (the region's build time, the throughput
+  // check) are shard 0's, whatever the order of the parts (held-out audit 11, h11-plan-05: shard
+  // 1's were taken).
+  {
+    std::ifstream in(parts[1]);  // shard 0/3
+    std::stringstream text;
+    text << in.rdbuf();
+    const miner::Json shard0 = miner::parse_json(text.str(), parts[1]);
+    REQUIRE(shard0["shard"]["index"] == 0);
+    CHECK(b["region"] == shard0["region"]);
+    CHECK(b["throughput"] == shard0["throughput"]);
+  }
   // A record that appears in two parts (a doctored or mis-copied shard) is refused by name.
   {
     std::ifstream in0(parts[1]), in1(parts[2]);

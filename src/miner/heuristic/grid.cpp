@@ -7,6 +7,7 @@
 #include <type_traits>
 
 #include "miner/core/error.hpp"
+#include "miner/core/text.hpp"
 #include "miner/plan/heuristic_region.hpp"
 #include "miner/world/map.hpp"
 
@@ -15,6 +16,10 @@ namespace miner::heuristic {
 Eigen::Vector3i cell_coords(const Eigen::Vector3i& dims, std::size_t index) {
   const auto nx = static_cast<std::size_t>(dims.x());
   const auto ny = static_cast<std::size_t>(dims.y());
+  // Fourteenth campaign L2: an index past the grid answered coordinates outside it.
+  if ((dims.array() < 1).any() || index / nx / ny >= static_cast<std::size_t>(dims.z()))
+    throw Error("grid cell index " + std::to_string(index) + " lies outside the " + std::to_string(dims.x()) + " x " +
+                std::to_string(dims.y()) + " x " + std::to_string(dims.z()) + " grid");
   return {static_cast<int>(index % nx), static_cast<int>((index / nx) % ny), static_cast<int>(index / (nx * ny))};
 }
 
@@ -23,6 +28,10 @@ Eigen::Vector3d cell_size(const world::Box& b, const Eigen::Vector3i& dims) {
 }
 
 Eigen::Vector3i cell_of(const world::Box& b, const Eigen::Vector3i& dims, const Eigen::Vector3d& p) {
+  // Fourteenth campaign L2: NaN was cast to int (undefined; -2147483648 in practice).
+  if (!p.allFinite())
+    throw Error("grid point (" + short_number(p.x()) + ", " + short_number(p.y()) + ", " + short_number(p.z()) +
+                ") is not finite: it lies in no cell");
   const Eigen::Vector3d c = cell_size(b, dims);
   Eigen::Vector3i idx;
   for (int a = 0; a < 3; ++a) {
@@ -507,6 +516,12 @@ std::vector<int> label_components(const std::vector<std::uint8_t>& mask, const E
 
 std::vector<std::uint8_t> component_of(const std::vector<std::uint8_t>& mask, const Eigen::Vector3i& dims,
                                        std::size_t cell, std::size_t stop) {
+  // Fourteenth campaign L1: a cell past the mask, or a mask shorter than the grid, was read out
+  // of bounds (SEGV under ASan).
+  require_mask(mask, dims);
+  if (cell >= mask.size())
+    throw Error("component_of: cell index " + std::to_string(cell) + " lies outside the mask's " +
+                std::to_string(mask.size()) + " cells");
   std::vector<std::uint8_t> in(mask.size(), 0);
   if (!mask[cell]) return in;
   const auto nx = static_cast<std::size_t>(dims.x()), nxy = nx * static_cast<std::size_t>(dims.y());
@@ -554,6 +569,9 @@ bool connects(const std::vector<std::uint8_t>& mask, const Eigen::Vector3i& dims
 }
 
 std::size_t solid_cells_in(const std::vector<std::uint8_t>& mask, const std::vector<std::uint8_t>& env) {
+  if (mask.size() != env.size())
+    throw Error("solid_cells_in: the region mask has " + std::to_string(mask.size()) + " cells and the environment " +
+                std::to_string(env.size()));
   std::size_t n = 0;
   for (std::size_t i = 0; i < mask.size(); ++i) n += (mask[i] && env[i] == kSolid) ? 1 : 0;
   return n;

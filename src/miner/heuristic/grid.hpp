@@ -40,10 +40,14 @@ inline std::size_t cell_index(const Eigen::Vector3i& dims, int i, int j, int k) 
              static_cast<std::size_t>(dims.x()) +
          static_cast<std::size_t>(i);
 }
+/// The (x, y, z) of cell `index`; throws miner::Error for an index past the grid.
 Eigen::Vector3i cell_coords(const Eigen::Vector3i& dims, std::size_t index);
 Eigen::Vector3d cell_size(const world::Box& bounds, const Eigen::Vector3i& dims);
-/// The cell holding p (clamped onto the grid for points on or beyond the bounds).
+/// The cell holding p (clamped onto the grid for points on or beyond the bounds); throws
+/// miner::Error for a point that is not finite.
 Eigen::Vector3i cell_of(const world::Box& bounds, const Eigen::Vector3i& dims, const Eigen::Vector3d& p);
+/// The box of cell c; a c past the grid gives the box the grid's lattice puts there (the
+/// encoder reads cell edges per axis this way).
 world::Box cell_box(const world::Box& bounds, const Eigen::Vector3i& dims, const Eigen::Vector3i& c);
 
 /// The most sub-box-in-box tests box_covered() makes (issue 20: n boxes with distinct faces
@@ -115,6 +119,7 @@ std::vector<int> label_components(const std::vector<std::uint8_t>& mask, const E
 /// The 26-connected component of the mask cells that holds `cell`: 1 on its cells, 0 elsewhere
 /// (all 0 if mask[cell] is 0). A breadth-first search that touches only that component, not
 /// the whole grid as label_components does; `stop`, if a valid index, ends it once reached.
+/// Throws miner::Error for a mask that is not dims' size or a cell past it.
 std::vector<std::uint8_t> component_of(const std::vector<std::uint8_t>& mask, const Eigen::Vector3i& dims,
                                        std::size_t cell, std::size_t stop = SIZE_MAX);
 
@@ -122,7 +127,8 @@ std::vector<std::uint8_t> component_of(const std::vector<std::uint8_t>& mask, co
 bool connects(const std::vector<std::uint8_t>& mask, const Eigen::Vector3i& dims, const Eigen::Vector3i& a,
               const Eigen::Vector3i& b);
 
-/// Number of kSolid cells of `env` inside the region `mask` (the region is safe iff 0).
+/// Number of kSolid cells of `env` inside the region `mask` (the region is safe iff 0); throws
+/// miner::Error when the two differ in size.
 std::size_t solid_cells_in(const std::vector<std::uint8_t>& mask, const std::vector<std::uint8_t>& env);
 
 }  // namespace miner::heuristic

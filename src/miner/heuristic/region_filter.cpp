@@ -40,6 +40,16 @@ void require_one_grid(const std::vector<float>& p, const std::vector<std::uint8_
   const auto n = static_cast<std::size_t>(dims.x()) * static_cast<std::size_t>(dims.y()) * static_cast<std::size_t>(dims.z());
   if (p.size() != n || env.size() != n || (!passability.empty() && passability.size() != n))
     throw Error("region filter: grids of different sizes");
+  // Fourteenth campaign L5: E level 9 and NaN probabilities were taken silently.
+  for (std::size_t i = 0; i < n; ++i) {
+    if (env[i] > kSolid)
+      throw Error("region filter: E cell " + std::to_string(i) + " holds " + std::to_string(env[i]) + ", outside its levels 0..2");
+    if (!(p[i] >= 0.0F && p[i] <= 1.0F))
+      throw Error("region filter: R cell " + std::to_string(i) + " is " + std::to_string(p[i]) + ", not a probability");
+    if (!passability.empty() && passability[i] > kPassAll)
+      throw Error("region filter: P cell " + std::to_string(i) + " holds " + std::to_string(passability[i]) +
+                  ", outside its bits 0..7");
+  }
   // Tenth campaign L4: a cell outside the grid corrupted the heap (filter_region) or read
   // outside it (widest_threshold).
   require_cell_in_grid(start_cell, dims, "region filter: the start cell");
@@ -122,6 +132,8 @@ std::optional<float> widest_threshold(const std::vector<float>& p, const std::ve
 double region_threshold(const std::vector<float>& p, const std::vector<std::uint8_t>& env, const Eigen::Vector3i& dims,
                         const Eigen::Vector3i& start_cell, const Eigen::Vector3i& goal_cell, double threshold,
                         bool widest, const std::vector<std::uint8_t>& passability) {
+  // Fourteenth campaign L5: a NaN threshold came back as the threshold (filter_region refuses it).
+  if (std::isnan(threshold)) throw Error("region filter: threshold must be a number, got nan");
   if (!widest) return threshold;
   require_one_grid(p, env, passability, dims, start_cell, goal_cell);
   const std::size_t is = cell_index(dims, start_cell.x(), start_cell.y(), start_cell.z());

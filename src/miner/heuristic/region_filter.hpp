@@ -6,8 +6,9 @@
 /// The filter (REQ-HEUR-007), on the heuristic grid (grid.hpp):
 ///   1. threshold: raw H = {cells with R >= threshold}, the threshold fixed or, with the
 ///      weights' rule "widest" (REQ-HEUR-016), lowered to the widest start-goal chain's;
-///   2. safety: drop the solid cells; add the start and goal cells (never solid: the query
-///      points are free for the robot radius);
+///   2. safety: drop the solid cells; add the start and goal cells (not solid for query points
+///      free for the robot radius; a solid one is not added, and the report then says the
+///      region is not connected);
 ///   3. islands: keep only the 26-connected components that hold the start or the goal cell;
 ///   4. bridge: if start and goal are still apart, add the cheapest chain of non-solid cells
 ///      joining their components (a cell already in H costs 0, any other 1 + (1 - R)), grown
@@ -62,6 +63,8 @@ struct FilteredRegion {
   FilterReport report;
 };
 
+/// Throws miner::Error for grids of different sizes, a cell outside the grid, an E level above
+/// 2, a probability outside [0, 1] or a NaN threshold.
 FilteredRegion filter_region(const std::vector<float>& probabilities, const std::vector<std::uint8_t>& environment,
                              const Eigen::Vector3i& dims, const Eigen::Vector3i& start_cell,
                              const Eigen::Vector3i& goal_cell, double threshold);

@@ -666,6 +666,40 @@ const Json& Sgan::meta() const { return live().meta; }
 const std::string& Sgan::path() const { return live().path; }
 bool Sgan::own_kernels() const { return live().own_kernels; }
 
+namespace {
+
+/// A probability outside [0, 1] or not a number means weights (or, for forward(), inputs) the
+/// network cannot carry (e.g. entries near FLT_MAX overflow a layer); the threshold would drop
+/// such cells silently and leave a 2-cell region (issue 20), so the answer is checked before it
+/// is returned.
+std::vector<float> checked_probabilities(const std::string& path, std::vector<float> r, const char* cause) {
+  for (std::size_t v = 0; v < r.size(); ++v)
+    if (!(r[v] >= 0.0F && r[v] <= 1.0F))
+      throw Error(path + ": the network's output at cell " + std::to_string(v) + " is " + std::to_string(r[v]) +
+                  ", not a probability: " + cause);
+  return r;
+}
+
+/// Fourteenth campaign L3: forward() ran NaN inputs through and returned NaN probabilities.
+void require_finite_input(const std::vector<float>& values, const char* name) {
+  for (std::size_t v = 0; v < values.size(); ++v)
+    if (!std::isfinite(values[v]))
+      throw Error(std::string("sgan: input ") + name + "[" + std::to_string(v) + "] is " + std::to_string(values[v]) +
+                  ", not a finite number");
+}
+
+/// The encoded channels' levels (REQ-HEUR-002): E in 0..2, S in 0..1, P in 0..kPassAll.
+void require_levels(const std::vector<std::uint8_t>& values, std::uint8_t max, const char* name) {
+  for (std::size_t v = 0; v < values.size(); ++v)
+    if (values[v] > max)
+      throw Error(std::string("sgan: ") + name + " cell " + std::to_string(v) + " holds " + std::to_string(values[v]) +
+                  ", outside its levels 0.." + std::to_string(max));
+}
+
+constexpr const char* kWeightsOverflow = "the weights overflow a layer (check the file's tensors)";
+
+}  // namespace
+
 std::vector<float> Sgan::forward(const std::vector<float>& env, const std::vector<float>& state,
                                  const std::vector<float>& noise, const std::vector<float>& scale,
                                  const std::vector<float>& passability) const {
@@ -678,6 +712,11 @@ std::vector<float> Sgan::forward(const std::vector<float>& env, const std::vecto
   if (pc != 0 && passability.size() != pc * n)
     throw Error("sgan: the network reads P: " + std::to_string(pc) + " x " + std::to_string(n) + " values, given " +
                 std::to_string(passability.size()));
+  require_finite_input(env, "env");
+  require_finite_input(state, "state");
+  require_finite_input(noise, "noise");
+  require_finite_input(scale, "scale");
+  require_finite_input(passability, "passability");
   g.set_scale(scale);
   g.begin_input();
   g.for_voxels([&](int x, int y, int z, std::size_t v) {
@@ -685,7 +724,7 @@ std::vector<float> Sgan::forward(const std::vector<float>& env, const std::vecto
     for (std::size_t a = 0; a < pc; ++a) p[a] = passability[a * n + v];
     g.set_input(x, y, z, v, env[v], state[v], noise[v], p);
   });
-  return g.run();
+  return checked_probabilities(g.path, g.run(), "a layer overflowed (check the inputs' magnitudes and the file's tensors)");
 }
 
 std::vector<float> scale_input(const world::Box& bounds, const Eigen::Vector3i& dims, double robot_radius,
@@ -772,21 +811,6 @@ std::vector<float> Sgan::Impl::run() {
   return g.out.data;
 }
 
-namespace {
-
-/// A probability outside [0, 1] or not a number means weights the network cannot carry (e.g.
-/// entries near FLT_MAX overflow a layer); the threshold would drop such cells silently and
-/// leave a 2-cell region (issue 20), so the answer is checked before it is returned.
-std::vector<float> checked_probabilities(const std::string& path, std::vector<float> r) {
-  for (std::size_t v = 0; v < r.size(); ++v)
-    if (!(r[v] >= 0.0F && r[v] <= 1.0F))
-      throw Error(path + ": the network's output at cell " + std::to_string(v) + " is " + std::to_string(r[v]) +
-                  ", not a probability: the weights overflow a layer (check the file's tensors)");
-  return r;
-}
-
-}  // namespace
-
 std::vector<float> Sgan::predict(const std::vector<std::uint8_t>& environment, const std::vector<std::uint8_t>& state,
                                  const std::vector<std::uint8_t>& passability, const world::Box& bounds,
                                  double robot_radius, Rng& rng) const {
@@ -798,6 +822,9 @@ std::vector<float> Sgan::predict(const std::vector<std::uint8_t>& environment, c
   const int pc = g.arch.passability_channels;
   if (pc != 0 && passability.size() != n)
     throw Error("sgan: the network reads P: " + std::to_string(n) + " cells, given " + std::to_string(passability.size()));
+  require_levels(environment, kSolid, "E");
+  require_levels(state, 1, "S");
+  if (pc != 0) require_levels(passability, kPassAll, "P");
   if (g.arch.scale_channels != 0) g.set_scale(scale_input(bounds, g.arch.dims, robot_radius, g.arch.scale_divisor));
   const auto scale = static_cast<float>(g.arch.environment_scale);
   // N(0, 1) in voxel order (x fastest), one bulk draw of the query's stream.
@@ -805,7 +832,7 @@ std::vector<float> Sgan::predict(const std::vector<std::uint8_t>& environment, c
   rng.fill_normal_ziggurat(g.noise_grid.data(), n);
   if (g.own_kernels) {
     g.set_input_encoded(environment.data(), state.data(), passability.data(), scale, g.noise_grid.data());
-    return checked_probabilities(g.path, g.run());
+    return checked_probabilities(g.path, g.run(), kWeightsOverflow);
   }
   g.begin_input();
   g.for_voxels([&](int x, int y, int z, std::size_t v) {
@@ -815,7 +842,7 @@ std::vector<float> Sgan::predict(const std::vector<std::uint8_t>& environment, c
     g.set_input(x, y, z, v, scale * static_cast<float>(environment[v]), static_cast<float>(state[v]),
                 g.noise_grid[v], p);
   });
-  return checked_probabilities(g.path, g.run());
+  return checked_probabilities(g.path, g.run(), kWeightsOverflow);
 }
 
 std::vector<double> reference_errors(const Sgan& sgan, const std::string& reference_path) {
@@ -879,22 +906,23 @@ std::vector<double> reference_errors(const Sgan& sgan, const std::string& refere
     const std::string p = std::to_string(k) + ".";
     const int sc = sgan.architecture().scale_channels;
     const int pc = sgan.architecture().passability_channels;
-    const auto out = sgan.forward(finite_input(p + "environment", shape), finite_input(p + "state", shape),
-                                  finite_input(p + "noise", shape),
-                                  sc ? finite_input(p + "scale", {sc}) : std::vector<float>{},
-                                  pc ? finite_input(p + "passability", {pc, d.z(), d.y(), d.x()}) : std::vector<float>{});
+    std::vector<float> out;
+    try {
+      out = sgan.forward(finite_input(p + "environment", shape), finite_input(p + "state", shape),
+                         finite_input(p + "noise", shape), sc ? finite_input(p + "scale", {sc}) : std::vector<float>{},
+                         pc ? finite_input(p + "passability", {pc, d.z(), d.y(), d.x()}) : std::vector<float>{});
+    } catch (const Error& e) {
+      // The inputs are finite (checked above): a non-finite output is the weights' overflow
+      // (seventh campaign C2: it was blamed on the reference).
+      throw Error(sgan.path() + ": the weights overflow a layer: on " + reference_path + "'s inputs, sample " +
+                  std::to_string(k) + ": " + e.what());
+    }
     const auto& want = ref.at(p + "output", shape).values;
     double worst = 0.0;
     for (std::size_t i = 0; i < out.size(); ++i) {
       const double diff = std::abs(static_cast<double>(out[i]) - static_cast<double>(want[i]));
       // std::max would skip a NaN and report agreement (issue 20: an all-NaN reference "agreed").
-      // The inputs are finite (checked above): a non-finite C++ output is the weights' overflow,
-      // a non-finite reference output the reference's fault (seventh campaign C2: the weights'
-      // overflow was blamed on the reference).
-      if (!std::isfinite(out[i]))
-        throw Error(sgan.path() + ": the weights overflow a layer: on " + reference_path + "'s inputs, " + p + "output[" +
-                    std::to_string(i) + "] is " + std::to_string(out[i]) + " (the reference has " +
-                    std::to_string(want[i]) + ")");
+      // forward() returns probabilities only, so a non-finite difference is the reference's fault.
       if (!std::isfinite(diff))
         throw Error(reference_path + ": " + p + "output[" + std::to_string(i) + "]: C++ gives " +
                     std::to_string(out[i]) + ", the reference " + std::to_string(want[i]) +

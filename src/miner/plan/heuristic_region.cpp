@@ -181,6 +181,11 @@ HeuristicRegion HeuristicRegion::from_path(const world::Box& bounds, const Eigen
 }
 
 Eigen::Vector3i HeuristicRegion::coords(std::size_t index) const {
+  // Fourteenth campaign L2: index 100000 of an 8^3 region answered (0, 4, 1562), and cell_box a
+  // box 976 m above the bounds.
+  if (index >= probabilities_.size())
+    throw Error("region cell index " + std::to_string(index) + " lies outside the region's " +
+                std::to_string(probabilities_.size()) + " cells");
   const auto nx = static_cast<std::size_t>(dims_.x());
   const auto ny = static_cast<std::size_t>(dims_.y());
   return Eigen::Vector3i(static_cast<int>(index % nx), static_cast<int>((index / nx) % ny),

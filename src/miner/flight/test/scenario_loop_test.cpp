@@ -1130,7 +1130,8 @@ TEST_CASE("The flight log ends with the final state the summary judges", "[REQ-F
   // Twelfth campaign C5: the flight ended an N3 tick after the last 100 Hz row, so the summary's
   // final_position_error and goal_reached came from a state the log did not hold.
   const pipeline::Scenario s = pipeline::default_scenario();
-  const flight::FlightResult r = pipeline::fly(s, pipeline::build_reference(s));
+  const auto ref = pipeline::build_reference(s);
+  const flight::FlightResult r = pipeline::fly(s, ref);
   const auto& columns = flight::flight_log_columns();
   const auto column = [&](const char* name) {
     const auto at = std::find(columns.begin(), columns.end(), name);
@@ -1144,6 +1145,27 @@ TEST_CASE("The flight log ends with the final state the summary judges", "[REQ-F
   const Eigen::Vector3d v(final_row[column("true_vx")], final_row[column("true_vy")], final_row[column("true_vz")]);
   CHECK((p - s.goal).norm() == r.final_position_error);
   CHECK(v.norm() == r.final_speed);
+  // Its reference is the trajectory at that instant, position and velocity (held-out audit 11:
+  // the velocity columns held the position).
+  const auto row3 = [&](const std::vector<double>& row, const char* x, const char* y, const char* z) {
+    return Eigen::Vector3d(row[column(x)], row[column(y)], row[column(z)]);
+  };
+  CHECK(row3(final_row, "ref_x", "ref_y", "ref_z") == ref.trajectory.evaluate(r.flight_time));
+  CHECK(row3(final_row, "ref_vx", "ref_vy", "ref_vz") == ref.trajectory.evaluate(r.flight_time, 1));
   // The rows before it are the 100 Hz control ticks, in order.
   for (std::size_t i = 1; i < r.log.size(); ++i) CHECK(r.log[i][0] > r.log[i - 1][0]);
+
+  // A final state that is the flight's first contact is counted (held-out audit 11: the summary
+  // said 0 collisions and goal reached over a last row saying collision 1). The flight is
+  // deterministic, so an obstacle exactly at the final truth position touches only that state.
+  flight::FlightSetup setup = s;
+  const auto map_collides = setup.collides;
+  setup.collides = [&](const Eigen::Vector3d& at) { return (map_collides && map_collides(at)) || at == p; };
+  const flight::FlightResult touched = flight::fly(setup, ref);
+  REQUIRE(touched.log.size() == r.log.size());
+  CHECK(r.collisions == 0);
+  CHECK(touched.collisions == 1);
+  CHECK(touched.log.back()[column("collision")] == 1.0);
+  CHECK_FALSE(touched.goal_reached);
+  for (std::size_t i = 0; i + 1 < touched.log.size(); ++i) REQUIRE(touched.log[i][column("collision")] == 0.0);
 }

@@ -489,6 +489,12 @@ TEST_CASE("A dataset folder that contradicts itself is refused naming the file a
         edit_shard(q0, [&](std::string& b) { std::fill(b.begin() + cells, b.begin() + 2 * cells, '\0'); });
       },
       "sample 0 of the shard, channel state: marks no cell");
+  // The target channel too (held-out audit 11, h11-heuristic-05: only S was tried).
+  refused(
+      [&](const std::string& q0, const std::string&) {
+        edit_shard(q0, [&](std::string& b) { std::fill(b.begin() + 2 * cells, b.begin() + 3 * cells, '\0'); });
+      },
+      "sample 0 of the shard, channel target: marks no cell");
 }
 
 TEST_CASE("Bad dataset options are refused naming the option", "[REQ-HEUR-003]") {
@@ -508,6 +514,14 @@ TEST_CASE("Bad dataset options are refused naming the option", "[REQ-HEUR-003]")
     o.dims = Eigen::Vector3i(8, 8, n);
     CHECK_THROWS_WITH(heuristic::validate(o), Contains("--dims"));
   }
+  // A validation share that rounds to every sample leaves none for training and is refused; one
+  // sample fewer is kept (held-out audit 11, h11-heuristic-03: ">" let 0.99 of 2 write 0).
+  o = small_options();
+  o.count = 2;
+  o.val_fraction = 0.99;  // rounds to 2 of 2
+  CHECK_THROWS_WITH(heuristic::validate(o), Contains("keeps every sample for validation"));
+  o.val_fraction = 0.74;  // rounds to 1 of 2
+  CHECK_NOTHROW(heuristic::validate(o));
   o = small_options();
   o.preset = "swamp";
   CHECK_THROWS_WITH(heuristic::validate(o), Contains("swamp"));

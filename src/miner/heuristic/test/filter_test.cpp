@@ -288,3 +288,78 @@ TEST_CASE("Tenth campaign: grid masks cells dilations and scale divisors are che
                     Contains("region dims"));
   CHECK(heuristic::encode_environment(walled, Eigen::Vector3i(4, 4, 4), 0.2).size() == 64);
 }
+
+TEST_CASE("Fourteenth campaign: grid region filter and network calls refuse what lies outside them",
+          "[REQ-LIB-003][REQ-HEUR-004][REQ-HEUR-005][REQ-HEUR-007]") {
+  using Catch::Matchers::Contains;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const Eigen::Vector3i d(8, 8, 8);
+  // L1: component_of and solid_cells_in read past their inputs (a SEGV under ASan).
+  const std::vector<std::uint8_t> full(512, 1);
+  CHECK_THROWS_WITH(heuristic::component_of(full, d, 100000), Contains("cell index 100000 lies outside the mask's 512 cells"));
+  CHECK_THROWS_WITH(heuristic::component_of(full, d, 512), Contains("cell index 512"));
+  CHECK(heuristic::component_of(full, d, 511)[0] == 1);  // the last cell is in the grid
+  CHECK_THROWS_WITH(heuristic::component_of(std::vector<std::uint8_t>(10, 1), d, 3), Contains("grid mask: 10 cells"));
+  CHECK_THROWS_WITH(heuristic::solid_cells_in(full, std::vector<std::uint8_t>(10, heuristic::kSolid)),
+                    Contains("mask has 512 cells and the environment 10"));
+  CHECK(heuristic::solid_cells_in(full, std::vector<std::uint8_t>(512, heuristic::kSolid)) == 512);
+  // L2: NaN was cast to int; indices past the grid answered coordinates and boxes outside it.
+  const miner::world::Box b{{0, 0, 0}, {8, 8, 8}};
+  CHECK_THROWS_WITH(heuristic::cell_of(b, d, Eigen::Vector3d(nan, 1, 1)), Contains("is not finite"));
+  CHECK(heuristic::cell_of(b, d, Eigen::Vector3d(-1e300, 1.5, 99)) == Eigen::Vector3i(0, 1, 7));  // clamped
+  CHECK_THROWS_WITH(heuristic::cell_coords(d, 512), Contains("grid cell index 512 lies outside the 8 x 8 x 8 grid"));
+  CHECK(heuristic::cell_coords(d, 511) == Eigen::Vector3i(7, 7, 7));
+  const auto region = miner::plan::HeuristicRegion::from_path(b, d, {Eigen::Vector3d(0.5, 0.5, 0.5), Eigen::Vector3d(7.5, 0.5, 0.5)}, 0, "t");
+  CHECK_THROWS_WITH(region.coords(100000), Contains("region cell index 100000 lies outside the region's 512 cells"));
+  CHECK_THROWS_WITH(region.cell_box(512), Contains("index 512"));
+  CHECK(region.cell_box(511).max == Eigen::Vector3d(8, 8, 8));
+  // L5: E level 9, NaN probabilities and a NaN threshold of the widest rule were taken.
+  Grid g;
+  const Eigen::Vector3i s(0, 0, 0), e(7, 3, 3);
+  g.env[5] = 9;
+  CHECK_THROWS_WITH(heuristic::filter_region(g.p, g.env, kDims, s, e, 0.5), Contains("E cell 5 holds 9"));
+  g.env[5] = heuristic::kFree;
+  g.p[7] = static_cast<float>(nan);
+  CHECK_THROWS_WITH(heuristic::widest_threshold(g.p, g.env, kDims, s, e), Contains("R cell 7 is nan"));
+  g.p[7] = 1.5f;
+  CHECK_THROWS_WITH(heuristic::filter_region(g.p, g.env, kDims, s, e, 0.5), Contains("R cell 7 is 1.5"));
+  g.p[7] = 1.0f;
+  CHECK_THROWS_WITH(heuristic::widest_threshold(g.p, g.env, kDims, s, e, std::vector<std::uint8_t>(128, 8)),
+                    Contains("P cell 0 holds 8"));
+  for (const bool widest : {false, true})
+    CHECK_THROWS_WITH(heuristic::region_threshold(g.p, g.env, kDims, s, e, nan, widest), Contains("threshold must be a number"));
+  CHECK(heuristic::region_threshold(g.p, g.env, kDims, s, e, 0.5, false) == 0.5);
+  // L3: forward() returned NaN probabilities for a NaN or an overflowing input; predict() took
+  // E, S and P values outside their levels.
+  const heuristic::Sgan net = heuristic::Sgan::builtin();
+  const std::size_t n = static_cast<std::size_t>(net.architecture().dims.prod());
+  const std::size_t pc = static_cast<std::size_t>(net.architecture().passability_channels);
+  std::vector<float> env(n, 0.0f), state(n, 0.0f), noise(n, 0.0f), blocked(pc * n, 0.0f);
+  state[0] = state[n - 1] = 1.0f;
+  const std::vector<float> scale = net.architecture().scale_channels ? std::vector<float>{0.5f, 0.5f, 0.5f}
+                                                                     : std::vector<float>{};
+  const auto probabilities = net.forward(env, state, noise, scale, blocked);
+  CHECK(std::all_of(probabilities.begin(), probabilities.end(), [](float v) { return v >= 0.0f && v <= 1.0f; }));
+  env[17] = static_cast<float>(nan);
+  CHECK_THROWS_WITH(net.forward(env, state, noise, scale, blocked), Contains("input env[17] is nan"));
+  env[17] = 0.0f;
+  noise[3] = std::numeric_limits<float>::infinity();
+  CHECK_THROWS_WITH(net.forward(env, state, noise, scale, blocked), Contains("input noise[3] is inf"));
+  std::fill(noise.begin(), noise.end(), 3e38f);
+  CHECK_THROWS_WITH(net.forward(env, state, noise, scale, blocked), Contains("not a probability: a layer overflowed"));
+  std::vector<std::uint8_t> E(n, heuristic::kFree), S(n, 0), P(n, heuristic::kPassAll);
+  S[0] = S[n - 1] = 1;
+  miner::Rng rng(1);
+  const miner::world::Box bounds{{0, 0, 0}, {10, 10, 4}};
+  CHECK(net.predict(E, S, P, bounds, 0.2, rng).size() == n);
+  E[9] = 9;
+  CHECK_THROWS_WITH(net.predict(E, S, P, bounds, 0.2, rng), Contains("E cell 9 holds 9, outside its levels 0..2"));
+  E[9] = heuristic::kSolid;
+  S[4] = 2;
+  CHECK_THROWS_WITH(net.predict(E, S, P, bounds, 0.2, rng), Contains("S cell 4 holds 2"));
+  S[4] = 0;
+  if (pc != 0) {
+    P[6] = 255;
+    CHECK_THROWS_WITH(net.predict(E, S, P, bounds, 0.2, rng), Contains("P cell 6 holds 255"));
+  }
+}

@@ -125,6 +125,14 @@ TEST_CASE("Cost from the coefficients equals the solver's Hermite-form cost", "[
   auto longer = p;
   longer.durations[1] = 1.4;
   CHECK_THROWS_WITH(solver.cost_and_gradients(longer, nullptr), Contains("another"));
+  // Problems that differ only at an end, in a derivative (held-out audit 11: the tail was not
+  // compared, and a different end velocity got the solved problem's cost).
+  for (const bool at_head : {true, false}) {
+    auto other_end = p;
+    (at_head ? other_end.head : other_end.tail)(1, 2) = 0.3;
+    INFO((at_head ? "head" : "tail") << " velocity changed");
+    CHECK_THROWS_WITH(solver.cost_and_gradients(other_end, nullptr), Contains("another"));
+  }
   solver.solve(longer, t);
   CHECK(solver.cost_and_gradients(longer, nullptr) == Approx(t.cost()).epsilon(1e-12));
   CHECK_THROWS_WITH(solver.cost_and_gradients(p, nullptr), Contains("another"));

@@ -212,6 +212,11 @@ TEST_CASE("Optimised allocation bounds its work: more segments than it optimises
   CHECK_THROWS_WITH(optimise_allocation(rest_to_rest(4, points, {}), o),
                     Contains("at most 64 segments") && Contains("has 65"));
   CHECK_NOTHROW(optimise_allocation(rest_to_rest(4, points.topRows(4), {}), o));
+  // Exactly kMaxOptimisedSegments segments pass the count (held-out audit 11: ">=" refused
+  // 64): with a moving head, the next check is what refuses them, before any solve.
+  auto moving = rest_to_rest(4, points.topRows(miner::traj::kMaxOptimisedSegments + 1), {});
+  moving.head(1, 0) = 0.5;
+  CHECK_THROWS_WITH(optimise_allocation(moving, o), Contains("needs a problem at rest at both ends"));
 }
 
 TEST_CASE("Allocation requests in problem files are checked", "[REQ-TRAJ-011]") {
@@ -410,6 +415,14 @@ TEST_CASE("scale_time refuses a k that puts a coefficient outside double precisi
     CHECK_THROWS_WITH(scale_time(scaled, k), Contains("scale_time: k = ") && Contains("outside double precision"));
     CHECK(scaled.coefficients() == t.coefficients());  // left as it was
   }
+  // Underflow alone (held-out audit 11: only overflow was tested, and every k^j there
+  // overflowed too): a coefficient of 1e-30 on u^5 divided by (1e60)^5 = 1e300 is 0.
+  Eigen::MatrixX3d c = Eigen::MatrixX3d::Zero(6, 3);
+  c(0, 0) = 1.0;
+  c(5, 0) = 1e-30;
+  PolynomialTrajectory tiny(3, {1.0}, c);
+  CHECK_THROWS_WITH(scale_time(tiny, 1e60), Contains("puts coefficient 5 of segment 0 outside double precision"));
+  CHECK(tiny.coefficients() == c);
   auto fine = t;
   scale_time(fine, 1e3);
   CHECK(std::isfinite(fine.cost()));

@@ -307,6 +307,17 @@ TEST_CASE("A* refuses a grid built from another map: its path would ignore this 
   CHECK(Map(Box{{0, 0, 0}, {10, 10, 10}}, 0.25, {Box{{4, 0, 0}, {6, 4, 10}}}).fingerprint() != walls.fingerprint());
   const Map voxels = Map::from_voxels({small_layer(), UnknownPolicy::kOccupied, "", ""});
   CHECK(voxels.with_unknown(UnknownPolicy::kFree).fingerprint() != voxels.fingerprint());
+  // Voxel maps that differ only in one voxel's state (held-out audit 11, h11-world-01: the
+  // states were left out of the hash, and A* took the other map's grid through an occupied
+  // voxel).
+  std::vector<std::uint8_t> states = small_layer()->states();
+  states[(0 * 4 + 3) * 4 + 0] = static_cast<std::uint8_t>(VoxelState::kOccupied);  // was free
+  const Map one_more = Map::from_voxels(
+      {std::make_shared<const VoxelLayer>(Eigen::Vector3i::Zero(), 1.0, Eigen::Vector3i(4, 4, 4), std::move(states)),
+       UnknownPolicy::kOccupied, "", ""});
+  CHECK(one_more.fingerprint() != voxels.fingerprint());
+  CHECK_THROWS_WITH(astar(one_more, VoxelGrid(voxels, 0.0), V(0.5, 3.5, 0.5), V(0.5, 0.5, 0.5)),
+                    Contains("the grid was built from another map"));
 }
 
 TEST_CASE("Tenth campaign: grid helpers refuse sizes and leaves they cannot hold by name", "[REQ-LIB-003][REQ-WORLD-012]") {

@@ -17,6 +17,7 @@
 #include "miner/core/progress.hpp"
 #include "miner/core/shard.hpp"
 #include "miner/core/stopwatch.hpp"
+#include "miner/core/text.hpp"
 #include "miner/core/json_io.hpp"
 #include "bench/campaign_stats.hpp"
 #include "miner/heuristic/region_filter.hpp"
@@ -364,6 +365,18 @@ void check_run_record(const JsonField& r, double lower_bound) {
   // A solved run's cost is a number, named as the field when it is not (issue 20, sixth
   // campaign U13: "malformed run record: type must be number, but is string").
   if (solved) (void)r.at("cost").number();
+  // A solved run found a first solution (fourteenth campaign C4: solved runs without one were
+  // merged as 100 % success with no first-solution figures).
+  if (solved && r.at("first").value().is_null()) r.at("first").fail("null, but the run is solved: a solved run has a first solution");
+  // Our planners count iterations and vertices; only OMPL's records leave them null (fourteenth
+  // campaign C4: null counters of rrtstar were merged).
+  const bool ours = r.at("planner").value().is_string() && r.at("planner").string().rfind("ompl:", 0) != 0;
+  if (ours) {
+    (void)r.at("iterations").number();
+    for (const char* stage : {"first", "target"})
+      if (!r.at(stage).value().is_null())
+        for (const char* k : {"iteration", "nodes"}) (void)r.at(stage).at(k).number();
+  }
   if (!solved)
     for (const char* k : {"cost", "first", "target"})
       if (!r.at(k).value().is_null()) r.at(k).fail("an unsolved run has no " + std::string(k));
@@ -381,7 +394,6 @@ void check_run_record(const JsonField& r, double lower_bound) {
       st.at("iteration").fail("comes after the run's last iteration " + r.at("iterations").value().dump());
     // Our planners' trees hold the root and at most one new vertex per iteration (seventh
     // campaign W3: 1e9 nodes at iteration 84 were averaged in). OMPL's may add batches.
-    const bool ours = r.at("planner").value().is_string() && r.at("planner").string().rfind("ompl:", 0) != 0;
     if (ours && st.at("nodes").value().is_number_unsigned() && st.at("iteration").value().is_number_unsigned() &&
         st.at("nodes").value().get<std::uint64_t>() > st.at("iteration").value().get<std::uint64_t>() + 1)
       st.at("nodes").fail(st.at("nodes").value().dump() + " vertices at iteration " + st.at("iteration").value().dump() +
@@ -467,7 +479,7 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
     (void)shard.at("count").integer();
     if (!(root.at("total_s").number() >= 0.0)) root.at("total_s").fail("a duration must be >= 0");
     (void)root.at("map").string();
-    (void)root.at("region");
+    root.at("region").only_keys({"source", "cells", "build_ms"});
     // The summaries and the throughput block have exactly the keys a campaign writes (issue 20:
     // unknown keys there were carried into the merge).
     root.at("throughput").only_keys({"iterations", "rrtstar_iterations_per_s", "ompl_rrtstar_iterations_per_s"});
@@ -485,6 +497,23 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
     // fourth campaign: a target below the straight line was merged): the bound is a length,
     // the A* reference a path no shorter than it, the target the factor times the reference.
     if (!(lower >= 0.0)) root.at("lower_bound").fail("the straight-line bound is a length, >= 0");
+    // The bound is |goal - start| (fourteenth campaign C4: 1.0 for a 10.77 m query was merged),
+    // and the planners' settings are what a campaign can run with.
+    {
+      const auto point = [&](const char* k) {
+        const JsonField f = root.at(k);
+        if (f.array_size() != 3) f.fail("expected [x, y, z]");
+        return Eigen::Vector3d(f.at(0).number(), f.at(1).number(), f.at(2).number());
+      };
+      const double line = (point("goal") - point("start")).norm();
+      if (std::fabs(lower - line) > kRoundoff * std::max(1.0, line))
+        root.at("lower_bound").fail(root.at("lower_bound").value().dump() + " is not |goal - start| = " + short_number(line));
+    }
+    const double steer = root.at("steer_step").number(), goal_radius = root.at("goal_radius").number(),
+                 robot_radius = root.at("robot_radius").number();
+    if (!(std::isfinite(steer) && steer > 0.0)) root.at("steer_step").fail("the steering step must be positive and finite");
+    if (!(std::isfinite(goal_radius) && goal_radius >= 0.0)) root.at("goal_radius").fail("the goal radius must be >= 0 and finite");
+    if (!(std::isfinite(robot_radius) && robot_radius >= 0.0)) root.at("robot_radius").fail("the robot radius must be >= 0 and finite");
     const double reference = root.at("reference_cost").number();
     if (reference < lower * (1.0 - kRoundoff))
       root.at("reference_cost").fail("the A* reference " + root.at("reference_cost").value().dump() +
@@ -552,6 +581,15 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
   // Everything but the per-shard fields must agree; the throughput check's iteration count is a
   // setting (shard 0 measures it, the merge keeps shard 0's rates: parts given other counts are
   // other campaigns; issue 20, --throughput-iterations merged across parts that disagreed).
+  // The region is built in every part from the same map and query: its source and cell count
+  // agree (fourteenth campaign C4: 1 cell in one part, 474 in the others, was merged); only its
+  // build time is the part's own.
+  for (std::size_t p = 1; p < parts.size(); ++p)
+    for (const char* k : {"source", "cells"})
+      if (parts[p].at("region").value(k, nlohmann::json()) != parts[0].at("region").value(k, nlohmann::json()))
+        throw Error("merge: " + names[p] + ": region." + k + " is " + parts[p].at("region").value(k, nlohmann::json()).dump() +
+                    " and " + parts[0].at("region").value(k, nlohmann::json()).dump() + " in " + names[0] +
+                    ": the parts are of different campaigns");
   const auto settings = [](nlohmann::json j) {
     for (const char* k : {"planners", "run_records", "shard", "total_s", "region"}) j.erase(k);
     if (j.contains("throughput") && j["throughput"].is_object()) {

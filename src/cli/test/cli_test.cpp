@@ -1536,6 +1536,27 @@ TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[RE
     doctor([](miner::Json& d) { d["reference_cost"] = 0.5 * d["lower_bound"].get<double>(); },
            "reference_cost: the A* reference");
     doctor([](miner::Json& d) { d["lower_bound"] = -1.0; }, "lower_bound: the straight-line bound is a length");
+    // Fourteenth campaign C4: a solved run with no first solution, our planner's null counters,
+    // a bound that is not |goal - start|, impossible settings and another region were merged.
+    doctor([&](miner::Json& d) { solved(d)["first"] = nullptr; }, "a solved run has a first solution");
+    doctor([&](miner::Json& d) {
+      for (auto& r : d["run_records"])
+        if (r["planner"] == "rrtstar") {
+          r["iterations"] = nullptr;
+          break;
+        }
+    }, ".iterations: expected a number, got null");
+    doctor([&](miner::Json& d) {
+      for (auto& r : d["run_records"])
+        if (r["planner"] == "rrtstar" && r["first"].is_object()) {
+          r["first"]["nodes"] = nullptr;
+          break;
+        }
+    }, ".first.nodes: expected a number, got null");
+    doctor([](miner::Json& d) { d["lower_bound"] = 0.5 * d["lower_bound"].get<double>(); }, "is not |goal - start| = ");
+    doctor([](miner::Json& d) { d["goal_radius"] = -1.0; }, "goal_radius: the goal radius must be >= 0 and finite");
+    doctor([](miner::Json& d) { d["steer_step"] = 0.0; }, "steer_step: the steering step must be positive and finite");
+    doctor([](miner::Json& d) { d["region"]["cells"] = 1; }, "region.cells is 1 and");
     // Fifth campaign: a part of other --planners was called "incomplete".
     doctor([](miner::Json& d) {
       const std::string last = d["planners"].back()["planner"].get<std::string>();

@@ -470,8 +470,15 @@ void write_folder_atomic(const std::string& path, const std::vector<std::pair<st
                          const FolderMarker& marker) {
   namespace fs = std::filesystem;
   require_path_without_nul(path, "output folder");
-  const fs::path target = fs::path(path).lexically_normal();
+  fs::path target = fs::path(path).lexically_normal();
   if (target.empty() || target.filename().empty()) throw Error(path + ": not a folder name");
+  // A symbolic link is followed, as for files (fourteenth campaign C6: `dataset --out LINK`
+  // replaced the user's link with a new folder and left the folder it named as it was).
+  std::error_code link_ec;
+  if (fs::is_symlink(fs::symlink_status(target, link_ec))) {
+    target = fs::weakly_canonical(target, link_ec);
+    if (link_ec || target.empty() || target.filename().empty()) throw Error(path + ": a link that cannot be followed");
+  }
   const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");
   std::error_code ec;
   fs::create_directories(parent, ec);

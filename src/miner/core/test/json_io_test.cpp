@@ -280,6 +280,19 @@ TEST_CASE("A folder write replaces only an earlier output of the same kind", "[R
   std::ofstream(other / "notes.json") << "{}";
   CHECK_THROWS_WITH(miner::write_folder_atomic(other.string(), first), Contains("holds none of the files"));
   CHECK(fs::exists(other / "notes.json"));
+  // A link to an earlier output is followed, as for files: the folder it names is replaced and
+  // the link kept (fourteenth campaign C6: the link itself was replaced by a new folder).
+  const fs::path link = dir / "link";
+  fs::create_directory_symlink(fs::path("run"), link);
+  miner::write_folder_atomic(link.string(), {{"summary.json", "{\"through\": 1}\n"}, {"other.csv", "y\n"}});
+  CHECK(fs::is_symlink(fs::symlink_status(link)));
+  CHECK(read_all(run + "/summary.json") == "{\"through\": 1}\n");
+  // ... and a link to a user's folder is refused as the folder itself would be.
+  const fs::path to_other = dir / "to_other";
+  fs::create_directory_symlink(fs::path("other"), to_other);
+  CHECK_THROWS_WITH(miner::write_folder_atomic(to_other.string(), first), Contains("holds none of the files"));
+  CHECK(fs::is_symlink(fs::symlink_status(to_other)));
+  CHECK(fs::exists(other / "notes.json"));
 }
 
 TEST_CASE("only_keys refuses an unknown key, naming it and the known ones", "[REQ-CORE-003]") {

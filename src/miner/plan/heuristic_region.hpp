@@ -59,7 +59,8 @@ class HeuristicRegion {
   void save(const std::string& path) const;
 
   /// The "ground truth" region of the paper's dataset (Sec. V-A.1): every cell a path
-  /// polyline passes through, dilated by `dilation` cells in each direction
+  /// polyline passes through (an exact traversal: the pieces between its crossings of cell
+  /// faces, and its points), dilated by `dilation` cells in each direction
   /// (dilation 1 = the 3x3x3 cube around each path cell). Probabilities are 0 or 1.
   static HeuristicRegion from_path(const world::Box& bounds, const Eigen::Vector3i& dims,
                                    const std::vector<Eigen::Vector3d>& path, int dilation,

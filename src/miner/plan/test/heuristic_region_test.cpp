@@ -136,6 +136,56 @@ TEST_CASE("The A*-dilated region covers the path and its 3x3x3 neighbourhood", "
   CHECK_THROWS_WITH(HeuristicRegion::from_path(bounds, I(10, 10, 10), {}, 1, "p"), Contains("no points"));
 }
 
+TEST_CASE("The A*-dilated region holds exactly the cells a path passes through", "[REQ-PLAN-005][REQ-HEUR-002]") {
+  // Fourteenth campaign C2: walking each segment in quarter-cell steps missed cells it crossed
+  // by less than a step (sim-1 at 32^3: 0.2165 m through cell (6, 8, 4)). Checked against an
+  // independent slab test: a cell the segment runs through for a positive length is in the
+  // region (dilation 0), and every cell of the region touches the path.
+  const auto inside_length = [](const V& a, const V& b, const Box& box) {
+    double t0 = 0.0, t1 = 1.0;
+    for (int ax = 0; ax < 3; ++ax) {
+      const double d = b[ax] - a[ax];
+      if (d == 0.0) {
+        if (a[ax] < box.min[ax] || a[ax] > box.max[ax]) return -1.0;
+        continue;
+      }
+      double lo = (box.min[ax] - a[ax]) / d, hi = (box.max[ax] - a[ax]) / d;
+      if (lo > hi) std::swap(lo, hi);
+      t0 = std::max(t0, lo);
+      t1 = std::min(t1, hi);
+    }
+    return t1 < t0 ? -1.0 : (t1 - t0) * (b - a).norm();
+  };
+  const auto check = [&](const Box& bounds, const I& dims, const std::vector<V>& path) {
+    const HeuristicRegion r = HeuristicRegion::from_path(bounds, dims, path, 0, "p");
+    const std::vector<std::size_t>& cells = r.cells();
+    int missed = 0, stray = 0;
+    for (std::size_t i = 0; i < r.probabilities().size(); ++i) {
+      double longest = -1.0;
+      for (std::size_t s = 0; s + 1 < path.size(); ++s) longest = std::max(longest, inside_length(path[s], path[s + 1], r.cell_box(i)));
+      const bool in = std::binary_search(cells.begin(), cells.end(), i);
+      // Crossed for more than rounding of the cell's faces: must be in; not touched at all: must not.
+      if (longest > 1e-9 * r.cell_size().minCoeff() && !in) ++missed;
+      if (longest < 0.0 && in) ++stray;
+    }
+    CHECK(missed == 0);
+    CHECK(stray == 0);
+  };
+  // The campaign's segment on sim-1's grid.
+  check(Box{{0, 0, 0}, {100, 100, 40}}, I(32, 32, 32), {V(21.75, 25.25, 6.25), V(22.25, 25.75, 5.75)});
+  // Random polylines on grids of unequal cells, some points outside the bounds (clamped).
+  miner::Rng rng(14, 0);
+  for (int trial = 0; trial < 40; ++trial) {
+    const I dims(1 + static_cast<int>(rng.uniform_index(12)), 1 + static_cast<int>(rng.uniform_index(12)),
+                 1 + static_cast<int>(rng.uniform_index(6)));
+    const Box bounds{{-1, 2, 0}, {7, 5, 3}};
+    std::vector<V> path;
+    for (int k = 0; k < 4; ++k) path.emplace_back(rng.uniform(-1, 7), rng.uniform(2, 5), rng.uniform(0, 3));
+    INFO("trial " << trial);
+    check(bounds, dims, path);
+  }
+}
+
 TEST_CASE("A region must match the map's bounds and hold at least one cell", "[REQ-PLAN-008]") {
   const auto map = miner::testing::wall_with_door_map();  // bounds [0,10] x [0,10] x [0,3]
   const HeuristicRegion wrong = two_cells();

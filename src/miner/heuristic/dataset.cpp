@@ -17,6 +17,7 @@
 #include "miner/core/rng.hpp"
 #include "miner/core/sha256.hpp"
 #include "miner/core/shard.hpp"
+#include "miner/core/text.hpp"
 #include "miner/heuristic/grid.hpp"
 #include "miner/plan/heuristic_region.hpp"
 #include "miner/world/astar.hpp"
@@ -327,6 +328,13 @@ Sample make_sample(const DatasetOptions& o, std::uint64_t k) {
   if (!path) {  // the generator's own query is solvable by construction
     s.start = map.query()->start;
     s.goal = map.query()->goal;
+    // ... but it must keep min_separation too (fourteenth campaign L4: asked 0.9 of the
+    // diagonal, a sample 0.842 apart came back).
+    if ((s.goal - s.start).norm() < min_distance)
+      throw Error("dataset: sample " + std::to_string(k) + ": no free, connected start and goal " +
+                  short_number(o.min_separation) + " of the map's diagonal apart in " + std::to_string(kMaxQueryAttempts) +
+                  " draws, and the map's own query is " + short_number((s.goal - s.start).norm() / (b.max - b.min).norm()) +
+                  " of it: lower min_separation");
     path = world::astar(map, grid, s.start, s.goal);
   }
   s.astar_cost = path->cost;

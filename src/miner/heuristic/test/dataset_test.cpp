@@ -195,6 +195,24 @@ TEST_CASE("Regions connect through faces, edges and corners only", "[REQ-HEUR-00
   CHECK(heuristic::solid_cells_in(m, env) == 1);
 }
 
+TEST_CASE("A sample keeps its start and goal min_separation of the diagonal apart or is refused", "[REQ-HEUR-002][REQ-HEUR-003]") {
+  // Fourteenth campaign L4: asked 0.9 and 0.99 of the diagonal, sample 0 of sim came back 0.842
+  // apart (the map's own query, taken when the draws found none).
+  auto o = small_options();
+  o.preset = "sim";
+  for (const double separation : {0.0, 0.5, 0.8, 0.9, 0.99}) {
+    o.min_separation = separation;
+    INFO("min_separation " << separation);
+    try {
+      const heuristic::Sample s = heuristic::make_sample(o, 0);
+      CHECK((s.goal - s.start).norm() >= separation * (s.bounds.max - s.bounds.min).norm());
+    } catch (const miner::Error& e) {
+      CHECK_THAT(e.what(), Contains("sample 0: no free, connected start and goal") && Contains("lower min_separation"));
+      CHECK(separation > 0.8);  // the draws and the map's own query (0.842) meet 0.8
+    }
+  }
+}
+
 TEST_CASE("A sample's state marks 3x3x3 cubes at start and goal and its target is a connected region between them",
           "[REQ-HEUR-002]") {
   const auto o = small_options();

@@ -481,8 +481,15 @@ Json merge_dataset_parts(const std::vector<std::string>& parts, const std::strin
   std::set<std::string> names;  // every file of the merged folder, once
   for (int sp = 0; sp < 3; ++sp) {
     const char* split = kSplits[sp];
-    std::vector<std::pair<std::string, Json>> shards;  // file name -> shard record, from every part
+    struct PartShard {
+      std::string file;
+      Json record;
+      std::size_t part, at, count;  // the part, its place in that part's list, its samples
+      std::size_t number = 0;       // n of the file name <split>-n.bin
+    };
+    std::vector<PartShard> shards;  // from every part
     std::vector<Json> index;
+    std::vector<std::pair<Json, std::size_t>> index_of;  // each part's entries, with the part
     std::set<std::uint64_t> ks;
     for (std::size_t p = 0; p < parts.size(); ++p) {
       const SplitLayout& S = layouts[p].splits[sp];
@@ -493,19 +500,66 @@ Json merge_dataset_parts(const std::vector<std::string>& parts, const std::strin
                       r.file + "\" is named by another part or split too");
         // A truncated, padded or altered shard is refused, not copied (issue 20).
         files.emplace_back(r.file, read_shard(parts[p], r, layouts[p].cells));
-        shards.emplace_back(r.file, docs[p]["splits"][split]["shards"][i]);
+        shards.push_back({r.file, docs[p]["splits"][split]["shards"][i], p, i, r.count});
       }
-      for (Json& e : read_index(parts[p], S, layouts[p].seed)) {
-        if (!ks.insert(e["k"].get<std::uint64_t>()).second)
-          throw Error(parts[p] + "/" + S.index + ": sample k = " + e["k"].dump() + " appears in two parts");
-        index.push_back(std::move(e));
-      }
+      for (Json& e : read_index(parts[p], S, layouts[p].seed)) index_of.emplace_back(std::move(e), p);
     }
-    std::sort(shards.begin(), shards.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    // The shards are the generator's, in its order: shard n of the split is named
+    // shard_name(split, n), every shard but the last holds the same count, and shard n holds
+    // the split's samples n x size onward (fourteenth campaign C1: a renamed shard sorted
+    // elsewhere and misaligned every sample with the index; C7: a part made with another
+    // --shard-size was blamed as a repeated sample).
+    const auto where = [&](const PartShard& sh) {
+      return parts[sh.part] + "/dataset.json: splits." + split + ".shards[" + std::to_string(sh.at) + "]";
+    };
+    const std::string prefix = std::string(split) + "-";
+    for (PartShard& sh : shards) {
+      const std::string digits = sh.file.size() == prefix.size() + 9 && sh.file.rfind(prefix, 0) == 0
+                                     ? sh.file.substr(prefix.size(), 5) : std::string();
+      const bool numbered = digits.size() == 5 && std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; });
+      if (!numbered || sh.file != shard_name(split, std::stoul(digits)))
+        throw Error(where(sh) + ".file: \"" + sh.file + "\" is not a generator's shard name (" + shard_name(split, 0) +
+                    ", " + shard_name(split, 1) + ", ...): shards are named by their place in the split");
+      sh.number = std::stoul(digits);
+    }
+    std::sort(shards.begin(), shards.end(), [](const auto& a, const auto& b) { return a.number < b.number; });
+    const std::size_t size = shards.empty() ? 0 : shards.front().count;
+    for (std::size_t n = 0; n < shards.size(); ++n) {
+      const PartShard& sh = shards[n];
+      if (sh.number != n)
+        throw Error(where(sh) + ".file: \"" + sh.file + "\" follows no shard " + shard_name(split, n) +
+                    " in any part: a shard is missing or renamed");
+      if (n + 1 < shards.size() ? sh.count != size : sh.count > size)
+        throw Error(where(sh) + ".count: " + std::to_string(sh.count) + " samples, where shard 0 (" +
+                    parts[shards.front().part] + ") holds " + std::to_string(size) +
+                    ": the parts were made with different --shard-size");
+    }
+    // Each part's index lists its shards' samples in order: sample j of shard n is the split's
+    // sample n x size + j.
+    std::uint64_t base = UINT64_MAX;
+    for (const auto& [e, p] : index_of) base = std::min(base, e["k"].get<std::uint64_t>());
+    std::vector<std::size_t> next_entry(parts.size(), 0);
+    std::vector<std::vector<const Json*>> by_part(parts.size());
+    for (const auto& [e, p] : index_of) by_part[p].push_back(&e);
+    for (const PartShard& sh : shards)
+      for (std::size_t j = 0; j < sh.count; ++j) {
+        const std::size_t at = next_entry[sh.part]++;
+        const std::uint64_t want = base + sh.number * size + j;
+        if (at >= by_part[sh.part].size() || (*by_part[sh.part][at])["k"].get<std::uint64_t>() != want)
+          throw Error(parts[sh.part] + "/" + layouts[sh.part].splits[sp].index + ": entry " + std::to_string(at) +
+                      " is not sample k = " + std::to_string(want) + ", sample " + std::to_string(j) + " of " + sh.file +
+                      " (shards of " + std::to_string(size) + "): the parts were made with different --shard-size, "
+                      "or the index was edited");
+      }
+    for (auto& [e, p] : index_of) {
+      if (!ks.insert(e["k"].get<std::uint64_t>()).second)
+        throw Error(parts[p] + "/" + layouts[p].splits[sp].index + ": sample k = " + e["k"].dump() + " appears in two parts");
+      index.push_back(std::move(e));
+    }
     std::sort(index.begin(), index.end(),
               [](const Json& a, const Json& b) { return a["k"].get<std::uint64_t>() < b["k"].get<std::uint64_t>(); });
     Json list = Json::array();
-    for (const auto& s : shards) list.push_back(s.second);
+    for (const auto& sh : shards) list.push_back(sh.record);
     doc["splits"][split]["shards"] = list;
     const std::size_t expected = layouts.front().splits[sp].count;
     if (index.size() != expected)

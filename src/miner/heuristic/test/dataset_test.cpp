@@ -414,7 +414,28 @@ TEST_CASE("A dataset folder that contradicts itself is refused naming the file a
           d[0]["map_seed"] = first["map_seed"];
         });
       },
-      "sample k = " + first["k"].dump() + " appears in two parts");
+      "/train-index.json: entry 0 is not sample k = ");
+  // Fourteenth campaign C1: a shard renamed (with its dataset.json entry) sorted elsewhere and
+  // misaligned every sample with the index; a number past a gap likewise.
+  for (const std::string name : {"weird.bin", "train-00007.bin"})
+    refused(
+        [&](const std::string& q0, const std::string&) {
+          fs::rename(q0 + "/train-00000.bin", q0 + "/" + name);
+          edit_json(q0 + "/dataset.json", [&](miner::Json& d) { d["splits"]["train"]["shards"][0]["file"] = name; });
+        },
+        name == "weird.bin" ? "splits.train.shards[0].file: \"weird.bin\" is not a generator's shard name"
+                            : "follows no shard train-00000.bin in any part: a shard is missing or renamed");
+  // C7: a part made with another --shard-size (here 1: its train-00001.bin holds sample 1,
+  // where part 0's shards of 2 put sample 2) is named with the setting, not as a repeated sample.
+  refused(
+      [&](const std::string&, const std::string& q1) {
+        auto other = o;
+        other.shard_size = 1;
+        other.shard_index = 1;
+        fs::remove_all(q1);
+        heuristic::write_dataset(other, q1, nullptr);
+      },
+      "the parts were made with different --shard-size");
   // Values the writer never writes (issue 20: each was read, and bench heuristic measured with
   // it): the format's own fields, the preset's radius, a sample twice in one index, a wrong map
   // seed, goal = start, a cost nothing could have measured.

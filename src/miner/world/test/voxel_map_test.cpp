@@ -286,7 +286,7 @@ TEST_CASE("A ray's direction is a unit vector and a clearance is asked within a 
 }
 
 TEST_CASE("A* refuses a grid built from another map: its path would ignore this map's obstacles",
-          "[REQ-LIB-003][REQ-WORLD-008]") {
+          "[REQ-LIB-003][REQ-WORLD-008][REQ-WORLD-012]") {
   // Tenth campaign L7: a grid of the empty map, same bounds and resolution, walked A* through
   // the wall of this one.
   const Map walls(Box{{0, 0, 0}, {10, 10, 10}}, 0.5, {Box{{4, 0, 0}, {6, 4, 10}}});

@@ -623,6 +623,10 @@ void verify_samples(const std::string& dir, const std::vector<Sample>& samples) 
     if (read.map_seed != made.map_seed || read.start != made.start || read.goal != made.goal ||
         read.astar_cost != made.astar_cost)
       throw Error(which + "its index entry (map_seed, start, goal or astar_cost)" + why);
+    // The bounds too: training reads sigma from them (REQ-HEUR-013; fourteenth campaign C5: a
+    // max of [101, 100, 40] for a 100 x 100 x 40 map passed).
+    if (read.bounds.min != made.bounds.min || read.bounds.max != made.bounds.max)
+      throw Error(which + "its index entry's bounds" + why);
     const std::vector<std::uint8_t>* got[] = {&read.environment, &read.state, &read.target, &read.passability};
     const std::vector<std::uint8_t>* want[] = {&made.environment, &made.state, &made.target, &made.passability};
     for (int c = 0; c < 4; ++c)

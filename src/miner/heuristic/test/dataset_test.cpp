@@ -646,6 +646,10 @@ TEST_CASE("A sample whose bytes differ from the generator's is refused naming th
   edited = test;
   edited[0].astar_cost += 1.0;
   CHECK_THROWS_WITH(heuristic::verify_samples(dir, edited), Contains("its index entry"));
+  // Fourteenth campaign C5: the bounds were not compared (training reads sigma from them).
+  edited = test;
+  edited[0].bounds.max.x() += 1.0;
+  CHECK_THROWS_WITH(heuristic::verify_samples(dir, edited), Contains("sample k = 4: its index entry's bounds"));
 }
 
 TEST_CASE("The validation split is the fraction rounded to whole samples, not truncated", "[REQ-HEUR-001]") {

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -71,6 +72,9 @@ struct SplitLayout {
   std::vector<ShardRecord> shards;  // those in this folder
   std::size_t samples_here = 0;     // their sum
 };
+/// [x, y, z] of an index entry read_index() has checked.
+Eigen::Vector3d vec3_of(const Json& a) { return {a[0].get<double>(), a[1].get<double>(), a[2].get<double>()}; }
+
 /// A sample's map bounds {"min": [x, y, z], "max": [x, y, z]}, min < max on every axis.
 world::Box index_bounds(const JsonField& f) {
   f.only_keys({"min", "max"});
@@ -541,6 +545,10 @@ Json merge_dataset_parts(const std::vector<std::string>& parts, const std::strin
     std::vector<std::size_t> next_entry(parts.size(), 0);
     std::vector<std::vector<const Json*>> by_part(parts.size());
     for (const auto& [e, p] : index_of) by_part[p].push_back(&e);
+    std::map<std::string, const std::string*> bytes_of;
+    for (const auto& f : files) bytes_of[f.first] = &f.second;
+    const Eigen::Vector3i dims = layouts.front().dims;
+    const std::size_t cells = layouts.front().cells;
     for (const PartShard& sh : shards)
       for (std::size_t j = 0; j < sh.count; ++j) {
         const std::size_t at = next_entry[sh.part]++;
@@ -550,6 +558,20 @@ Json merge_dataset_parts(const std::vector<std::string>& parts, const std::strin
                       " is not sample k = " + std::to_string(want) + ", sample " + std::to_string(j) + " of " + sh.file +
                       " (shards of " + std::to_string(size) + "): the parts were made with different --shard-size, "
                       "or the index was edited");
+        // The sample's S channel marks its index entry's start and goal cells (fourteenth
+        // campaign C1: another part's shard bytes, re-hashed, merged under this index).
+        const Json& e = *by_part[sh.part][at];
+        const world::Box b{vec3_of(e["bounds"]["min"]), vec3_of(e["bounds"]["max"])};
+        const auto* state = reinterpret_cast<const std::uint8_t*>(bytes_of.at(sh.file)->data()) +
+                            (j * kDatasetChannels + 1) * cells;
+        for (const char* end : {"start", "goal"}) {
+          const Eigen::Vector3i c = cell_of(b, dims, vec3_of(e[end]));
+          if (state[cell_index(dims, c.x(), c.y(), c.z())] != 1)
+            throw Error(parts[sh.part] + "/" + sh.file + ": sample " + std::to_string(j) + " (k = " + std::to_string(want) +
+                        "): its state channel does not mark the " + end + " cell of " + parts[sh.part] + "/" +
+                        layouts[sh.part].splits[sp].index + " entry " + std::to_string(at) +
+                        ": the shard holds other samples than its index");
+        }
       }
     for (auto& [e, p] : index_of) {
       if (!ks.insert(e["k"].get<std::uint64_t>()).second)

@@ -534,6 +534,16 @@ TEST_CASE("A dataset folder that contradicts itself is refused naming the file a
         edit_shard(q0, [&](std::string& b) { std::fill(b.begin() + 2 * cells, b.begin() + 3 * cells, '\0'); });
       },
       "sample 0 of the shard, channel target: marks no cell");
+  // Fourteenth campaign C1: a shard holding other samples than its index (here its two samples
+  // swapped), re-hashed, was merged; the state channel must mark each entry's start and goal.
+  refused(
+      [&](const std::string& q0, const std::string&) {
+        edit_shard(q0, [&](std::string& b) {
+          const std::size_t sample = 4 * cells;
+          std::swap_ranges(b.begin(), b.begin() + static_cast<std::ptrdiff_t>(sample), b.begin() + static_cast<std::ptrdiff_t>(sample));
+        });
+      },
+      "train-00000.bin: sample 0 (k = 0): its state channel does not mark the start cell");
 }
 
 TEST_CASE("Bad dataset options are refused naming the option", "[REQ-HEUR-003]") {

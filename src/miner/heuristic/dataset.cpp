@@ -540,8 +540,8 @@ Json merge_dataset_parts(const std::vector<std::string>& parts, const std::strin
     }
     // Each part's index lists its shards' samples in order: sample j of shard n is the split's
     // sample n x size + j.
-    std::uint64_t base = UINT64_MAX;
-    for (const auto& [e, p] : index_of) base = std::min(base, e["k"].get<std::uint64_t>());
+    std::uint64_t first_k = UINT64_MAX;
+    for (const auto& [e, p] : index_of) first_k = std::min(first_k, e["k"].get<std::uint64_t>());
     std::vector<std::size_t> next_entry(parts.size(), 0);
     std::vector<std::vector<const Json*>> by_part(parts.size());
     for (const auto& [e, p] : index_of) by_part[p].push_back(&e);
@@ -552,7 +552,7 @@ Json merge_dataset_parts(const std::vector<std::string>& parts, const std::strin
     for (const PartShard& sh : shards)
       for (std::size_t j = 0; j < sh.count; ++j) {
         const std::size_t at = next_entry[sh.part]++;
-        const std::uint64_t want = base + sh.number * size + j;
+        const std::uint64_t want = first_k + sh.number * size + j;
         if (at >= by_part[sh.part].size() || (*by_part[sh.part][at])["k"].get<std::uint64_t>() != want)
           throw Error(parts[sh.part] + "/" + layouts[sh.part].splits[sp].index + ": entry " + std::to_string(at) +
                       " is not sample k = " + std::to_string(want) + ", sample " + std::to_string(j) + " of " + sh.file +

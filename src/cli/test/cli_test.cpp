@@ -1556,7 +1556,7 @@ TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[RE
     doctor([](miner::Json& d) { d["lower_bound"] = 0.5 * d["lower_bound"].get<double>(); }, "is not |goal - start| = ");
     doctor([](miner::Json& d) { d["goal_radius"] = -1.0; }, "goal_radius: the goal radius must be >= 0 and finite");
     doctor([](miner::Json& d) { d["steer_step"] = 0.0; }, "steer_step: the steering step must be positive and finite");
-    doctor([](miner::Json& d) { d["region"]["cells"] = 1; }, "region.cells is 1 and");
+    doctor([](miner::Json& d) { d["region"]["cells"] = 1; }, "different campaigns: region.cells is 1 in the one");
     // Fifth campaign: a part of other --planners was called "incomplete".
     doctor([](miner::Json& d) {
       const std::string last = d["planners"].back()["planner"].get<std::string>();

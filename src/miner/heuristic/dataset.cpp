@@ -72,9 +72,6 @@ struct SplitLayout {
   std::vector<ShardRecord> shards;  // those in this folder
   std::size_t samples_here = 0;     // their sum
 };
-/// [x, y, z] of an index entry read_index() has checked.
-Eigen::Vector3d vec3_of(const Json& a) { return {a[0].get<double>(), a[1].get<double>(), a[2].get<double>()}; }
-
 /// A sample's map bounds {"min": [x, y, z], "max": [x, y, z]}, min < max on every axis.
 world::Box index_bounds(const JsonField& f) {
   f.only_keys({"min", "max"});
@@ -560,12 +557,13 @@ Json merge_dataset_parts(const std::vector<std::string>& parts, const std::strin
                       "or the index was edited");
         // The sample's S channel marks its index entry's start and goal cells (fourteenth
         // campaign C1: another part's shard bytes, re-hashed, merged under this index).
-        const Json& e = *by_part[sh.part][at];
-        const world::Box b{vec3_of(e["bounds"]["min"]), vec3_of(e["bounds"]["max"])};
+        const JsonField e(*by_part[sh.part][at], "[" + std::to_string(at) + "]",
+                          parts[sh.part] + "/" + layouts[sh.part].splits[sp].index);
+        const world::Box b = index_bounds(e.at("bounds"));
         const auto* state = reinterpret_cast<const std::uint8_t*>(bytes_of.at(sh.file)->data()) +
                             (j * kDatasetChannels + 1) * cells;
         for (const char* end : {"start", "goal"}) {
-          const Eigen::Vector3i c = cell_of(b, dims, vec3_of(e[end]));
+          const Eigen::Vector3i c = cell_of(b, dims, e.at(end).vec3());
           if (state[cell_index(dims, c.x(), c.y(), c.z())] != 1)
             throw Error(parts[sh.part] + "/" + sh.file + ": sample " + std::to_string(j) + " (k = " + std::to_string(want) +
                         "): its state channel does not mark the " + end + " cell of " + parts[sh.part] + "/" +

@@ -487,6 +487,13 @@ void require_cell_in_grid(const Eigen::Vector3i& c, const Eigen::Vector3i& dims,
                 std::to_string(dims.z()) + " grid");
 }
 
+void require_levels(const std::vector<std::uint8_t>& values, std::uint8_t max, const std::string& what) {
+  for (std::size_t v = 0; v < values.size(); ++v)
+    if (values[v] > max)
+      throw Error(what + " cell " + std::to_string(v) + " holds " + std::to_string(values[v]) + ", outside its levels 0.." +
+                  std::to_string(max));
+}
+
 std::vector<int> label_components(const std::vector<std::uint8_t>& mask, const Eigen::Vector3i& dims) {
   require_mask(mask, dims);
   std::vector<int> label(mask.size(), 0);

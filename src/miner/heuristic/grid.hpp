@@ -112,6 +112,10 @@ std::vector<std::uint8_t> encode_state(const world::Box& bounds, const Eigen::Ve
 /// the grid: the check of every function here that takes a cell.
 void require_cell_in_grid(const Eigen::Vector3i& c, const Eigen::Vector3i& dims, const std::string& what);
 
+/// Throws miner::Error "<what> cell i holds v, outside its levels 0..max" for the first value
+/// above max: the check of an encoded channel's levels (E 0..2, S 0..1, P 0..kPassAll).
+void require_levels(const std::vector<std::uint8_t>& values, std::uint8_t max, const std::string& what);
+
 /// Labels the 26-connected components of the cells with mask != 0: label 0 for cells
 /// outside the mask, 1.. for components in order of their lowest index.
 std::vector<int> label_components(const std::vector<std::uint8_t>& mask, const Eigen::Vector3i& dims);

@@ -41,15 +41,11 @@ void require_one_grid(const std::vector<float>& p, const std::vector<std::uint8_
   if (p.size() != n || env.size() != n || (!passability.empty() && passability.size() != n))
     throw Error("region filter: grids of different sizes");
   // Fourteenth campaign L5: E level 9 and NaN probabilities were taken silently.
-  for (std::size_t i = 0; i < n; ++i) {
-    if (env[i] > kSolid)
-      throw Error("region filter: E cell " + std::to_string(i) + " holds " + std::to_string(env[i]) + ", outside its levels 0..2");
+  require_levels(env, kSolid, "region filter: E");
+  require_levels(passability, kPassAll, "region filter: P");
+  for (std::size_t i = 0; i < n; ++i)
     if (!(p[i] >= 0.0F && p[i] <= 1.0F))
       throw Error("region filter: R cell " + std::to_string(i) + " is " + std::to_string(p[i]) + ", not a probability");
-    if (!passability.empty() && passability[i] > kPassAll)
-      throw Error("region filter: P cell " + std::to_string(i) + " holds " + std::to_string(passability[i]) +
-                  ", outside its bits 0..7");
-  }
   // Tenth campaign L4: a cell outside the grid corrupted the heap (filter_region) or read
   // outside it (widest_threshold).
   require_cell_in_grid(start_cell, dims, "region filter: the start cell");
@@ -91,12 +87,11 @@ bool chain_at(const std::vector<float>& p, const std::vector<std::uint8_t>& env,
   return false;
 }
 
-}  // namespace
-
-std::optional<float> widest_threshold(const std::vector<float>& p, const std::vector<std::uint8_t>& env,
-                                      const Eigen::Vector3i& dims, const Eigen::Vector3i& start_cell,
-                                      const Eigen::Vector3i& goal_cell, const std::vector<std::uint8_t>& passability) {
-  require_one_grid(p, env, passability, dims, start_cell, goal_cell);
+/// widest_threshold() on inputs require_one_grid() has checked (region_threshold() checks once
+/// and may search twice).
+std::optional<float> widest_chain(const std::vector<float>& p, const std::vector<std::uint8_t>& env,
+                                  const Eigen::Vector3i& dims, const Eigen::Vector3i& start_cell,
+                                  const Eigen::Vector3i& goal_cell, const std::vector<std::uint8_t>& passability) {
   const auto n = static_cast<std::size_t>(dims.prod());
   const std::size_t is = cell_index(dims, start_cell.x(), start_cell.y(), start_cell.z());
   const std::size_t ig = cell_index(dims, goal_cell.x(), goal_cell.y(), goal_cell.z());
@@ -129,6 +124,15 @@ std::optional<float> widest_threshold(const std::vector<float>& p, const std::ve
   return std::nullopt;
 }
 
+}  // namespace
+
+std::optional<float> widest_threshold(const std::vector<float>& p, const std::vector<std::uint8_t>& env,
+                                      const Eigen::Vector3i& dims, const Eigen::Vector3i& start_cell,
+                                      const Eigen::Vector3i& goal_cell, const std::vector<std::uint8_t>& passability) {
+  require_one_grid(p, env, passability, dims, start_cell, goal_cell);
+  return widest_chain(p, env, dims, start_cell, goal_cell, passability);
+}
+
 double region_threshold(const std::vector<float>& p, const std::vector<std::uint8_t>& env, const Eigen::Vector3i& dims,
                         const Eigen::Vector3i& start_cell, const Eigen::Vector3i& goal_cell, double threshold,
                         bool widest, const std::vector<std::uint8_t>& passability) {
@@ -140,10 +144,10 @@ double region_threshold(const std::vector<float>& p, const std::vector<std::uint
   const std::size_t ig = cell_index(dims, goal_cell.x(), goal_cell.y(), goal_cell.z());
   // Most queries: the fixed threshold's cells already hold a chain (a search of those alone).
   if (env[is] != kSolid && env[ig] != kSolid && chain_at(p, env, passability, dims, is, ig, threshold)) return threshold;
-  std::optional<float> w = widest_threshold(p, env, dims, start_cell, goal_cell, passability);
+  std::optional<float> w = widest_chain(p, env, dims, start_cell, goal_cell, passability);
   // P is decided on sub-cells: a door narrower than one may leave no chain through it; then
   // the chain is sought without P.
-  if (!w && !passability.empty()) w = widest_threshold(p, env, dims, start_cell, goal_cell);
+  if (!w && !passability.empty()) w = widest_chain(p, env, dims, start_cell, goal_cell, {});
   if (!w) return threshold;
   // A chain whose weakest cell the network rates below kWidestFloor is no evidence (the
   // sigmoid's saturated tail, down to exactly 0, which no region threshold may be): the

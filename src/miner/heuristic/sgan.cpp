@@ -688,14 +688,6 @@ void require_finite_input(const std::vector<float>& values, const char* name) {
                   ", not a finite number");
 }
 
-/// The encoded channels' levels (REQ-HEUR-002): E in 0..2, S in 0..1, P in 0..kPassAll.
-void require_levels(const std::vector<std::uint8_t>& values, std::uint8_t max, const char* name) {
-  for (std::size_t v = 0; v < values.size(); ++v)
-    if (values[v] > max)
-      throw Error(std::string("sgan: ") + name + " cell " + std::to_string(v) + " holds " + std::to_string(values[v]) +
-                  ", outside its levels 0.." + std::to_string(max));
-}
-
 constexpr const char* kWeightsOverflow = "the weights overflow a layer (check the file's tensors)";
 
 }  // namespace
@@ -822,9 +814,10 @@ std::vector<float> Sgan::predict(const std::vector<std::uint8_t>& environment, c
   const int pc = g.arch.passability_channels;
   if (pc != 0 && passability.size() != n)
     throw Error("sgan: the network reads P: " + std::to_string(n) + " cells, given " + std::to_string(passability.size()));
-  require_levels(environment, kSolid, "E");
-  require_levels(state, 1, "S");
-  if (pc != 0) require_levels(passability, kPassAll, "P");
+  // The encoded channels' levels (REQ-HEUR-002).
+  require_levels(environment, kSolid, "sgan: E");
+  require_levels(state, 1, "sgan: S");
+  if (pc != 0) require_levels(passability, kPassAll, "sgan: P");
   if (g.arch.scale_channels != 0) g.set_scale(scale_input(bounds, g.arch.dims, robot_radius, g.arch.scale_divisor));
   const auto scale = static_cast<float>(g.arch.environment_scale);
   // N(0, 1) in voxel order (x fastest), one bulk draw of the query's stream.

@@ -116,6 +116,10 @@ void require_cell_in_grid(const Eigen::Vector3i& c, const Eigen::Vector3i& dims,
 /// above max: the check of an encoded channel's levels (E 0..2, S 0..1, P 0..kPassAll).
 void require_levels(const std::vector<std::uint8_t>& values, std::uint8_t max, const std::string& what);
 
+/// The index of the first value of p outside [0, 1] (NaN included), p.size() if every value is a
+/// probability: the check of R wherever a probability grid is taken or returned.
+std::size_t first_non_probability(const std::vector<float>& p);
+
 /// Labels the 26-connected components of the cells with mask != 0: label 0 for cells
 /// outside the mask, 1.. for components in order of their lowest index.
 std::vector<int> label_components(const std::vector<std::uint8_t>& mask, const Eigen::Vector3i& dims);

@@ -43,9 +43,8 @@ void require_one_grid(const std::vector<float>& p, const std::vector<std::uint8_
   // Fourteenth campaign L5: E level 9 and NaN probabilities were taken silently.
   require_levels(env, kSolid, "region filter: E");
   require_levels(passability, kPassAll, "region filter: P");
-  for (std::size_t i = 0; i < n; ++i)
-    if (!(p[i] >= 0.0F && p[i] <= 1.0F))
-      throw Error("region filter: R cell " + std::to_string(i) + " is " + std::to_string(p[i]) + ", not a probability");
+  if (const std::size_t i = first_non_probability(p); i != n)
+    throw Error("region filter: R cell " + std::to_string(i) + " is " + std::to_string(p[i]) + ", not a probability");
   // Tenth campaign L4: a cell outside the grid corrupted the heap (filter_region) or read
   // outside it (widest_threshold).
   require_cell_in_grid(start_cell, dims, "region filter: the start cell");
@@ -133,13 +132,13 @@ std::optional<float> widest_threshold(const std::vector<float>& p, const std::ve
   return widest_chain(p, env, dims, start_cell, goal_cell, passability);
 }
 
-double region_threshold(const std::vector<float>& p, const std::vector<std::uint8_t>& env, const Eigen::Vector3i& dims,
-                        const Eigen::Vector3i& start_cell, const Eigen::Vector3i& goal_cell, double threshold,
-                        bool widest, const std::vector<std::uint8_t>& passability) {
-  // Fourteenth campaign L5: a NaN threshold came back as the threshold (filter_region refuses it).
-  if (std::isnan(threshold)) throw Error("region filter: threshold must be a number, got nan");
-  if (!widest) return threshold;
-  require_one_grid(p, env, passability, dims, start_cell, goal_cell);
+namespace {
+
+/// region_threshold() on inputs require_one_grid() has checked, with the widest-chain rule.
+double widest_rule_threshold(const std::vector<float>& p, const std::vector<std::uint8_t>& env,
+                             const Eigen::Vector3i& dims, const Eigen::Vector3i& start_cell,
+                             const Eigen::Vector3i& goal_cell, double threshold,
+                             const std::vector<std::uint8_t>& passability) {
   const std::size_t is = cell_index(dims, start_cell.x(), start_cell.y(), start_cell.z());
   const std::size_t ig = cell_index(dims, goal_cell.x(), goal_cell.y(), goal_cell.z());
   // Most queries: the fixed threshold's cells already hold a chain (a search of those alone).
@@ -155,11 +154,10 @@ double region_threshold(const std::vector<float>& p, const std::vector<std::uint
   return std::min(threshold, std::max(static_cast<double>(*w), kWidestFloor));
 }
 
-FilteredRegion filter_region(const std::vector<float>& p, const std::vector<std::uint8_t>& env,
-                             const Eigen::Vector3i& dims, const Eigen::Vector3i& start_cell,
-                             const Eigen::Vector3i& goal_cell, double threshold) {
-  require_one_grid(p, env, {}, dims, start_cell, goal_cell);
-  if (std::isnan(threshold)) throw Error("region filter: threshold must be a number, got nan");
+/// filter_region() on inputs require_one_grid() has checked and a threshold that is a number.
+FilteredRegion filter_checked(const std::vector<float>& p, const std::vector<std::uint8_t>& env,
+                              const Eigen::Vector3i& dims, const Eigen::Vector3i& start_cell,
+                              const Eigen::Vector3i& goal_cell, double threshold) {
   const auto n = static_cast<std::size_t>(dims.prod());
   FilteredRegion out;
   FilterReport& r = out.report;
@@ -253,6 +251,31 @@ FilteredRegion filter_region(const std::vector<float>& p, const std::vector<std:
   return out;
 }
 
+/// Fourteenth campaign L5: a NaN threshold came back as the threshold (region_threshold) or
+/// kept no cell (filter_region).
+void require_threshold(double threshold) {
+  if (std::isnan(threshold)) throw Error("region filter: threshold must be a number, got nan");
+}
+
+}  // namespace
+
+double region_threshold(const std::vector<float>& p, const std::vector<std::uint8_t>& env, const Eigen::Vector3i& dims,
+                        const Eigen::Vector3i& start_cell, const Eigen::Vector3i& goal_cell, double threshold,
+                        bool widest, const std::vector<std::uint8_t>& passability) {
+  require_threshold(threshold);
+  if (!widest) return threshold;
+  require_one_grid(p, env, passability, dims, start_cell, goal_cell);
+  return widest_rule_threshold(p, env, dims, start_cell, goal_cell, threshold, passability);
+}
+
+FilteredRegion filter_region(const std::vector<float>& p, const std::vector<std::uint8_t>& env,
+                             const Eigen::Vector3i& dims, const Eigen::Vector3i& start_cell,
+                             const Eigen::Vector3i& goal_cell, double threshold) {
+  require_one_grid(p, env, {}, dims, start_cell, goal_cell);
+  require_threshold(threshold);
+  return filter_checked(p, env, dims, start_cell, goal_cell, threshold);
+}
+
 HeuristicQuery query_region(const Sgan& sgan, const world::Map& map, const Eigen::Vector3d& start,
                             const Eigen::Vector3d& goal, double robot_radius, std::uint64_t seed, bool filter,
                             bool strict) {
@@ -281,10 +304,14 @@ HeuristicQuery query_region(const Sgan& sgan, const world::Map& map, const Eigen
   const double inference_ms = elapsed_ms(t0);
   t0 = std::chrono::steady_clock::now();
   const Eigen::Vector3i start_cell = cell_of(b, dims, start), goal_cell = cell_of(b, dims, goal);
+  // One check of the grids for the two steps below (each public step checks its own inputs).
+  require_one_grid(prob, env, encoded.passability, dims, start_cell, goal_cell);
+  require_threshold(arch.threshold);
   const double threshold =
-      region_threshold(prob, env, dims, start_cell, goal_cell, arch.threshold, arch.threshold_rule == ThresholdRule::kWidest,
-                       encoded.passability);
-  FilteredRegion f = filter_region(prob, env, dims, start_cell, goal_cell, threshold);
+      arch.threshold_rule == ThresholdRule::kWidest
+          ? widest_rule_threshold(prob, env, dims, start_cell, goal_cell, arch.threshold, encoded.passability)
+          : arch.threshold;
+  FilteredRegion f = filter_checked(prob, env, dims, start_cell, goal_cell, threshold);
   std::vector<Eigen::Vector3d> witness;
   if (filter && strict) {
     StrictBridgeReport s = strict_bridge(map, robot_radius, dims, env, f.mask, start, goal);

@@ -673,10 +673,10 @@ namespace {
 /// such cells silently and leave a 2-cell region (issue 20), so the answer is checked before it
 /// is returned.
 std::vector<float> checked_probabilities(const std::string& path, std::vector<float> r, const char* cause) {
-  for (std::size_t v = 0; v < r.size(); ++v)
-    if (!(r[v] >= 0.0F && r[v] <= 1.0F))
-      throw Error(path + ": the network's output at cell " + std::to_string(v) + " is " + std::to_string(r[v]) +
-                  ", not a probability: " + cause);
+  const std::size_t v = first_non_probability(r);
+  if (v != r.size())
+    throw Error(path + ": the network's output at cell " + std::to_string(v) + " is " + std::to_string(r[v]) +
+                ", not a probability: " + cause);
   return r;
 }
 

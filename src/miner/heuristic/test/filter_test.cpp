@@ -363,3 +363,31 @@ TEST_CASE("Fourteenth campaign: grid region filter and network calls refuse what
     CHECK_THROWS_WITH(net.predict(E, S, P, bounds, 0.2, rng), Contains("P cell 6 holds 255"));
   }
 }
+
+TEST_CASE("The level and probability checks name the first offending cell anywhere in a grid of many check blocks",
+          "[REQ-LIB-003][REQ-HEUR-002][REQ-HEUR-007]") {
+  using Catch::Matchers::Equals;
+  // Session 35 made the checks branch-free per block of cells (the query checks its grids
+  // several times); an offender in any block, at either end of one, or in a short last block is
+  // still found, and the first of two is the one named.
+  constexpr std::size_t kCells = 3 * 4096 + 17;
+  for (const std::size_t at : {std::size_t{0}, std::size_t{4095}, std::size_t{4096}, std::size_t{8191}, kCells - 1}) {
+    std::vector<std::uint8_t> levels(kCells, heuristic::kSolid);
+    CHECK_NOTHROW(heuristic::require_levels(levels, heuristic::kSolid, "E"));
+    levels[at] = 3;
+    if (at + 5 < kCells) levels[at + 5] = 7;
+    CHECK_THROWS_WITH(heuristic::require_levels(levels, heuristic::kSolid, "E"),
+                      Equals("E cell " + std::to_string(at) + " holds 3, outside its levels 0..2"));
+    std::vector<float> p(kCells, 1.0f);
+    p[1] = 0.0f;
+    CHECK(heuristic::first_non_probability(p) == kCells);
+    for (const float bad : {std::numeric_limits<float>::quiet_NaN(), -1e-9f, 1.0000001f,
+                            std::numeric_limits<float>::infinity()}) {
+      p[at] = bad;
+      if (at + 3 < kCells) p[at + 3] = -5.0f;
+      CHECK(heuristic::first_non_probability(p) == at);
+      p[at] = 0.5f;
+    }
+  }
+  CHECK(heuristic::first_non_probability({}) == 0);
+}

@@ -118,7 +118,7 @@ void add_heuristic_commands(CLI::App& app, std::ostream& out) {
   d->add_option("--shard", o->shard, "i/N: write only part i of N (shard files j with j % N == i); join with --merge")
       ->check(kShard);
   d->add_option("--merge", o->merge, "join these part folders (made with --shard) into --out instead of generating");
-  d->add_option("--out", o->out, "output folder (written as a whole)")->required()->check(output_folder_for(FolderMarker{"dataset.json", heuristic::kDatasetFormat}, {".json", ".bin"}));
+  d->add_option("--out", o->out, "output folder (written as a whole)")->required()->check(output_folder_for(heuristic::dataset_folder_marker(), {".json", ".bin"}));
   d->add_flag("--json", o->json, "print the summary as JSON");
   d->callback([o, d, &out] {
     if (!o->merge.empty()) {

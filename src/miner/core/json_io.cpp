@@ -461,7 +461,9 @@ std::string folder_marker_problem(const std::string& path, const FolderMarker& m
       format.clear();
     }
   }
-  if (format == marker.format) return {};
+  if (format == marker.format ||
+      std::find(marker.earlier_formats.begin(), marker.earlier_formats.end(), format) != marker.earlier_formats.end())
+    return {};
   return path + ": the folder holds " + marker.file + ", which is not a \"" + marker.format + "\" file (" +
          (format.empty() ? std::string("no such \"format\"") : "format \"" + format + "\"") + ")" + not_ours;
 }

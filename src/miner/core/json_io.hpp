@@ -128,11 +128,15 @@ void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& 
 /// marker.file, a JSON object whose "format" is marker.format (issue 20, seventh campaign D1: a
 /// user's own summary.json, by its name alone, let `fly --out` replace the folder). Where
 /// by_name_fallback is set (figure folders written before they carried a manifest), a folder
-/// without marker.file is judged by the names rule above.
+/// without marker.file is judged by the names rule above. A marker of one of
+/// marker.earlier_formats counts as the command's output too (a dataset of the previous format
+/// is regenerated in place).
 struct FolderMarker {
   std::string file;
   std::string format;
   bool by_name_fallback = false;
+  /// Earlier formats of the same output (an older miner's folder), replaced like marker.format.
+  std::vector<std::string> earlier_formats = {};
 };
 void write_folder_atomic(const std::string& path, const std::vector<std::pair<std::string, std::string>>& files,
                          const FolderMarker& marker = {});

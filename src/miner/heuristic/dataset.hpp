@@ -16,7 +16,8 @@
 /// encoding while a 3D convolution over 32^3 stays within the 5 ms CPU budget of the
 /// issue (~0.45 GFLOP per 16->16 channel layer, ../shared/anchors.md).
 ///
-/// Layout on disk (`miner-dataset-v2`; v1 had no P): DIR/dataset.json describes everything; each split
+/// Layout on disk (`miner-dataset-v3`; v2 had no hash of the index files, v1 no P): DIR/dataset.json
+/// describes everything, with the SHA-256 of every shard and index file; each split
 /// (train, val, test) is a series of shards `<split>-NNNNN.bin`, each the raw bytes of
 /// uint8[n][4][nz][ny][nx] (channel order E, S, T, P; x fastest), readable with
 /// numpy.fromfile(..., dtype=uint8).reshape(n, 4, nz, ny, nx); DIR/<split>-index.json
@@ -41,8 +42,11 @@
 
 namespace miner::heuristic {
 
-inline constexpr const char* kDatasetFormat = "miner-dataset-v2";
+inline constexpr const char* kDatasetFormat = "miner-dataset-v3";
 inline constexpr std::size_t kDatasetChannels = 4;  ///< E, S, T, P
+/// What marks a dataset folder `miner dataset` may replace: dataset.json of this format or an
+/// earlier one (v1, v2: read no more, regenerated in place).
+FolderMarker dataset_folder_marker();
 
 struct DatasetOptions {
   std::string preset = "sim";

@@ -20,6 +20,7 @@ Writes OUT/sgan.bin (weights, miner-tensors-v1), OUT/reference.bin (inputs and o
 the first validation samples, for the C++ agreement test) and OUT/metrics.json.
 """
 import argparse
+import hashlib
 import json
 import math
 import os
@@ -121,8 +122,9 @@ def load_split(data, split, pool=1):
         raise SystemExit(f"train: {path} not found (make one with `miner dataset`)")
     with open(path) as f:
         meta = json.load(f)
-    if meta.get("format") != "miner-dataset-v2":
-        raise SystemExit(f"train: {data}/dataset.json is not a miner-dataset-v2 folder")
+    if meta.get("format") != "miner-dataset-v3":
+        raise SystemExit(f"train: {data}/dataset.json is not a miner-dataset-v3 folder "
+                         "(v2 had no hash of its index files: generate it again)")
     nx, ny, nz = meta["dims"]
     ch = len(meta["channels"])  # E, S, T, P
     parts = []
@@ -131,11 +133,17 @@ def load_split(data, split, pool=1):
         raw = np.fromfile(path, dtype=np.uint8)
         if raw.size != shard["count"] * ch * nx * ny * nz:
             raise SystemExit(f"train: {path} is truncated")
+        if hashlib.sha256(raw.tobytes()).hexdigest() != shard["sha256"]:
+            raise SystemExit(f"train: {path}: its SHA-256 differs from the one dataset.json records")
         parts.append(raw.reshape(shard["count"], ch, nz, ny, nx))
     x = np.concatenate(parts) if parts else np.zeros((0, ch, nz, ny, nx), np.uint8)
     index_path = os.path.join(data, meta["splits"][split]["index"])
-    with open(index_path) as f:
-        index = json.load(f)
+    with open(index_path, "rb") as f:
+        index_bytes = f.read()
+    # The index is hashed in dataset.json like the shards (REQ-HEUR-001): an edited one is refused.
+    if hashlib.sha256(index_bytes).hexdigest() != meta["splits"][split].get("index_sha256"):
+        raise SystemExit(f"train: {index_path}: its SHA-256 differs from the one dataset.json records")
+    index = json.loads(index_bytes)
     if len(index) != len(x) or any("bounds" not in e for e in index):
         raise SystemExit(f"train: {index_path} must hold one entry with the map's bounds per sample "
                          "(a dataset written before the bounds were recorded: generate it again)")

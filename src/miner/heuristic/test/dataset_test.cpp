@@ -351,10 +351,21 @@ TEST_CASE("A dataset folder that contradicts itself is refused naming the file a
   heuristic::write_dataset(o, p1, nullptr);  // train-00001 (1 sample)
   heuristic::merge_dataset_parts({p0, p1}, root + "/honest");
   CHECK(heuristic::read_split(root + "/honest", "train").size() == 3);
+  // Edits a JSON file of a part; an index edited this way gets its hash in dataset.json
+  // recomputed, as a deliberate editor would, so the checks behind the hash are reached.
   const auto edit_json = [](const std::string& path, const auto& change) {
     miner::Json d = miner::read_json_file(path);
     change(d);
-    miner::write_file_atomic(path, miner::dump_json(d));
+    const std::string bytes = miner::dump_json(d);
+    miner::write_file_atomic(path, bytes);
+    const fs::path file(path);
+    const std::string name = file.filename().string(), suffix = "-index.json";
+    if (name.size() > suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0) {
+      const std::string layout = (file.parent_path() / "dataset.json").string();
+      miner::Json doc = miner::read_json_file(layout);
+      doc["splits"][name.substr(0, name.size() - suffix.size())]["index_sha256"] = miner::sha256_hex(bytes);
+      miner::write_file_atomic(layout, miner::dump_json(doc));
+    }
   };
   int n = 0;
   // Copies the honest parts, breaks the copy, and expects the merge to refuse it naming `what`
@@ -456,6 +467,33 @@ TEST_CASE("A dataset folder that contradicts itself is refused naming the file a
       {[](miner::Json& d) { d[0]["astar_cost"] = 1e300; }, "over 1000 times the bounds' diagonal"}};
   for (const auto& [lie, what] : index_lies)
     refused([&](const std::string& q0, const std::string&) { edit_json(q0 + "/train-index.json", lie); }, what);
+  // Fourteenth campaign C5: an index edited in a part (an entry's bounds or start moved) merged
+  // unnoticed; dataset.json now records each index file's SHA-256 like each shard's.
+  const std::string moved = refused(
+      [&](const std::string& q0, const std::string&) {
+        miner::Json d = miner::read_json_file(q0 + "/train-index.json");
+        d[0]["bounds"]["max"][0] = d[0]["bounds"]["max"][0].get<double>() + 1.0;
+        miner::write_file_atomic(q0 + "/train-index.json", miner::dump_json(d));
+      },
+      "train-index.json: its SHA-256 differs from the one dataset.json records");
+  CHECK_THROWS_WITH(heuristic::read_split(moved, "train"), Contains("train-index.json: its SHA-256 differs"));
+  refused([&](const std::string& q0, const std::string&) {
+    edit_json(q0 + "/dataset.json", [](miner::Json& d) { d["splits"]["val"].erase("index_sha256"); });
+  }, "splits.val.index_sha256: missing required field");
+  refused([&](const std::string& q0, const std::string&) {
+    edit_json(q0 + "/dataset.json", [](miner::Json& d) { d["splits"]["val"]["index_sha256"] = "ABC"; });
+  }, "splits.val.index_sha256: expected 64 lower-case hex digits");
+  // A folder of the format before the hashes is named as such, not read with its index unchecked.
+  refused([&](const std::string& q0, const std::string&) {
+    edit_json(q0 + "/dataset.json", [](miner::Json& d) { d["format"] = "miner-dataset-v2"; });
+  }, "\"miner-dataset-v2\" was written by an earlier miner (v1 had no channel P, v2 no hash of its index files)");
+  // The merged folder's index files are hashed too: what merges reads back (the honest merge
+  // above), and its dataset.json names the merged index's hash, not a part's.
+  {
+    const miner::Json merged = miner::read_json_file(root + "/honest/dataset.json");
+    CHECK(merged["splits"]["train"]["index_sha256"] == miner::sha256_hex(read_bytes(root + "/honest/train-index.json")));
+    CHECK(merged["splits"]["train"]["index_sha256"] != miner::read_json_file(p0 + "/dataset.json")["splits"]["train"]["index_sha256"]);
+  }
   // An index that does not match its shards.
   refused(
       [&](const std::string& q0, const std::string&) {
@@ -544,6 +582,25 @@ TEST_CASE("A dataset folder that contradicts itself is refused naming the file a
         });
       },
       "train-00000.bin: sample 0 (k = 0): its state channel does not mark the start cell");
+}
+
+TEST_CASE("A dataset folder of an earlier format is regenerated in place, a user's folder is not replaced",
+          "[REQ-HEUR-001]") {
+  // miner-dataset-v3 (session 35) hashes the index files; a v2 folder is read no more, so the
+  // natural fix, `miner dataset --out` over it, must be allowed.
+  const auto o = small_options();
+  const std::string dir = temp_dir() + "/earlier";
+  heuristic::write_dataset(o, dir, nullptr);
+  miner::Json doc = miner::read_json_file(dir + "/dataset.json");
+  doc["format"] = "miner-dataset-v2";
+  miner::write_file_atomic(dir + "/dataset.json", miner::dump_json(doc));
+  CHECK_THROWS_WITH(heuristic::read_split(dir, "train"), Contains("written by an earlier miner"));
+  CHECK_NOTHROW(heuristic::write_dataset(o, dir, nullptr));
+  CHECK(miner::read_json_file(dir + "/dataset.json")["format"] == heuristic::kDatasetFormat);
+  CHECK(heuristic::read_split(dir, "train").size() == 3);
+  doc["format"] = "my-own-notes";
+  miner::write_file_atomic(dir + "/dataset.json", miner::dump_json(doc));
+  CHECK_THROWS_WITH(heuristic::write_dataset(o, dir, nullptr), Contains("is not an earlier output of this command"));
 }
 
 TEST_CASE("Bad dataset options are refused naming the option", "[REQ-HEUR-003]") {

@@ -39,15 +39,26 @@ std::vector<double> stage_values(const FrontendBenchResult& r, const std::string
   for (const auto& run : r.runs) {
     if (run.planner != planner) continue;
     const auto& stage = target ? run.result.target : run.result.first;
+    // A counter OMPL does not report (RRTConnect's iterations) is NaN, not kUnknownCount's
+    // 1.8e19 (the suite's tables printed "18446744073709551616 ± 0").
     if (!stage) v.push_back(std::numeric_limits<double>::infinity());
-    else v.push_back(time ? stage->time_ms : static_cast<double>(stage->iteration));
+    else if (time) v.push_back(stage->time_ms);
+    else v.push_back(stage->iteration == kUnknownCount ? std::numeric_limits<double>::quiet_NaN()
+                                                       : static_cast<double>(stage->iteration));
   }
   return v;
 }
 
 /// "mean ± sd" over the runs that got there, and "median [q1, q3]" over all runs with a
 /// miss as +inf ("miss" where a quantile lands on one).
+bool any_uncounted(const std::vector<double>& v) {
+  return std::any_of(v.begin(), v.end(), [](double x) { return std::isnan(x); });
+}
+/// Written in place of an iteration figure the planner does not count.
+constexpr const char* kUncounted = "not counted by the planner";
+
 std::string mean_sd(const std::vector<double>& v, int digits) {
+  if (any_uncounted(v)) return kUncounted;
   std::vector<double> reached;
   for (double x : v)
     if (std::isfinite(x)) reached.push_back(x);
@@ -56,6 +67,7 @@ std::string mean_sd(const std::vector<double>& v, int digits) {
 }
 std::string median_iqr(const std::vector<double>& v, int digits) {
   if (v.empty()) return "—";
+  if (any_uncounted(v)) return kUncounted;
   const auto q = [&](double p) {
     const double x = quantile(v, p);
     return std::isfinite(x) ? f(x, digits) : std::string("miss");
@@ -440,7 +452,8 @@ std::string suite_markdown(const SuiteBenchResult& r, const std::string& figure_
       if (!s) continue;
       const auto fi = stage_values(fr, p, false, false), ft = stage_values(fr, p, false, true);
       const auto ti = stage_values(fr, p, true, false), tt = stage_values(fr, p, true, true);
-      md << "| " << planner_label(p) << " | " << s->runs << " | " << reached(fi) << "/" << s->runs << " | "
+      // Reached counts come from the times, which every planner reports.
+      md << "| " << planner_label(p) << " | " << s->runs << " | " << reached(ft) << "/" << s->runs << " | "
          << mean_sd(fi, 0) << " | " << median_iqr(fi, 0) << " | " << median_iqr(ft, 2) << " | " << reached(tt) << "/"
          << s->runs << " | " << median_iqr(ti, 0) << " | " << mean_sd(tt, 2) << " | " << median_iqr(tt, 2) << " |\n";
     }

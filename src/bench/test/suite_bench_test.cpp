@@ -161,6 +161,25 @@ TEST_CASE("The suite runs every planner at every step and reports spread, n and 
   CHECK(figures.count("tiny-0.1-target.svg") == 1);  // steps named by 6 significant digits (seventh campaign W4)
   CHECK_THAT(svg, Contains("n=4, 4 missed"));
 
+  // A planner that does not count iterations (OMPL's RRTConnect: kUnknownCount) has them
+  // written as not counted, not as 2^64 (docs/suite.md printed "18446744073709551616 ± 0"), and
+  // its first solutions still count as reached.
+  auto uncounted = r;
+  const std::string who = o.planners.front();
+  int solved = 0;
+  for (auto& run : uncounted.cells[0].result.runs)
+    if (run.planner == who && run.result.first) {
+      ++solved;
+      run.result.first->iteration = kUnknownCount;
+      if (run.result.target) run.result.target->iteration = kUnknownCount;
+    }
+  REQUIRE(solved > 0);
+  const std::string md_uncounted = suite_markdown(uncounted, "suite");
+  CHECK(md_uncounted.find("18446744073709551616") == std::string::npos);
+  CHECK(md_uncounted.find("1.8e+19") == std::string::npos);
+  CHECK_THAT(md_uncounted, Contains("| `" + who + "` | 4 | " + std::to_string(solved) +
+                                   "/4 | not counted by the planner | not counted by the planner | "));
+
   // Same seed, same records (time fields aside), OMPL's included.
   const auto again = run_suite_bench(o, "test", nullptr);
   CHECK(untimed(to_json(again)) == untimed(to_json(r)));

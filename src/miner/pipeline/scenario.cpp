@@ -141,11 +141,14 @@ void read_scenario_fields(const JsonField& root, const std::string& origin, cons
       for (Eigen::Index i = 0; i < s.waypoints->rows(); ++i)
         route.emplace_back(s.waypoints->row(i).transpose(), "waypoints[" + std::to_string(i) + "]");
     route.emplace_back(s.goal, "goal");
-    constexpr double kCoincident = 1e-9;  // m: closer points are one point
+    // m: closer points are one point. The reference's ends are checked to 1e-6 (m, m/s,
+    // m/s^2), so a leg shorter than that has no trajectory those checks can tell from a point
+    // (fifteenth campaign F3: a 1e-9 m route was refused as "must start and end at rest").
+    constexpr double kCoincident = 1e-6;
     for (std::size_t i = 1; i < route.size(); ++i)
-      if ((route[i].first - route[i - 1].first).norm() <= kCoincident)
+      if ((route[i].first - route[i - 1].first).norm() < kCoincident)
         root.fail(route[i].second + " " + format_point(route[i].first) + " coincides with " + route[i - 1].second +
-                  ": remove the repeated point");
+                  " (closer than " + short_number(kCoincident) + " m): remove the repeated point");
   }
   if (root.has("trajectory")) {
     const JsonField t = root.at("trajectory");
@@ -487,11 +490,23 @@ Scenario load_scenario(const std::string& path) {
 
 namespace {
 
-/// Sampling step for the limit checks: 1 ms resolves every polynomial of these orders
-/// on segments of tenths of seconds and more.
+/// Sampling step of the thrust and tilt envelope check (the v_max / a_max checks use
+/// exact_extremes): 1 ms resolves every polynomial of these orders on segments of tenths of
+/// seconds and more.
 constexpr double kLimitSampleStep = 1e-3;
-/// A trajectory may exceed v_max / a_max by this relative amount (sampling, rounding).
+/// A trajectory may exceed v_max / a_max by this relative amount (the peaks' rounding).
 constexpr double kLimitSlack = 1e-6;
+/// Whether sampled peaks v, a break the limits beyond kLimitSlack: the one test of a reference's
+/// limits, used where a reference is built and where it is checked before flying (fifteenth
+/// campaign F3: the builder stretched time only past sqrt(a / a_max) > 1 + kLimitSlack, which
+/// let a exceed a_max (1 + kLimitSlack) by up to 2e-6 relative, and the check then refused the
+/// reference it had just built).
+/// v and a are exact_extremes(): a 1 ms sampling of a 0.4 s reference missed its peaks by
+/// ~1e-5 relative, more than kLimitSlack, and the peak sampled after a time stretch differed.
+bool exceeds_limits(double v, double a, const traj::Limits& limits) {
+  return v > limits.v_max * (1 + kLimitSlack) || a > limits.a_max * (1 + kLimitSlack);
+}
+
 /// Start/end states must match to this (m, m/s, m/s^2).
 constexpr double kEndpointTolerance = 1e-6;
 
@@ -595,8 +610,8 @@ ReferencePlan build_reference(const Scenario& s) {
     for (int i = 0; i < m; ++i) r.path.row(i) = r.trajectory.evaluate_segment(i, 0.0).transpose();
     r.path.row(m) = r.trajectory.evaluate(r.trajectory.total_duration()).transpose();
     require_flight_length(s, r.trajectory, true);
-    const auto [v, a] = traj::trajectory_extremes(r.trajectory, kLimitSampleStep);
-    if (v > s.limits.v_max * (1 + kLimitSlack) || a > s.limits.a_max * (1 + kLimitSlack))
+    const auto [v, a] = traj::exact_extremes(r.trajectory);
+    if (exceeds_limits(v, a, s.limits))
       throw Error(s.origin + ": trajectory file: maximum speed " + std::to_string(v) + " m/s and acceleration " +
                   std::to_string(a) + " m/s^2 exceed the limits v_max " + std::to_string(s.limits.v_max) +
                   ", a_max " + std::to_string(s.limits.a_max));
@@ -687,9 +702,11 @@ ReferencePlan build_reference(const Scenario& s) {
     r.trajectory = std::move(repaired.trajectory);
     r.path = std::move(repaired.waypoints);
     require_flight_length(s, r.trajectory);
-    const auto [v, a] = traj::trajectory_extremes(r.trajectory, kLimitSampleStep);
-    const double k = std::max({1.0, v / s.limits.v_max, std::sqrt(a / s.limits.a_max)});
-    if (k > 1.0 + kLimitSlack) {
+    const auto [v, a] = traj::exact_extremes(r.trajectory);
+    if (exceeds_limits(v, a, s.limits)) {
+      // Stretching time by k divides v by k and a by k^2; the extra (1 + kLimitSlack) leaves
+      // room for the peaks' rounding, so the check below and check_reference() pass.
+      const double k = std::max({1.0, v / s.limits.v_max, std::sqrt(a / s.limits.a_max)});
       r.time_scale = k * (1.0 + kLimitSlack);
       traj::scale_time(r.trajectory, r.time_scale);
       require_flight_length(s, r.trajectory);
@@ -698,7 +715,7 @@ ReferencePlan build_reference(const Scenario& s) {
   }
   check_reference_ends(s, r.trajectory);
   check_envelope(s, r.trajectory);
-  const auto [v, a] = traj::trajectory_extremes(r.trajectory, kLimitSampleStep);
+  const auto [v, a] = traj::exact_extremes(r.trajectory);
   r.max_speed = v;
   r.max_acceleration = a;
   return r;
@@ -711,8 +728,8 @@ void check_reference(const Scenario& s, const ReferencePlan& reference) {
   const traj::PolynomialTrajectory& t = reference.trajectory;
   check_reference_ends(s, t);
   require_flight_length(s, t, reference.source == "file");
-  const auto [v, a] = traj::trajectory_extremes(t, kLimitSampleStep);
-  if (v > s.limits.v_max * (1 + kLimitSlack) || a > s.limits.a_max * (1 + kLimitSlack))
+  const auto [v, a] = traj::exact_extremes(t);
+  if (exceeds_limits(v, a, s.limits))
     throw Error(s.origin + ": the reference's maximum speed " + short_number(v) + " m/s and acceleration " +
                 short_number(a) + " m/s^2 exceed the scenario's trajectory.v_max " + short_number(s.limits.v_max) +
                 " m/s, a_max " + short_number(s.limits.a_max) + " m/s^2: build the reference from this scenario");

@@ -21,6 +21,7 @@
 #include "miner/pipeline/run_folder.hpp"
 #include "miner/pipeline/scenario.hpp"
 #include "miner/traj/problem_io.hpp"
+#include "miner/traj/time_allocation.hpp"
 #include "miner/testing/flight_scenarios.hpp"
 
 using Catch::Matchers::Contains;
@@ -254,7 +255,7 @@ TEST_CASE("Bad scenarios are refused before flight with the fault named", "[REQ-
   doc = default_doc();
   doc["start"] = start;
   doc["goal"] = start;
-  expect_scenario_error(doc, "coincides with start: remove the repeated point");
+  expect_scenario_error(doc, "coincides with start (closer than 1e-06 m): remove the repeated point");
   doc = default_doc();
   doc["start"] = start;
   doc["waypoints"] = {start};
@@ -584,6 +585,35 @@ TEST_CASE("The pipeline owns the run folder: its files in order, the summary nam
   const miner::Json doc{{"map", "maps/m.json"}, {"vehicle", "v.json"}};
   CHECK(pipeline::run_folder_conflict("/data/maps", doc, "/data").value_or("") == "/data/maps/m.json");
   CHECK_FALSE(pipeline::run_folder_conflict("/data/runs/a", doc, "/data").has_value());
+}
+
+TEST_CASE("A reference built for a scenario holds its limits at their exact peaks and passes its own check",
+          "[REQ-FLIGHT-007][REQ-TRAJ-010]") {
+  // Fifteenth campaign F3: short routes (1 cm: a peak of 0.500002 for a_max 0.5) and a 0.5 m
+  // route with a_max 2.14 got references whose 1 ms samples passed the builder's stretch test
+  // and failed check_reference, so `miner fly` refused the reference it had just built; a
+  // 1e-9 m route was refused as "must start and end at rest".
+  const Eigen::Vector3d start(1.05, 1.4, 1.4);
+  const std::vector<std::pair<double, double>> cases{{1e-5, 0.5}, {1e-2, 0.5}, {0.1, 0.5}, {0.5, 2.14}, {0.5, 2.39}};
+  for (const auto& [separation, a_max] : cases) {
+    INFO("separation " << separation << " m, a_max " << a_max);
+    miner::Json doc = default_doc();
+    doc["start"] = {start.x(), start.y(), start.z()};
+    doc["goal"] = {start.x(), start.y() + separation, start.z()};
+    doc["trajectory"]["a_max"] = a_max;
+    const pipeline::Scenario s = pipeline::scenario_from_json(doc, "s.json", kScenarios);
+    const pipeline::ReferencePlan ref = pipeline::build_reference(s);
+    CHECK_NOTHROW(pipeline::check_reference(s, ref));
+    const auto [v, a] = miner::traj::exact_extremes(ref.trajectory);
+    CHECK(v <= s.limits.v_max * (1.0 + 1e-6));
+    CHECK(a <= s.limits.a_max * (1.0 + 1e-6));
+    CHECK(ref.max_speed == v);
+    CHECK(ref.max_acceleration == a);
+  }
+  miner::Json doc = default_doc();
+  doc["start"] = {start.x(), start.y(), start.z()};
+  doc["goal"] = {start.x() + 1e-9, start.y(), start.z()};
+  expect_scenario_error(doc, "coincides with start (closer than 1e-06 m)");
 }
 
 TEST_CASE("A reference flies only in the scenario it was built for", "[REQ-FLIGHT-007]") {

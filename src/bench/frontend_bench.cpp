@@ -610,11 +610,16 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
     tags.push_back(parts[p].at("shard"));
   }
   require_complete_parts(tags, names, "merge: the campaign");
+  // The parts' times summed in shard order, not argument order (fifteenth campaign F6: the
+  // merged total_s differed in its last digit with the order of the files, "any order").
+  std::vector<std::pair<int, double>> part_seconds;
+  for (const auto& part : parts) part_seconds.emplace_back(part.at("shard").at("index").get<int>(), part.at("total_s").get<double>());
+  std::sort(part_seconds.begin(), part_seconds.end());
   double total_s = 0.0;
+  for (const auto& [index, seconds] : part_seconds) total_s += seconds;
   nlohmann::json merged = parts.front();
   for (std::size_t p = 0; p < parts.size(); ++p) {
     const auto& part = parts[p];
-    total_s += part.at("total_s").get<double>();
     if (part.at("shard").at("index").get<int>() == 0) {
       merged["throughput"] = part.at("throughput");
       merged["region"] = part.at("region");

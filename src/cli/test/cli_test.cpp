@@ -16,6 +16,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "bench/frontend_bench.hpp"
 #include "bench/ompl_planners.hpp"
 #include "cli/cli.hpp"
 #include "miner/core/json_io.hpp"
@@ -1444,6 +1445,24 @@ TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[RE
     CHECK(b["region"] == shard0["region"]);
     CHECK(b["throughput"] == shard0["throughput"]);
   }
+  // The same bytes whatever the order of the parts (fifteenth campaign F6: total_s was summed
+  // in argument order; 0.1 + 0.2 + 0.3 and 0.3 + 0.2 + 0.1 differ in the last digit).
+  {
+    std::vector<miner::Json> docs;
+    const double seconds[] = {0.3, 0.1, 0.2};  // shards 2, 0, 1
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+      std::ifstream in(parts[i]);
+      std::stringstream text;
+      text << in.rdbuf();
+      docs.push_back(miner::parse_json(text.str(), parts[i]));
+      docs.back()["total_s"] = seconds[i];
+    }
+    const std::string forward = miner::bench::merge_frontend_shards(docs).dump();
+    std::swap(docs[0], docs[2]);
+    CHECK(miner::bench::merge_frontend_shards(docs).dump() == forward);
+    std::swap(docs[0], docs[1]);
+    CHECK(miner::bench::merge_frontend_shards(docs).dump() == forward);
+  }
   // A record that appears in two parts (a doctored or mis-copied shard) is refused by name.
   {
     std::ifstream in0(parts[1]), in1(parts[2]);
@@ -1632,7 +1651,12 @@ TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[RE
   const Run half = miner_cli({"dataset", "--merge", dir() + "/ds-1", "--out", dir() + "/ds-half"});
   CHECK(half.code == 1);
   CHECK_THAT(half.err, Contains("2 parts, got 1"));
-  CHECK(miner_cli({"dataset", "--merge", dir() + "/ds-full", "--out", dir() + "/ds-x"}).code == 1);
+  // A whole dataset merges on its own (fifteenth campaign F5: --shard 0/1 writes one), not
+  // beside a part.
+  CHECK(miner_cli({"dataset", "--merge", dir() + "/ds-full", "--out", dir() + "/ds-x"}).code == 0);
+  const Run mixed = miner_cli({"dataset", "--merge", dir() + "/ds-full", dir() + "/ds-1", "--out", dir() + "/ds-y"});
+  CHECK(mixed.code == 1);
+  CHECK_THAT(mixed.err, Contains("not a part folder"));
   CHECK_FALSE(std::filesystem::exists(dir() + "/ds-half"));
   // A truncated shard in a part is refused, naming it, not copied.
   std::filesystem::copy(dir() + "/ds-1", dir() + "/ds-1-cut", std::filesystem::copy_options::recursive);

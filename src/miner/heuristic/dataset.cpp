@@ -486,7 +486,12 @@ Json merge_dataset_parts(const std::vector<std::string>& parts, const std::strin
   for (const auto& p : parts) {
     docs.push_back(read_json_file(p + "/dataset.json"));
     layouts.push_back(read_layout(docs.back(), p + "/dataset.json"));
-    if (!layouts.back().is_part) throw Error(p + ": not a part folder (made without --shard)");
+    // A whole dataset (made without --shard, or with --shard 0/1, which writes the unsharded
+    // folder) is the one part of 1 (fifteenth campaign F5: an array job of N = 1 could not
+    // merge its own output); beside other parts it is not a part.
+    if (!layouts.back().is_part && parts.size() > 1)
+      throw Error(p + ": not a part folder (made without --shard, or with --shard 0/1): it is a whole dataset, "
+                  "merged only on its own");
   }
   const auto common = [](Json d) {
     d.erase("part");
@@ -503,7 +508,7 @@ Json merge_dataset_parts(const std::vector<std::string>& parts, const std::strin
     // campaign U21: "a part of a different dataset (options differ)").
     if (const std::string d = first_difference(common(docs[p]), base); !d.empty())
       throw Error(parts[p] + ": a part of a different dataset than " + parts.front() + ": " + d);
-    tags.push_back(docs[p]["part"]);
+    tags.push_back(layouts[p].is_part ? docs[p]["part"] : Json{{"index", 0}, {"count", 1}});
   }
   require_complete_parts(tags, parts, "dataset merge: the dataset");
   Json doc = docs.front();

@@ -141,6 +141,12 @@ HeuristicRegion HeuristicRegion::from_path(const world::Box& bounds, const Eigen
   HeuristicRegion region(bounds, dims,
                          std::vector<double>(cell_count(dims), 0.0),
                          1.0, std::move(source));
+  // A path lies in the region's bounds (fifteenth campaign F2: points outside were clamped onto
+  // border cells the path never touches, and coordinates near 1e17 lost the cells crossed).
+  for (std::size_t s = 0; s < path.size(); ++s)
+    if (!region.bounds_.contains(path[s]))
+      throw Error("region from path: point " + std::to_string(s) + " " + format_point(path[s]) +
+                  " lies outside the region's bounds " + format_point(bounds.min) + " - " + format_point(bounds.max));
   const Eigen::Vector3d cell = region.cell_size_;
   auto cell_of = [&](const Eigen::Vector3d& p) {
     Eigen::Vector3i c;

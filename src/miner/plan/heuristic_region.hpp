@@ -61,7 +61,8 @@ class HeuristicRegion {
   /// The "ground truth" region of the paper's dataset (Sec. V-A.1): every cell a path
   /// polyline passes through (an exact traversal: the pieces between its crossings of cell
   /// faces, and its points), dilated by `dilation` cells in each direction
-  /// (dilation 1 = the 3x3x3 cube around each path cell). Probabilities are 0 or 1.
+  /// (dilation 1 = the 3x3x3 cube around each path cell). Probabilities are 0 or 1. Throws
+  /// miner::Error for a path point that is not finite or lies outside the bounds.
   static HeuristicRegion from_path(const world::Box& bounds, const Eigen::Vector3i& dims,
                                    const std::vector<Eigen::Vector3d>& path, int dilation,
                                    std::string source);

@@ -603,6 +603,27 @@ TEST_CASE("A dataset folder of an earlier format is regenerated in place, a user
   CHECK_THROWS_WITH(heuristic::write_dataset(o, dir, nullptr), Contains("is not an earlier output of this command"));
 }
 
+TEST_CASE("A whole dataset (--shard 0/1) merges on its own into the same bytes", "[REQ-REPORT-006]") {
+  // Fifteenth campaign F5: `dataset --shard 0/1` wrote the unsharded folder, which `--merge`
+  // refused as "not a part folder", so an array job of N = 1 could not merge its own output.
+  const auto o = small_options();  // shard 0 of 1
+  const std::string whole = temp_dir() + "/whole", out = temp_dir() + "/whole-merged";
+  std::filesystem::remove_all(out);
+  heuristic::write_dataset(o, whole, nullptr);
+  heuristic::merge_dataset_parts({whole}, out);
+  for (const char* f : {"dataset.json", "train-00000.bin", "train-00001.bin", "val-00000.bin", "test-00000.bin",
+                        "train-index.json", "val-index.json", "test-index.json"})
+    CHECK(read_bytes(out + "/" + f) == read_bytes(whole + "/" + f));
+  // Beside a part it is not a part.
+  auto part = o;
+  part.shard_count = 2;
+  part.shard_index = 1;
+  const std::string p1 = temp_dir() + "/part-1-of-2";
+  heuristic::write_dataset(part, p1, nullptr);
+  CHECK_THROWS_WITH(heuristic::merge_dataset_parts({whole, p1}, temp_dir() + "/mixed"),
+                    Contains("whole: not a part folder (made without --shard, or with --shard 0/1)"));
+}
+
 TEST_CASE("Bad dataset options are refused naming the option", "[REQ-HEUR-003]") {
   auto o = small_options();
   o.count = 0;

@@ -134,6 +134,15 @@ TEST_CASE("The A*-dilated region covers the path and its 3x3x3 neighbourhood", "
   CHECK_FALSE(r1.contains(V(5, 2.5, 0.5)));
   CHECK_THROWS_WITH(HeuristicRegion::from_path(bounds, I(10, 10, 10), path, -1, "p"), Contains("dilation"));
   CHECK_THROWS_WITH(HeuristicRegion::from_path(bounds, I(10, 10, 10), {}, 1, "p"), Contains("no points"));
+  // Fifteenth campaign F2: a path outside the bounds was clamped onto border cells it never
+  // touches ((-5, 5.5, 5.5) -> (-1, 5.5, 5.5) gave cell (0, 5, 5)), and coordinates near 1e17
+  // lost the cells crossed; a path on the bounds' faces is inside.
+  for (const std::vector<V>& outside : {std::vector<V>{V(-5, 5.5, 5.5), V(-1, 5.5, 5.5)}, std::vector<V>{V(15, 5.5, 5.5)},
+                                        std::vector<V>{V(0.5, 0.5, 0.5), V(9.5, 9.5, 11)},
+                                        std::vector<V>{V(-1e17, 1, 1), V(1e17, 1, 1)}})
+    CHECK_THROWS_WITH(HeuristicRegion::from_path(bounds, I(10, 10, 10), outside, 0, "p"),
+                      Contains("lies outside the region's bounds"));
+  CHECK(HeuristicRegion::from_path(bounds, I(10, 10, 10), {V(0, 0, 0), V(10, 10, 10)}, 0, "p").cells().size() == 10);
 }
 
 TEST_CASE("The A*-dilated region holds exactly the cells a path passes through", "[REQ-PLAN-005][REQ-HEUR-002]") {

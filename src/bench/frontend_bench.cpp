@@ -391,11 +391,25 @@ void check_run_record(const JsonField& r, double lower_bound) {
       st.at("iteration").fail("comes after the run's last iteration " + r.at("iterations").value().dump());
     // Our planners' trees hold the root and at most one new vertex per iteration (seventh
     // campaign W3: 1e9 nodes at iteration 84 were averaged in). OMPL's may add batches.
+    // nodes counts the vertices besides the root: a solution found after iteration 0 ends at a
+    // vertex the run added (fifteenth campaign F7: first.nodes 0 at iteration 84 merged); only a
+    // start within the goal radius is solved at iteration 0 by the root alone.
+    if (ours && st.at("nodes").value().is_number_unsigned() && st.at("nodes").value().get<std::uint64_t>() == 0 &&
+        st.at("iteration").value().is_number_unsigned() && st.at("iteration").value().get<std::uint64_t>() > 0)
+      st.at("nodes").fail("0 vertices at iteration " + st.at("iteration").value().dump() + ": a solution of " +
+                          r.at("planner").string() + " after iteration 0 ends at a vertex the run added");
     if (ours && st.at("nodes").value().is_number_unsigned() && st.at("iteration").value().is_number_unsigned() &&
         st.at("nodes").value().get<std::uint64_t>() > st.at("iteration").value().get<std::uint64_t>() + 1)
       st.at("nodes").fail(st.at("nodes").value().dump() + " vertices at iteration " + st.at("iteration").value().dump() +
                           ": a tree of " + r.at("planner").string() + " holds its root and at most one vertex per iteration");
   }
+  // Our planners stop at the target cost (the campaign sets it): a run with a target stage ran
+  // no iteration after it (fifteenth campaign F7: 821 iterations after a target at 820 merged).
+  if (ours && !r.at("target").value().is_null() && r.at("target").at("iteration").value().is_number_unsigned() &&
+      r.at("iterations").value().is_number_unsigned() &&
+      r.at("iterations").value().get<std::uint64_t>() != r.at("target").at("iteration").value().get<std::uint64_t>())
+    r.at("iterations").fail(r.at("iterations").value().dump() + " iterations, but the target was reached at iteration " +
+                            r.at("target").at("iteration").value().dump() + " (a run stops at its target)");
   // The target is reached at or after the first solution: never at an earlier iteration, with
   // fewer vertices or sooner (ninth campaign recheck of C1: such records were merged).
   const JsonField first = r.at("first"), target = r.at("target");
@@ -458,8 +472,10 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
   // or a truncated file is named with the field at fault, not as "a different campaign".
   std::vector<std::string> names;
   std::vector<RunRecord> runs;  // every part's records, parsed once here
+  std::vector<std::size_t> first_run;  // part p's records are runs[first_run[p], first_run[p + 1])
   for (std::size_t p = 0; p < parts.size(); ++p) {
     names.push_back(p < files.size() ? files[p] : "shard file " + std::to_string(p + 1));
+    first_run.push_back(runs.size());
     const JsonField root(parts[p], "", names.back());
     if (!parts[p].is_object()) root.fail("expected the JSON of `miner bench frontend --shard i/N --json`");
     if (parts[p].contains("format"))
@@ -509,7 +525,13 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
     const double steer = root.at("steer_step").number(), goal_radius = root.at("goal_radius").number(),
                  robot_radius = root.at("robot_radius").number();
     if (!(std::isfinite(steer) && steer > 0.0)) root.at("steer_step").fail("the steering step must be positive and finite");
-    if (!(std::isfinite(goal_radius) && goal_radius >= 0.0)) root.at("goal_radius").fail("the goal radius must be >= 0 and finite");
+    // The ranges `bench frontend` takes (fifteenth campaign F7: a goal radius or a time limit of
+    // 0, which no campaign can run with, merged).
+    if (!(goal_radius >= kMinGoalRadius && goal_radius <= kMaxGoalRadius))
+      root.at("goal_radius").fail("the goal radius must be in [1e-6, 1e6] m (as --goal-radius)");
+    const double time_limit = root.at("time_limit_s").number();
+    if (!(time_limit >= kMinTimeLimitS && time_limit <= kMaxTimeLimitS))
+      root.at("time_limit_s").fail("the time limit must be in [0.001, 86400] s (as --time-limit)");
     if (!(std::isfinite(robot_radius) && robot_radius >= 0.0)) root.at("robot_radius").fail("the robot radius must be >= 0 and finite");
     const double reference = root.at("reference_cost").number();
     if (reference < lower * (1.0 - kRoundoff))
@@ -526,7 +548,18 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
       const JsonField r = records.at(k);
       r.only_keys({"planner", "run", "solved", "cost", "iterations", "first", "target"});
       (void)r.at("planner").string();
+      // A run number as a campaign writes it: an integer, not 1.0 (fifteenth campaign F7).
+      if (!r.at("run").value().is_number_integer()) r.at("run").fail("expected an integer run number, got " + r.at("run").value().dump());
       (void)r.at("run").integer();
+      // OMPL's planners stop at the time limit, checked every 64 termination calls: a stage
+      // found past twice the limit and a second is no run of this campaign (fifteenth campaign
+      // F7: a target at 20 s of a 10 s campaign merged). Ours stop on iterations only.
+      if (r.at("planner").string().rfind("ompl:", 0) == 0)
+        for (const char* stage : {"first", "target"})
+          if (r.has(stage) && r.at(stage).value().is_object() && r.at(stage).has("time_ms") &&
+              r.at(stage).at("time_ms").number() > kOmplOvershoot * 1000.0 * time_limit + 1000.0)
+            r.at(stage).at("time_ms").fail(r.at(stage).at("time_ms").value().dump() + " ms, past the campaign's time limit " +
+                                           root.at("time_limit_s").value().dump() + " s (OMPL's runs stop there)");
       // A cost is a path length: finite and >= 0 (issue 20: a cost of -5 was averaged in), never
       // below the campaign's lower bound (the straight line), never above the run's own first
       // solution (costs only fall); a run stops within the iteration budget.
@@ -573,6 +606,22 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
       } catch (const nlohmann::json::exception& e) {
         r.fail("malformed run record: " + json_error_text(e));
       }
+    }
+    // Shard 0 alone measures the throughput (when its iterations are > 0); other parts carry
+    // null rates (fifteenth campaign F7: rates in part 1, or null rates in part 0, merged).
+    {
+      const JsonField tp = root.at("throughput");
+      const bool measures = shard.at("index").integer() == 0 && tp.at("iterations").number() > 0;
+      if (measures && !tp.at("rrtstar_iterations_per_s").value().is_number())
+        tp.at("rrtstar_iterations_per_s").fail("null, but shard 0 of a campaign with throughput iterations measures it");
+      if (!measures)
+        for (const char* k : {"rrtstar_iterations_per_s", "ompl_rrtstar_iterations_per_s"})
+          if (!tp.at(k).value().is_null())
+            tp.at(k).fail("a rate, but only shard 0 of a campaign with throughput iterations > 0 measures one");
+      if (measures && tp.at("rrtstar_iterations_per_s").number() <= 0.0)
+        tp.at("rrtstar_iterations_per_s").fail("a rate must be > 0");
+      if (measures && tp.at("ompl_rrtstar_iterations_per_s").value().is_number() && tp.at("ompl_rrtstar_iterations_per_s").number() <= 0.0)
+        tp.at("ompl_rrtstar_iterations_per_s").fail("a rate must be > 0");
     }
   }
   // Everything but the per-shard fields must agree; the throughput check's iteration count is a
@@ -666,6 +715,21 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
       if (!seen.count({planner, run}))
         throw Error("merge: planner " + planner + " run " + std::to_string(run) + " has no record in any part (part " +
                     std::to_string(run % static_cast<int>(parts.size())) + " is incomplete)");
+  // Each part's summaries are what its own records give (fifteenth campaign F7: a summary
+  // edited to contradict the records merged; the merge recomputes them, but a part that
+  // contradicts itself is not a campaign's output). Checked after the records are known to be
+  // the campaign's, so a missing or foreign record is named as such.
+  first_run.push_back(runs.size());
+  for (std::size_t p = 0; p < parts.size(); ++p) {
+    const std::vector<RunRecord> own(runs.begin() + static_cast<std::ptrdiff_t>(first_run[p]),
+                                     runs.begin() + static_cast<std::ptrdiff_t>(first_run[p + 1]));
+    const JsonField planners = JsonField(parts[p], "", names[p]).at("planners");
+    for (std::size_t i = 0; i < planners.array_size(); ++i) {
+      const nlohmann::json want = summary_json(summarise(planners.at(i).at("planner").string(), own));
+      if (const std::string d = first_difference(parts[p]["planners"][i], want); !d.empty())
+        planners.at(i).fail("contradicts the part's own run_records (" + d + ")");
+    }
+  }
   const auto rank = [&](const std::string& planner) {
     return std::find(order.begin(), order.end(), planner) - order.begin();
   };

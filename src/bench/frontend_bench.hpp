@@ -33,7 +33,7 @@ struct FrontendBenchOptions {
   std::uint64_t seed = 1;
   double target_factor = 1.0;   ///< target cost = factor x A* reference cost
   std::size_t max_iterations = 200000;  ///< the project's planners (and OMPL's RRT*s)
-  double time_limit_s = 10.0;   ///< per run, every planner (wall clock, benchmark only)
+  double time_limit_s = 10.0;   ///< per run of OMPL's planners (wall clock); ours stop on max_iterations
   plan::PlannerOptions planner_options;  ///< steer step, goal radius, mu_1, mu_2, ...
   Eigen::Vector3i region_dims = plan::HeuristicRegion::default_dims();
   int region_dilation = 1;
@@ -48,6 +48,15 @@ struct FrontendBenchOptions {
   int shard_index = 0;
   int shard_count = 1;
 };
+
+/// The ranges `bench frontend` takes for --goal-radius and --time-limit, which `bench merge`
+/// checks in the parts too.
+inline constexpr double kMinGoalRadius = 1e-6, kMaxGoalRadius = 1e6;
+inline constexpr double kMinTimeLimitS = 1e-3, kMaxTimeLimitS = 86400.0;
+/// How far past its time limit an OMPL run may find a stage, as a factor of the limit (plus
+/// one second): OMPL's termination condition reads the clock every 64 calls and a planner's
+/// iteration (a BIT* batch) may run on after it.
+inline constexpr double kOmplOvershoot = 2.0;
 
 /// The front-end options a campaign of campaigns (`bench paper`, `bench suite`) runs each map
 /// with: its planners, runs, seed, limits and weights; no throughput check (it is Table I's).

@@ -143,14 +143,14 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   fc->add_option("--iterations,--max-iterations", f->bench.max_iterations, "iteration budget per run (as plan --iterations)")
       ->check(kIterationsRange)
       ->capture_default_str();
-  fc->add_option("--time-limit", f->bench.time_limit_s, "wall-clock cap per run in s")
-      ->check(finite_in(1e-3, 86400.0))
+  fc->add_option("--time-limit", f->bench.time_limit_s, "wall-clock cap per run of OMPL's planners in s (ours stop on --iterations)")
+      ->check(finite_in(bench::kMinTimeLimitS, bench::kMaxTimeLimitS))
       ->capture_default_str();
   // The same ranges as plan's (issue 20: 1e308 was accepted and printed with all its digits).
   fc->add_option("--step", f->bench.planner_options.steer_step, "steering step eta in m (default 0.1 x diagonal)")
       ->check(finite_in(1e-6, 1e6));
   fc->add_option("--goal-radius", f->bench.planner_options.goal_radius, "goal radius in m (default 2 x resolution)")
-      ->check(finite_in(1e-6, 1e6));
+      ->check(finite_in(bench::kMinGoalRadius, bench::kMaxGoalRadius));
   fc->add_flag("!--no-safeguard", f->bench.planner_options.safeguard,
                "miner, miner-sgan: the paper's fixed mu, without the safeguard (REQ-PLAN-020)");
   fc->add_option("--region", f->bench.region_file, "miner's region file (default: the A*-dilated region)");
@@ -257,8 +257,8 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   pc->add_option("--runs", p->bench.runs, "front-end runs per planner and map")->capture_default_str()
       ->check(kRunsRange);
   pc->add_option("--seed", p->bench.seed, "seed of every campaign")->capture_default_str()->check(kUnsigned64);
-  pc->add_option("--time-limit", p->bench.time_limit_s, "seconds per front-end run")->capture_default_str()
-      ->check(finite_in(1e-3, 86400.0));
+  pc->add_option("--time-limit", p->bench.time_limit_s, "wall-clock cap per front-end run of OMPL's planners in s")->capture_default_str()
+      ->check(finite_in(bench::kMinTimeLimitS, bench::kMaxTimeLimitS));
   pc->add_option("--iterations", p->bench.max_iterations, "front-end iteration budget")->capture_default_str()
       ->check(kIterationsRange);
   pc->add_option("--weights", p->bench.weights, "sGAN weights (default: the shipped ones)");
@@ -318,8 +318,8 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   sc->add_option("--runs", su->bench.runs, "runs per planner, map and steering step")->capture_default_str()
       ->check(kRunsRange);
   sc->add_option("--seed", su->bench.seed, "seed of every campaign")->capture_default_str()->check(kUnsigned64);
-  sc->add_option("--time-limit", su->bench.time_limit_s, "seconds per run")->capture_default_str()
-      ->check(finite_in(1e-3, 86400.0));
+  sc->add_option("--time-limit", su->bench.time_limit_s, "wall-clock cap per run of OMPL's planners in s")->capture_default_str()
+      ->check(finite_in(bench::kMinTimeLimitS, bench::kMaxTimeLimitS));
   sc->add_option("--iterations", su->bench.max_iterations, "iteration budget per run")->capture_default_str()
       ->check(kIterationsRange);
   sc->add_option("--weights", su->bench.weights, "sGAN weights (default: the shipped ones)");

@@ -1573,7 +1573,41 @@ TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[RE
         }
     }, ".first.nodes: expected a number, got null");
     doctor([](miner::Json& d) { d["lower_bound"] = 0.5 * d["lower_bound"].get<double>(); }, "is not |goal - start| = ");
-    doctor([](miner::Json& d) { d["goal_radius"] = -1.0; }, "goal_radius: the goal radius must be >= 0 and finite");
+    doctor([](miner::Json& d) { d["goal_radius"] = -1.0; }, "goal_radius: the goal radius must be in [1e-6, 1e6] m");
+    // Fifteenth campaign F7: values a campaign cannot produce, each one edit of a valid part.
+    doctor([](miner::Json& d) { d["goal_radius"] = 0.0; }, "goal_radius: the goal radius must be in [1e-6, 1e6] m");
+    doctor([](miner::Json& d) { d["time_limit_s"] = 0.0; }, "time_limit_s: the time limit must be in [0.001, 86400] s");
+    doctor([&](miner::Json& d) {
+      for (auto& r : d["run_records"])
+        if (r["planner"] == "rrtstar" && r["first"].is_object() && r["first"]["iteration"].get<std::uint64_t>() > 0) {
+          r["first"]["nodes"] = 0;
+          return;
+        }
+      FAIL("no rrtstar record solved after iteration 0");
+    }, "first.nodes: 0 vertices at iteration");
+    doctor([&](miner::Json& d) {
+      for (auto& r : d["run_records"])
+        if (r["planner"].get<std::string>().rfind("ompl:", 0) != 0 && r["target"].is_object() &&
+            r["target"]["iteration"].get<std::uint64_t>() < d["max_iterations"].get<std::uint64_t>()) {
+          r["iterations"] = r["target"]["iteration"].get<std::uint64_t>() + 1;
+          return;
+        }
+      FAIL("no record of our planners reached the target within the budget");
+    }, "(a run stops at its target)");
+    doctor([](miner::Json& d) { d["run_records"][0]["run"] = 1.0; }, "run: expected an integer run number, got 1.0");
+    doctor([](miner::Json& d) { d["planners"][0]["success_rate"] = 0.123; }, "planners[0]: contradicts the part's own run_records");
+    doctor([](miner::Json& d) { d["planners"][1]["runs"] = 7; }, "planners[1]: contradicts the part's own run_records");
+    doctor([](miner::Json& d) { d["throughput"]["rrtstar_iterations_per_s"] = 1000.0; },
+           "throughput.rrtstar_iterations_per_s: a rate, but only shard 0");
+    if (miner::bench::ompl_available())
+      doctor([&](miner::Json& d) {
+        for (auto& r : d["run_records"])
+          if (r["planner"] == "ompl:RRTConnect" && r["first"].is_object()) {
+            r["first"]["time_ms"] = 1e6;  // 1000 s in a campaign of 10 s per run
+            return;
+          }
+        FAIL("no solved ompl:RRTConnect record");
+      }, "first.time_ms: 1000000.0 ms, past the campaign's time limit");
     doctor([](miner::Json& d) { d["steer_step"] = 0.0; }, "steer_step: the steering step must be positive and finite");
     doctor([](miner::Json& d) { d["region"]["cells"] = 1; }, "different campaigns: region.cells is 1 in the one");
     // Fifth campaign: a part of other --planners was called "incomplete".

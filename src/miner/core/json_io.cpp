@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "miner/core/error.hpp"
+#include "miner/core/text.hpp"
 
 namespace miner {
 
@@ -590,6 +591,34 @@ std::optional<std::pair<std::size_t, std::size_t>> first_repeated(const std::vec
   return std::nullopt;
 }
 
-std::string dump_json(const Json& j) { return j.dump(2) + "\n"; }
+namespace {
+/// The JSON pointer and value of the first number of j that parse_json refuses to read back (a
+/// nonzero magnitude below the smallest normal double); an empty pointer if none. `at` is j's own.
+std::pair<std::string, double> first_unreadable_number(const Json& j, const std::string& at) {
+  if (j.is_number_float()) {
+    const double v = j.get<double>();
+    if (v != 0.0 && std::fabs(v) < std::numeric_limits<double>::min()) return {at.empty() ? "/" : at, v};
+  } else if (j.is_object()) {
+    for (const auto& [key, value] : j.items())
+      if (auto found = first_unreadable_number(value, at + "/" + key); !found.first.empty()) return found;
+  } else if (j.is_array()) {
+    for (std::size_t i = 0; i < j.size(); ++i)
+      if (auto found = first_unreadable_number(j[i], at + "/" + std::to_string(i)); !found.first.empty()) return found;
+  }
+  return {};
+}
+}  // namespace
+
+std::string dump_json(const Json& j, const std::string& origin) {
+  // What is written is read back (fifteenth campaign F10: a region threshold or an obstacle
+  // coordinate of 1e-310 was saved, and load() of the file refused it): a subnormal number,
+  // which parse_json refuses because it keeps too few digits to be read as written, is refused
+  // here, before any byte is written.
+  if (const auto [at, v] = first_unreadable_number(j, ""); !at.empty())
+    throw Error((origin.empty() ? std::string() : origin + ": ") + "cannot be written: the number at " + at + " (" +
+                short_number(v) + ") is below the smallest normal double (2.2e-308), which no reader takes back as "
+                "written: use 0");
+  return j.dump(2) + "\n";
+}
 
 }  // namespace miner

@@ -156,7 +156,10 @@ bool is_same_or_inside(const std::string& folder, const std::string& path);
 /// headers are read through it.
 bool is_decimal_number(const std::string& text);
 
-/// JSON text as the project writes it: 2-space indent, trailing newline.
-std::string dump_json(const Json& j);
+/// JSON text as the project writes it: 2-space indent, trailing newline. Throws miner::Error
+/// (prefixed with `origin` when given) naming the JSON pointer of a number parse_json would
+/// refuse to read back (nonzero, below the smallest normal double), so no writer saves a file
+/// its reader refuses.
+std::string dump_json(const Json& j, const std::string& origin = "");
 
 }  // namespace miner

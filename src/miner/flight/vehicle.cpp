@@ -33,9 +33,11 @@ void validate(const VehicleParams& v, const std::string& origin) {
   // that still refuse the absurd (issue 20: values near 1e308 flew).
   auto positive = [&](double x, const char* field, double hi) {
     if (!std::isfinite(x) || !(x > 0.0) || x > hi) {
+      // The value as written, every digit it needs (fifteenth campaign F13: 1000.001 was shown
+      // as "got 1000", in range to the eye).
       char text[160];
-      std::snprintf(text, sizeof text, "must be a finite number in (0, %g], got %g", hi, x);
-      bad(origin, field, text);
+      std::snprintf(text, sizeof text, "must be a finite number in (0, %g], got ", hi);
+      bad(origin, field, text + (std::isfinite(x) ? Json(x).dump() : std::string(std::isnan(x) ? "nan" : (x > 0 ? "inf" : "-inf"))));
     }
   };
   positive(v.mass, "mass_kg", 1000.0);

@@ -89,6 +89,7 @@ struct DatasetLayout {
   bool is_part = false;
   int part_index = 0, part_count = 1;
   std::uint64_t seed = 0;
+  int dilation = 0;
 };
 
 /// The fields of dataset.json that describe the format itself: written as they are, and a file
@@ -145,6 +146,7 @@ DatasetLayout read_layout(const Json& doc, const std::string& origin) {
   const int dilation = root.at("dilation").integer();
   if (dilation < 0 || dilation > plan::HeuristicRegion::kMaxDilation)
     root.at("dilation").fail("must be in [0, " + std::to_string(plan::HeuristicRegion::kMaxDilation) + "]");
+  L.dilation = dilation;
   const double separation = root.at("min_separation").number();
   if (!(separation >= 0.0 && separation < 1.0)) root.at("min_separation").fail("must be in [0, 1)");
   if (!root.at("seed").value().is_number_unsigned()) root.at("seed").fail("expected an integer in [0, 2^64 - 1]");
@@ -271,6 +273,89 @@ std::vector<Json> read_index(const std::string& dir, const SplitLayout& S, std::
   return out;
 }
 
+/// "cell (x, y, z)" of cell index i.
+std::string cell_name(const Eigen::Vector3i& dims, std::size_t i) {
+  const Eigen::Vector3i c = cell_coords(dims, i);
+  return "cell (" + std::to_string(c.x()) + ", " + std::to_string(c.y()) + ", " + std::to_string(c.z()) + ")";
+}
+
+/// The checks of REQ-HEUR-002 that a sample's own index entry and channels allow, without
+/// regenerating its map (fifteenth campaign F1: parts whose channels contradicted the index or
+/// REQ-HEUR-002, re-hashed, merged silently):
+///  - S is exactly encode_state(bounds, dims, start, goal, dilation): it is fixed by the entry;
+///  - E is not solid on the start or goal cell (both are free for the robot radius);
+///  - P is kPassAll on every free cell and 0 on every solid one (grid.hpp);
+///  - T holds the start and goal cells and no solid cell, and its cells are one 26-connected
+///    component (the A* path's cells joined by their free dilation).
+/// `grids` holds the sample's kDatasetChannels grids (E, S, T, P); `where` names the sample.
+/// Throws miner::Error naming the channel and the first offending cell.
+void check_sample_channels(const std::uint8_t* grids, const Eigen::Vector3i& dims, const world::Box& bounds,
+                           const Eigen::Vector3d& start, const Eigen::Vector3d& goal, int dilation,
+                           const std::string& where) {
+  const std::size_t cells = static_cast<std::size_t>(dims.prod());
+  const std::uint8_t* E = grids;
+  const std::uint8_t* S = grids + cells;
+  const std::uint8_t* T = grids + 2 * cells;
+  const std::uint8_t* P = grids + 3 * cells;
+  const auto fail = [&](const std::string& what) { throw Error(where + ": " + what); };
+  const std::vector<std::uint8_t> state = encode_state(bounds, dims, start, goal, dilation);
+  for (std::size_t i = 0; i < cells; ++i)
+    if (S[i] != state[i])
+      fail("channel state at " + cell_name(dims, i) + " holds " + std::to_string(S[i]) + ", where the " +
+           std::to_string(2 * dilation + 1) + "^3 cubes around its index entry's start and goal cells hold " +
+           std::to_string(state[i]) + " (REQ-HEUR-002): the channels are not this entry's sample");
+  for (std::size_t i = 0; i < cells; ++i) {
+    if (E[i] == kFree && P[i] != kPassAll)
+      fail("channel passability at " + cell_name(dims, i) + " holds " + std::to_string(P[i]) +
+           " on a free cell (free cells pass every axis, " + std::to_string(kPassAll) + ")");
+    if (E[i] == kSolid && P[i] != 0)
+      fail("channel passability at " + cell_name(dims, i) + " holds " + std::to_string(P[i]) +
+           " on a solid cell (solid cells pass no axis, 0)");
+    if (E[i] == kSolid && T[i] != 0)
+      fail("channel target at " + cell_name(dims, i) + " marks a solid cell (the target stays clear of solid cells, "
+           "REQ-HEUR-002)");
+  }
+  const std::size_t ends[2] = {[&] { const Eigen::Vector3i c = cell_of(bounds, dims, start); return cell_index(dims, c.x(), c.y(), c.z()); }(),
+                               [&] { const Eigen::Vector3i c = cell_of(bounds, dims, goal); return cell_index(dims, c.x(), c.y(), c.z()); }()};
+  const char* const end_names[2] = {"start", "goal"};
+  for (int e = 0; e < 2; ++e) {
+    if (E[ends[e]] == kSolid)
+      fail("channel environment marks the " + std::string(end_names[e]) + " " + cell_name(dims, ends[e]) +
+           " solid (start and goal are free for the robot radius, REQ-HEUR-002)");
+    if (T[ends[e]] != 1)
+      fail("channel target does not mark the " + std::string(end_names[e]) + " " + cell_name(dims, ends[e]) +
+           " (the target holds the start and goal cells, REQ-HEUR-002)");
+  }
+  // The path's cells are one 26-connected chain from start to goal inside T; every other T cell
+  // is a free cell of some path cell's (2D+1)^3 cube, so it lies within D cells (Chebyshev) of
+  // the start's component of T. (With D >= 2 a dilation cell may be cut off from the path by
+  // partial cells, so "T is one component" would be too strong.)
+  const std::vector<std::uint8_t> target(T, T + cells);
+  const std::vector<std::uint8_t> joined = component_of(target, dims, ends[0]);
+  if (!joined[ends[1]])
+    fail("channel target does not join the start " + cell_name(dims, ends[0]) + " to the goal " +
+         cell_name(dims, ends[1]) + " (26-connectivity; the target holds the A* path's cells, REQ-HEUR-002)");
+  // Chebyshev dilation of the component by D cells: a running window maximum per axis.
+  std::vector<std::uint8_t> near = joined, next(cells);
+  const int n[3] = {dims.x(), dims.y(), dims.z()};
+  const std::size_t stride[3] = {1, static_cast<std::size_t>(n[0]), static_cast<std::size_t>(n[0]) * n[1]};
+  for (int a = 0; a < 3 && dilation > 0; ++a) {
+    for (std::size_t i = 0; i < cells; ++i) {
+      const int at = static_cast<int>((i / stride[a]) % static_cast<std::size_t>(n[a]));
+      std::uint8_t v = 0;
+      for (int d = std::max(0, at - dilation); d <= std::min(n[a] - 1, at + dilation) && !v; ++d)
+        v = near[i - static_cast<std::size_t>(at) * stride[a] + static_cast<std::size_t>(d) * stride[a]];
+      next[i] = v;
+    }
+    near.swap(next);
+  }
+  for (std::size_t i = 0; i < cells; ++i)
+    if (T[i] && !near[i])
+      fail("channel target at " + cell_name(dims, i) + " lies more than the dilation (" + std::to_string(dilation) +
+           " cells) from the target's cells joined to the start " + cell_name(dims, ends[0]) +
+           " (the target is the A* path's cells and their dilation, REQ-HEUR-002)");
+}
+
 }  // namespace
 
 FolderMarker dataset_folder_marker() {
@@ -319,7 +404,7 @@ void validate(const DatasetOptions& o) {
                     std::to_string(o.shard_size) + ", and part " + std::to_string(o.shard_index) +
                     " takes the files j with j % " + std::to_string(o.shard_count) + " == " +
                     std::to_string(o.shard_index) + ": it would hold no sample (use at most " + std::to_string(files) +
-                    " parts, or a smaller --shard-size)",
+                    (files == 1 ? " part" : " parts") + (o.shard_size > 1 ? ", or a smaller --shard-size)" : ")"),
                 ExitCode::kUsage);
   if (!(o.min_separation >= 0.0 && o.min_separation < 1.0)) throw Error("dataset: min_separation must be in [0, 1)");
 }
@@ -590,21 +675,18 @@ Json merge_dataset_parts(const std::vector<std::string>& parts, const std::strin
                       " is not sample k = " + std::to_string(want) + ", sample " + std::to_string(j) + " of " + sh.file +
                       " (shards of " + std::to_string(size) + "): the parts were made with different --shard-size, "
                       "or the index was edited");
-        // The sample's S channel marks its index entry's start and goal cells (fourteenth
-        // campaign C1: another part's shard bytes, re-hashed, merged under this index).
+        // The sample's channels agree with its index entry and with REQ-HEUR-002 (fourteenth
+        // campaign C1: another part's shard bytes, re-hashed, merged under this index; fifteenth
+        // F1: T without its start cell, S all ones, P 0 on a free cell).
         const JsonField e(*by_part[sh.part][at], "[" + std::to_string(at) + "]",
                           parts[sh.part] + "/" + layouts[sh.part].splits[sp].index);
-        const world::Box b = index_bounds(e.at("bounds"));
-        const auto* state = reinterpret_cast<const std::uint8_t*>(bytes_of.at(sh.file)->data()) +
-                            (j * kDatasetChannels + 1) * cells;
-        for (const char* end : {"start", "goal"}) {
-          const Eigen::Vector3i c = cell_of(b, dims, e.at(end).vec3());
-          if (state[cell_index(dims, c.x(), c.y(), c.z())] != 1)
-            throw Error(parts[sh.part] + "/" + sh.file + ": sample " + std::to_string(j) + " (k = " + std::to_string(want) +
-                        "): its state channel does not mark the " + end + " cell of " + parts[sh.part] + "/" +
-                        layouts[sh.part].splits[sp].index + " entry " + std::to_string(at) +
-                        ": the shard holds other samples than its index");
-        }
+        check_sample_channels(reinterpret_cast<const std::uint8_t*>(bytes_of.at(sh.file)->data()) +
+                                  j * kDatasetChannels * cells,
+                              dims, index_bounds(e.at("bounds")), e.at("start").vec3(), e.at("goal").vec3(),
+                              layouts[sh.part].dilation,
+                              parts[sh.part] + "/" + sh.file + ": sample " + std::to_string(j) + " (k = " +
+                                  std::to_string(want) + ", " + parts[sh.part] + "/" + layouts[sh.part].splits[sp].index +
+                                  " entry " + std::to_string(at) + ")");
       }
     for (auto& [e, p] : index_of) {
       if (!ks.insert(e["k"].get<std::uint64_t>()).second)
@@ -728,6 +810,8 @@ std::vector<Sample> read_split(const std::string& dir, const std::string& split)
       sample.state.assign(base + L.cells, base + 2 * L.cells);
       sample.target.assign(base + 2 * L.cells, base + 3 * L.cells);
       sample.passability.assign(base + 3 * L.cells, base + 4 * L.cells);
+      check_sample_channels(base, L.dims, sample.bounds, sample.start, sample.goal, L.dilation,
+                            dir + "/" + r.file + ": sample " + std::to_string(s) + " (k = " + std::to_string(sample.k) + ")");
       out.push_back(std::move(sample));
     }
   }

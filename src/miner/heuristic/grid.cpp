@@ -31,7 +31,17 @@ Eigen::Vector3i cell_coords(const Eigen::Vector3i& dims, std::size_t index) {
 }
 
 Eigen::Vector3d cell_size(const world::Box& b, const Eigen::Vector3i& dims) {
-  return (b.max - b.min).cwiseQuotient(dims.cast<double>());
+  // Fifteenth campaign F9: zero-extent bounds gave NaN cells (cell_of cast NaN to int) and
+  // dims 0 a cell (-1, ..) "clamped onto the grid". Every helper that places cells reads the
+  // cell size here, so the grid is checked once here.
+  const Eigen::Vector3d c = (b.max - b.min).cwiseQuotient(dims.cast<double>());
+  if ((dims.array() < 1).any() || !(c.array() > 0.0).all() || !c.allFinite())
+    throw Error("grid of " + std::to_string(dims.x()) + " x " + std::to_string(dims.y()) + " x " +
+                std::to_string(dims.z()) + " cells over the bounds (" + short_number(b.min.x()) + ", " +
+                short_number(b.min.y()) + ", " + short_number(b.min.z()) + ") - (" + short_number(b.max.x()) + ", " +
+                short_number(b.max.y()) + ", " + short_number(b.max.z()) +
+                "): needs at least one cell per axis and bounds with max > min, finite, on every axis");
+  return c;
 }
 
 Eigen::Vector3i cell_of(const world::Box& b, const Eigen::Vector3i& dims, const Eigen::Vector3d& p) {

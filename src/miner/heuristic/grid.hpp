@@ -42,9 +42,12 @@ inline std::size_t cell_index(const Eigen::Vector3i& dims, int i, int j, int k) 
 }
 /// The (x, y, z) of cell `index`; throws miner::Error for an index past the grid.
 Eigen::Vector3i cell_coords(const Eigen::Vector3i& dims, std::size_t index);
+/// (bounds.max - bounds.min) / dims; throws miner::Error for a grid with no cells on an axis
+/// (dims < 1) or bounds that are not finite with max > min on every axis: the check of every
+/// helper here that places cells (cell_of, cell_box, the encoders).
 Eigen::Vector3d cell_size(const world::Box& bounds, const Eigen::Vector3i& dims);
 /// The cell holding p (clamped onto the grid for points on or beyond the bounds); throws
-/// miner::Error for a point that is not finite.
+/// miner::Error for a point that is not finite or a grid cell_size() refuses.
 Eigen::Vector3i cell_of(const world::Box& bounds, const Eigen::Vector3i& dims, const Eigen::Vector3d& p);
 /// The box of cell c; a c past the grid gives the box the grid's lattice puts there (the
 /// encoder reads cell edges per axis this way).

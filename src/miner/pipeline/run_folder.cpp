@@ -38,7 +38,7 @@ RunFolder::RunFolder(std::string dir, const Json& scenario_as_flown, const Scena
   files_.emplace_back("scenario.json", dump_json(scenario_as_flown));
   files_.emplace_back("map.json", dump_json(s.map->to_json()));
   if (reference.region) {
-    files_.emplace_back("region.json", reference.region->to_json().dump() + "\n");
+    files_.emplace_back("region.json", dump_json(reference.region->to_json()));
     path["planned"] = points(reference.planned_path);
     Json vertices = Json::array();
     for (const auto& v : reference.tree_vertices) vertices.push_back(vec3_json(v));

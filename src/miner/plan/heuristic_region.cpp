@@ -126,7 +126,7 @@ Json HeuristicRegion::to_json() const {
 }
 
 void HeuristicRegion::save(const std::string& path) const {
-  write_file_atomic(path, to_json().dump() + "\n");
+  write_file_atomic(path, dump_json(to_json(), path));
 }
 
 HeuristicRegion HeuristicRegion::from_path(const world::Box& bounds, const Eigen::Vector3i& dims,
@@ -255,18 +255,49 @@ std::vector<int> HeuristicRegion::hops_to(const Eigen::Vector3d& p) const {
 }
 
 double HeuristicRegion::length_fraction_inside(const std::vector<Eigen::Vector3d>& path) const {
+  // Checked (fifteenth campaign F8: a NaN point gave 0, a segment to x = 1e300 gave NaN and
+  // asked for ~1e300 steps): finite points, a finite total length; each segment is walked only
+  // over its part inside the bounds (no cell lies outside them), so the steps are bounded by
+  // the bounds' diagonal over the step, whatever the segment's length.
+  for (std::size_t s = 0; s < path.size(); ++s)
+    if (!path[s].allFinite())
+      throw Error("heuristic region: length_fraction_inside: path point " + std::to_string(s) + " " +
+                  format_point(path[s]) + " is not finite");
   const double step = 0.25 * cell_size_.minCoeff();
   double inside = 0.0, total = 0.0;
   for (std::size_t s = 1; s < path.size(); ++s) {
     const Eigen::Vector3d a = path[s - 1], d = path[s] - path[s - 1];
-    const double length = d.norm();
-    const int steps = std::max(1, static_cast<int>(std::ceil(length / step)));
-    int in = 0;
-    for (int t = 0; t < steps; ++t) in += contains(a + d * ((t + 0.5) / steps));
-    inside += length * in / steps;
+    // norm() squares the components (1e300 overflows); stableNorm() only where it must, so
+    // the usual lengths keep norm()'s rounding.
+    double length = d.norm();
+    if (!std::isfinite(length)) length = d.stableNorm();
+    if (!std::isfinite(length))
+      throw Error("heuristic region: length_fraction_inside: segment " + std::to_string(s - 1) + " from " +
+                  format_point(a) + " to " + format_point(path[s]) + " has no finite length");
     total += length;
+    if (length == 0.0) continue;
+    // The segment's parameter interval [lo, hi] inside the closed bounds (slab clipping).
+    double lo = 0.0, hi = 1.0;
+    for (int ax = 0; ax < 3 && lo <= hi; ++ax) {
+      if (d[ax] == 0.0) {
+        if (a[ax] < bounds_.min[ax] || a[ax] > bounds_.max[ax]) hi = -1.0;
+        continue;
+      }
+      double t0 = (bounds_.min[ax] - a[ax]) / d[ax], t1 = (bounds_.max[ax] - a[ax]) / d[ax];
+      if (t0 > t1) std::swap(t0, t1);
+      lo = std::max(lo, t0);
+      hi = std::min(hi, t1);
+    }
+    if (!(hi > lo)) continue;
+    const double part = length * (hi - lo);
+    const int steps = std::max(1, static_cast<int>(std::ceil(part / step)));
+    int in = 0;
+    for (int t = 0; t < steps; ++t) in += contains(a + d * (lo + (hi - lo) * (t + 0.5) / steps));
+    inside += part * in / steps;
   }
-  return total > 0.0 ? inside / total : 0.0;
+  if (!std::isfinite(total))
+    throw Error("heuristic region: length_fraction_inside: the path's length overflows a double");
+  return total > 0.0 ? std::min(1.0, inside / total) : 0.0;
 }
 
 double HeuristicRegion::volume() const { return static_cast<double>(cells_.size()) * cell_size_.prod(); }

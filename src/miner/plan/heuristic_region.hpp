@@ -91,8 +91,10 @@ class HeuristicRegion {
   /// Whether p lies in a cell of H (points outside the bounds are not).
   bool contains(const Eigen::Vector3d& p) const;
   /// The share of a polyline's length that lies in H (0 for a path of zero length): each
-  /// segment is walked in steps of a quarter of the smallest cell side, a step counting
-  /// as inside when its midpoint is (REQ-PLAN-020's path trust).
+  /// segment is walked over its part inside the bounds in steps of a quarter of the smallest
+  /// cell side, a step counting as inside when its midpoint is (REQ-PLAN-020's path trust);
+  /// length outside the bounds counts as outside. Throws miner::Error for a point that is not
+  /// finite or a length that overflows.
   double length_fraction_inside(const std::vector<Eigen::Vector3d>& path) const;
   /// Lebesgue measure of H: number of cells times the cell volume.
   double volume() const;

@@ -553,9 +553,9 @@ void Map::save(const std::string& path) const {
     saved.sha256 = sha256_hex(bytes);
     Json doc = Map(bounds_, resolution_, obstacles_, query_, std::move(saved)).to_json();
     doc["voxels"]["file"] = bt.filename().string();  // relative: the pair moves together
-    write_file_atomic(path, dump_json(doc));
+    write_file_atomic(path, dump_json(doc, path));
   } else {
-    write_file_atomic(path, dump_json(to_json()));
+    write_file_atomic(path, dump_json(to_json(), path));
   }
 }
 

@@ -19,6 +19,7 @@ using miner::Error;
 using miner::Json;
 using miner::JsonField;
 using Catch::Matchers::Contains;
+using Catch::Matchers::StartsWith;
 
 namespace {
 std::string read_all(const std::string& path) {
@@ -313,6 +314,20 @@ TEST_CASE("only_keys refuses an unknown key, naming it and the known ones", "[RE
 
 TEST_CASE("dump_json writes two-space indented JSON with a trailing newline", "[REQ-CORE-003]") {
   CHECK(miner::dump_json(Json{{"a", 1}}) == "{\n  \"a\": 1\n}\n");
+}
+
+TEST_CASE("dump_json never writes a number parse_json refuses: a subnormal is named by its JSON pointer",
+          "[REQ-CORE-003]") {
+  // Fifteenth campaign F10: save() wrote 1e-310 and load() of the same file refused it.
+  const Json doc{{"obstacles", Json::array({Json{{"min", {0.0, 1e-310, 0.0}}}})}, {"t", 4e-320}};
+  CHECK_THROWS_WITH(miner::dump_json(doc, "m.json"),
+                    StartsWith("m.json: cannot be written: the number at /obstacles/0/min/1 (1e-310)") &&
+                        Contains("below the smallest normal double"));
+  CHECK_THROWS_WITH(miner::dump_json(Json{{"t", -4e-320}}), StartsWith("cannot be written: the number at /t"));
+  CHECK_THROWS_WITH(miner::dump_json(Json(5e-324)), Contains("the number at / "));
+  // Everything it writes, zeros, the smallest normal double and the largest included, reads back.
+  const Json fine{{"z", 0.0}, {"nz", -0.0}, {"min", 2.2250738585072014e-308}, {"max", 1.7976931348623157e308}, {"i", -3}};
+  CHECK(miner::parse_json(miner::dump_json(fine), "fine.json") == fine);
 }
 
 TEST_CASE("A path holding a NUL byte is refused, not opened cut short", "[REQ-CORE-003][REQ-CORE-004]") {

@@ -57,6 +57,9 @@ TEST_CASE("Missing or non-physical vehicle parameters are refused naming the par
   doc = vehicle_doc();
   doc["mass_kg"] = 1e300;  // issue 20: values near the largest double flew
   expect_vehicle_error(doc, "mass_kg: must be a finite number in (0, 1000], got 1e+300");
+  // Fifteenth campaign F13: the value with every digit it needs ("got 1000" looked in range).
+  doc["mass_kg"] = 1000.001;
+  expect_vehicle_error(doc, "mass_kg: must be a finite number in (0, 1000], got 1000.001");
   doc = vehicle_doc();
   doc["radius_m"] = 50.0;
   expect_vehicle_error(doc, "radius_m: must be a finite number in (0, 10]");

@@ -22,6 +22,7 @@
 #include "miner/world/voxel_grid.hpp"
 
 using Catch::Matchers::Contains;
+using Catch::Matchers::EndsWith;
 namespace heuristic = miner::heuristic;
 
 namespace {
@@ -330,8 +331,21 @@ TEST_CASE("A part that would hold no shard file is refused before any sample is 
   const std::string out = temp_dir() + "/empty-part";
   std::filesystem::remove_all(out);
   CHECK_THROWS_WITH(heuristic::write_dataset(o, out, nullptr),
-                    Contains("--shard 2/3: the largest split has 2 shard file(s)") && Contains("no sample"));
+                    Contains("--shard 2/3: the largest split has 2 shard file(s)") && Contains("no sample") &&
+                        Contains("(use at most 2 parts, or a smaller --shard-size)"));
   CHECK_FALSE(std::filesystem::exists(out));
+  // The advice is one that can be followed (fifteenth campaign F13: "use at most 1 parts", and a
+  // smaller --shard-size at 1).
+  {
+    auto one = o;
+    one.count = 1;
+    one.val_fraction = 0.0;
+    one.test_count = 0;
+    one.shard_size = 1;
+    one.shard_count = 2;
+    one.shard_index = 1;
+    CHECK_THROWS_WITH(heuristic::write_dataset(one, out, nullptr), EndsWith("(use at most 1 part)"));
+  }
   o.shard_index = 1;  // the last part that holds a file is written
   CHECK_NOTHROW(heuristic::write_dataset(o, out, nullptr));
 }
@@ -581,7 +595,7 @@ TEST_CASE("A dataset folder that contradicts itself is refused naming the file a
           std::swap_ranges(b.begin(), b.begin() + static_cast<std::ptrdiff_t>(sample), b.begin() + static_cast<std::ptrdiff_t>(sample));
         });
       },
-      "train-00000.bin: sample 0 (k = 0): its state channel does not mark the start cell");
+      "train-00000.bin: sample 0 (k = 0, ");
 }
 
 TEST_CASE("A dataset folder of an earlier format is regenerated in place, a user's folder is not replaced",
@@ -815,4 +829,134 @@ TEST_CASE("A dataset part whose index equals its part count is refused naming th
                       Contains("dataset.json") && Contains("part: needs 0 <= index < count"));
     CHECK_FALSE(fs::exists(out));
   }
+}
+
+TEST_CASE("A part whose channels contradict its index entry or REQ-HEUR-002 is refused, re-hashed or not",
+          "[REQ-HEUR-001][REQ-HEUR-002][REQ-REPORT-006]") {
+  // Fifteenth campaign F1: with the shard's SHA-256 recomputed, a T without its start cell, an S
+  // of all ones, P 0 on a free cell or an E solid on the start merged silently. Each is
+  // checkable from the sample's own index entry and channels (check_sample_channels).
+  namespace fs = std::filesystem;
+  auto o = small_options();
+  o.dims = Eigen::Vector3i(16, 16, 8);
+  o.shard_count = 2;
+  const std::string root = temp_dir() + "/channels";
+  fs::remove_all(root);
+  const std::string p0 = root + "/p0", p1 = root + "/p1";
+  o.shard_index = 0;
+  heuristic::write_dataset(o, p0, nullptr);
+  o.shard_index = 1;
+  heuristic::write_dataset(o, p1, nullptr);
+  heuristic::merge_dataset_parts({p0, p1}, root + "/honest");
+  const heuristic::Sample s0 = heuristic::read_split(root + "/honest", "train").at(0);  // k = 0: p0's first
+  REQUIRE(s0.k == 0);
+  const std::size_t cells = static_cast<std::size_t>(o.dims.prod());
+  const auto index_of = [&](const Eigen::Vector3d& p) {
+    const Eigen::Vector3i c = heuristic::cell_of(s0.bounds, o.dims, p);
+    return heuristic::cell_index(o.dims, c.x(), c.y(), c.z());
+  };
+  const std::size_t start = index_of(s0.start), goal = index_of(s0.goal);
+  // A free cell off T farther than the dilation from every T cell, and a free cell in none.
+  std::size_t far = cells, free_cell = cells;
+  for (std::size_t i = 0; i < cells; ++i) {
+    if (s0.environment[i] != heuristic::kFree) continue;
+    if (free_cell == cells) free_cell = i;
+    const Eigen::Vector3i c = heuristic::cell_coords(o.dims, i);
+    bool near = false;
+    for (std::size_t j = 0; j < cells && !near; ++j)
+      near = s0.target[j] && (heuristic::cell_coords(o.dims, j) - c).cwiseAbs().maxCoeff() <= o.dilation;
+    if (!near) {
+      far = i;
+      break;
+    }
+  }
+  REQUIRE(far < cells);
+  REQUIRE(free_cell < cells);
+  int n = 0;
+  const auto refused = [&](const std::function<void(std::string&)>& change, const std::string& what) {
+    const std::string q0 = root + "/q0-" + std::to_string(n), q1 = root + "/q1-" + std::to_string(n);
+    const std::string out = root + "/out-" + std::to_string(n++);
+    fs::copy(p0, q0);
+    fs::copy(p1, q1);
+    const std::string shard = q0 + "/train-00000.bin";
+    std::string bytes = read_bytes(shard);
+    change(bytes);
+    miner::write_file_atomic(shard, bytes);
+    miner::Json doc = miner::read_json_file(q0 + "/dataset.json");
+    doc["splits"]["train"]["shards"][0]["sha256"] = miner::sha256_hex(bytes);
+    miner::write_file_atomic(q0 + "/dataset.json", miner::dump_json(doc));
+    CHECK_THROWS_WITH(heuristic::merge_dataset_parts({q0, q1}, out), Contains("train-00000.bin: sample 0 (k = 0, ") && Contains(what));
+    CHECK_FALSE(fs::exists(out));
+  };
+  const auto E = [](std::string& b, std::size_t i) -> char& { return b[i]; };
+  const auto S = [&](std::string& b, std::size_t i) -> char& { return b[cells + i]; };
+  const auto T = [&](std::string& b, std::size_t i) -> char& { return b[2 * cells + i]; };
+  const auto P = [&](std::string& b, std::size_t i) -> char& { return b[3 * cells + i]; };
+  refused([&](std::string& b) { T(b, start) = 0; }, "channel target does not mark the start cell");
+  refused([&](std::string& b) { T(b, goal) = 0; }, "channel target does not mark the goal cell");
+  refused([&](std::string& b) { for (std::size_t i = 0; i < cells; ++i) S(b, i) = 1; }, "channel state at cell");
+  refused([&](std::string& b) { S(b, far) = 1; }, "channel state at cell");
+  refused([&](std::string& b) { P(b, free_cell) = 0; }, "on a free cell");
+  refused([&](std::string& b) { P(b, free_cell) = heuristic::kPassX; }, "on a free cell");
+  refused([&](std::string& b) { E(b, far) = heuristic::kSolid; }, "on a solid cell");
+  refused([&](std::string& b) { E(b, start) = heuristic::kSolid; P(b, start) = 0; }, "marks a solid cell");
+  refused([&](std::string& b) { E(b, start) = heuristic::kSolid; P(b, start) = 0; T(b, start) = 0; },
+          "channel environment marks the start cell");
+  refused([&](std::string& b) { T(b, far) = 1; }, "lies more than the dilation");
+  // A T cut between start and goal: every T cell but the start's own cube cleared.
+  refused(
+      [&](std::string& b) {
+        const Eigen::Vector3i c = heuristic::cell_coords(o.dims, start);
+        for (std::size_t i = 0; i < cells; ++i)
+          if ((heuristic::cell_coords(o.dims, i) - c).cwiseAbs().maxCoeff() > 1 && i != goal) T(b, i) = 0;
+      },
+      "channel target does not join the start");
+  // The readers check the same: a whole folder edited and re-hashed is refused by read_split.
+  const std::string whole = root + "/whole";
+  fs::copy(root + "/honest", whole);
+  std::string bytes = read_bytes(whole + "/train-00000.bin");
+  P(bytes, free_cell) = 0;
+  miner::write_file_atomic(whole + "/train-00000.bin", bytes);
+  miner::Json doc = miner::read_json_file(whole + "/dataset.json");
+  doc["splits"]["train"]["shards"][0]["sha256"] = miner::sha256_hex(bytes);
+  miner::write_file_atomic(whole + "/dataset.json", miner::dump_json(doc));
+  CHECK_THROWS_WITH(heuristic::read_split(whole, "train"), Contains("train-00000.bin: sample 0 (k = 0)") && Contains("on a free cell"));
+  // Every sample the generator writes passes the checks, in every preset, at dilations 0-2 in
+  // turn (each preset at one: the sweep of all three took 20 s).
+  int turn = 0;
+  for (const std::string& preset : miner::world::generator_preset_names())
+    for (int dilation : {turn++ % 3}) {
+      auto g = small_options();
+      g.count = 2;
+      g.preset = preset;
+      g.dilation = dilation;
+      g.dims = Eigen::Vector3i(16, 16, 8);
+      const std::string dir = root + "/gen-" + preset + std::to_string(dilation);
+      INFO(dir);
+      heuristic::write_dataset(g, dir, nullptr);
+      CHECK_NOTHROW(heuristic::merge_dataset_parts({dir}, dir + "-merged"));
+      for (const char* split : {"train", "val", "test"}) CHECK_NOTHROW(heuristic::read_split(dir, split));
+    }
+}
+
+TEST_CASE("The grid helpers refuse a grid without cells or bounds without extent, naming both",
+          "[REQ-HEUR-002][REQ-HEUR-004]") {
+  // Fifteenth campaign F9: zero-extent bounds gave cell_of (2, 2, INT_MIN) (a NaN cast to int),
+  // dims 0 a cell (-1, 5, 5) "clamped onto the grid", and encode_state an all-zero S.
+  const miner::world::Box good{{0, 0, 0}, {10, 10, 10}};
+  const Eigen::Vector3d p(5, 5, 5), q(8, 8, 8);
+  const miner::world::Box flat{{0, 0, 0}, {10, 10, 0}};
+  const miner::world::Box inverted{{0, 0, 0}, {10, -10, 10}};
+  for (const auto& [bounds, dims] : {std::pair{flat, Eigen::Vector3i(4, 4, 4)}, std::pair{inverted, Eigen::Vector3i(4, 4, 4)},
+                                    std::pair{good, Eigen::Vector3i(0, 4, 4)}, std::pair{good, Eigen::Vector3i(4, -1, 4)}}) {
+    CHECK_THROWS_WITH(heuristic::cell_of(bounds, dims, p),
+                      Contains("cells over the bounds") && Contains("needs at least one cell per axis"));
+    CHECK_THROWS_WITH(heuristic::cell_box(bounds, dims, Eigen::Vector3i(0, 0, 0)), Contains("cells over the bounds"));
+    CHECK_THROWS_WITH(heuristic::encode_state(bounds, dims, p, q, 1),
+                      Contains("cells over the bounds") || Contains("dims: every entry must be >= 1"));
+  }
+  const miner::world::Box huge{{-1e308, 0, 0}, {1e308, 10, 10}};  // its extent overflows
+  CHECK_THROWS_WITH(heuristic::cell_size(huge, Eigen::Vector3i(4, 4, 4)), Contains("finite"));
+  // The helpers still place every point of a valid grid on it, clamped.
+  CHECK(heuristic::cell_of(good, Eigen::Vector3i(4, 4, 4), Eigen::Vector3d(-5, 5, 50)) == Eigen::Vector3i(0, 2, 3));
 }

@@ -26,6 +26,7 @@
 #include "miner/world/map_generator.hpp"
 
 using Catch::Matchers::Contains;
+using Catch::Matchers::StartsWith;
 namespace heuristic = miner::heuristic;
 
 namespace {
@@ -180,15 +181,26 @@ TEST_CASE("A reference whose inputs are not finite is refused naming the tensor"
   // belonging together, or on the outputs.
   const std::string shipped = miner::read_file_bytes(kFixtures + "reference.bin");
   const std::string path = (std::filesystem::temp_directory_path() / "miner_sgan_test_nan_input.bin").string();
-  for (const char* tensor : {"0.environment", "0.noise", "0.state"}) {
-    const std::string blob = with_tensor_edited(shipped, tensor, [](std::string& data, std::size_t offset, std::size_t) {
+  // Fifteenth campaign F4: the message began "the weights overflow a layer" for the reference's
+  // own fault; the weights are not named at all.
+  for (const std::string tensor : {"0.environment", "0.noise", "0.state", "0.scale", "0.passability"}) {
+    const std::size_t element = tensor == "0.scale" ? 0 : 5;  // scale holds a few values only
+    const std::string blob = with_tensor_edited(shipped, tensor, [&](std::string& data, std::size_t offset, std::size_t) {
       const float inf = std::numeric_limits<float>::infinity();
-      std::memcpy(&data[offset + 4 * 5], &inf, 4);  // element 5
+      std::memcpy(&data[offset + 4 * element], &inf, 4);
     });
     miner::write_file_atomic(path, blob);
     CHECK_THROWS_WITH(heuristic::reference_errors(heuristic::Sgan::builtin(), path),
-                      Contains(path + ": " + tensor + "[5]: is inf") && !Contains("belong"));
+                      StartsWith(path + ": " + tensor + "[" + std::to_string(element) + "]: is inf") && !Contains("belong") && !Contains("overflow") &&
+                          !Contains("sgan.bin"));
   }
+  // A meta that counts a sample the file does not hold: the reference's missing tensor, not the
+  // weights (F4: "the weights overflow a layer: ... no tensor '2.passability'").
+  miner::Json h = header_of(shipped);
+  h["meta"]["samples"] = h["meta"]["samples"].get<int>() + 1;
+  miner::write_file_atomic(path, with_header(shipped, h));
+  CHECK_THROWS_WITH(heuristic::reference_errors(heuristic::Sgan::builtin(), path),
+                    Contains(path) && Contains("no tensor") && !Contains("overflow"));
 }
 
 TEST_CASE("A reference's meta refuses an unknown key, suggesting the known one", "[REQ-HEUR-005]") {

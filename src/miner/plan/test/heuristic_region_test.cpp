@@ -54,6 +54,10 @@ TEST_CASE("A region round-trips through miner-region-v1 and bad files name the f
   CHECK(back.cells() == r.cells());
   CHECK(back.probabilities() == r.probabilities());
   CHECK(back.source() == "test");
+  // Fifteenth campaign F10: a threshold load() refuses (subnormal) is refused by save().
+  const HeuristicRegion tiny(Box{{0, 0, 0}, {8, 4, 4}}, I(2, 1, 1), {1.0, 0.5}, 1e-310);
+  CHECK_THROWS_WITH(tiny.save(path), Contains(path + ": cannot be written: the number at /threshold"));
+  CHECK(HeuristicRegion::load(path).cells() == r.cells());  // the earlier file is kept
 
   miner::Json doc = r.to_json();
   doc["format"] = "other";
@@ -240,4 +244,17 @@ TEST_CASE("Hops through H and a path's share in H are measured on the region's c
   const double exact = 6.0 / 6.1, half_step = 0.5 * (6.1 / 25.0) / 6.1;
   CHECK(std::abs(r.length_fraction_inside({V(6.1, 0.5, 0.5), V(0, 0.5, 0.5)}) - exact) <= half_step + 1e-12);
   CHECK(std::abs(r.length_fraction_inside({V(0, 0.5, 0.5), V(6.1, 0.5, 0.5)}) - exact) <= half_step + 1e-12);
+  // Fifteenth campaign F8: length outside the bounds counts as outside, walked only where cells
+  // are (a segment to x = 1e300 gave NaN after ~1e300 steps), and a point that is not finite is
+  // refused (a NaN point gave 0).
+  CHECK(r.length_fraction_inside({V(0, 0.5, 0.5), V(16, 0.5, 0.5)}) == Approx(6.0 / 16.0));
+  CHECK(r.length_fraction_inside({V(-8, 0.5, 0.5), V(8, 0.5, 0.5)}) == Approx(6.0 / 16.0));
+  CHECK(r.length_fraction_inside({V(0, 0.5, 0.5), V(1e300, 0.5, 0.5)}) == Approx(6e-300).epsilon(1e-9));
+  CHECK(r.length_fraction_inside({V(0, 0.5, -3), V(8, 0.5, -3)}) == 0.0);  // beside the bounds
+  CHECK_THROWS_WITH(r.length_fraction_inside({V(0, 0.5, 0.5), V(NAN, 0.5, 0.5)}),
+                    Contains("length_fraction_inside: path point 1") && Contains("is not finite"));
+  CHECK_THROWS_WITH(r.length_fraction_inside({V(-1e308, 0.5, 0.5), V(1e308, 0.5, 0.5)}),
+                    Contains("segment 0") && Contains("has no finite length"));
+  CHECK_THROWS_WITH(r.length_fraction_inside({V(0, 0, 0), V(1e308, 0, 0), V(0, 0, 0)}),
+                    Contains("the path's length overflows a double"));
 }

@@ -48,13 +48,13 @@ void validate(const VehicleParams& v, const std::string& origin) {
   positive(v.rotor_speed_max, "rotor_speed_max_rad_s", 1e5);
   for (const auto& [tau, field] : {std::pair{v.motor_time_constant_up, "motor_time_constant_up_s"},
                                    std::pair{v.motor_time_constant_down, "motor_time_constant_down_s"}})
-    if (!std::isfinite(tau) || !(tau >= kMinPlantTimeConstant) || tau > 1.0) {
-      char text[200];
+    if (!std::isfinite(tau) || !(tau >= kMinPlantTimeConstant) || tau > kMaxMotorTimeConstant) {
+      char text[240];
       std::snprintf(text, sizeof text,
-                    "must be a finite number in [%g, 1] s (real motors respond in 10-100 ms; shorter ones are "
-                    "too stiff for the integrator), got %g",
-                    kMinPlantTimeConstant, tau);
-      bad(origin, field, text);
+                    "must be a finite number in [%g, %g] s (real motors respond in 10-100 ms; shorter ones are "
+                    "too stiff for the integrator, slower ones lose the N3's attitude loop), got ",
+                    kMinPlantTimeConstant, kMaxMotorTimeConstant);
+      bad(origin, field, text + (std::isfinite(tau) ? Json(tau).dump() : std::string("a value that is not finite")));
     }
   positive(v.radius, "radius_m", kMaxRobotRadius);
   for (int i = 0; i < 3; ++i) {
@@ -109,6 +109,21 @@ void validate(const VehicleParams& v, const std::string& origin) {
                   "best, more than the %g s a position loop can wait: the vehicle cannot follow a trajectory",
                   torque_max, kN3MaxTiltDeg, tilt_time, kMaxTiltTime);
     bad(origin, "inertia_kg_m2", text);
+  }
+  // The rotors must hold the heading too: rest to rest through kTiltLimitRad about z under the
+  // largest yaw torque (two rotors at w_max, two at w_min: 2 k_m (T_max - T_min) per pair) takes
+  // 2 sqrt(theta J_z / tau_z) (fifteenth campaign F12: a torque ratio of 1e-12 was accepted and
+  // the vehicle left the map).
+  const double yaw_torque_max = 2.0 * v.torque_to_thrust_ratio * rotor_span;
+  const double yaw_time = 2.0 * std::sqrt(kTiltLimitRad * v.inertia.z() / yaw_torque_max);
+  if (!(yaw_time <= kMaxYawTime)) {
+    char text[300];
+    std::snprintf(text, sizeof text,
+                  "the rotors' largest yaw torque %g N m (torque_to_thrust_ratio_m %g) turns this vehicle's J_z %g "
+                  "kg m^2 by %g deg in %g s at best, more than the %g s that holds its heading: raise the ratio "
+                  "(propellers give 0.005-0.03 m)",
+                  yaw_torque_max, v.torque_to_thrust_ratio, v.inertia.z(), kN3MaxTiltDeg, yaw_time, kMaxYawTime);
+    bad(origin, "torque_to_thrust_ratio_m", text);
   }
   // The drag's lag, mass over the linear coefficients at full rotor speed, is a plant time
   // constant too: a 1 g vehicle with 100 N s/m of drag is as stiff as a 10 us motor.

@@ -30,6 +30,20 @@ inline constexpr const char* kVehicleFormat = "miner-vehicle-v1";
 /// (issue 20, sixth campaign U9). 1 ms keeps even a 0.5x model mismatch to a few steps per tick.
 inline constexpr double kMinPlantTimeConstant = 1e-3;
 
+/// The longest motor time constant (up or down) a vehicle file may give, s. Real multirotor
+/// motors respond in 10-100 ms; the N3's fixed attitude gains lose the vehicle beyond that
+/// (fifteenth campaign F12: 1 s, then the documented maximum, left the map; the default scenario's
+/// vehicle flies with both constants at 0.15 s and leaves the map at 0.18 s).
+inline constexpr double kMaxMotorTimeConstant = 0.1;
+
+/// The longest a vehicle may take to turn 35 degrees about z at full differential rotor torque
+/// (rest to rest), s: the yaw counterpart of kMaxTiltTime. Yaw authority only holds the heading,
+/// so the bound is looser; the default scenario's vehicle loses its heading and leaves the map
+/// at ~11 s (torque_to_thrust_ratio_m 5e-5 flies, 3e-5 does not; F12: 1e-12 was accepted), the
+/// N3-class vehicle itself takes 0.63 s and a 0.5 x 0.5 x 0.9 kg m^2 one that flies 2.6 s. Necessary, not sufficient: a harsher scenario (wind,
+/// model mismatch) may need more, and `fly` says so by exit 3.
+inline constexpr double kMaxYawTime = 3.0;
+
 /// The longest a vehicle may take to tilt from level to the N3's tilt limit at full differential
 /// thrust (rest to rest), s. A position loop of ~1 Hz bandwidth waits about this long for the
 /// attitude it asks for; an N3-class 1.5 kg quadrotor takes ~0.15 s.

@@ -1205,3 +1205,64 @@ TEST_CASE("The flight log ends with the final state the summary judges", "[REQ-F
   CHECK_FALSE(touched.goal_reached);
   for (std::size_t i = 0; i + 1 < touched.log.size(); ++i) REQUIRE(touched.log[i][column("collision")] == 0.0);
 }
+
+TEST_CASE("The tracking figures are over the reference's rows and the hover is judged by the final figures",
+          "[REQ-FLIGHT-009]") {
+  // Fifteenth campaign F11: position_mse, velocity_mse and max_position_error leave out the hover
+  // after the reference; REQ-FLIGHT-009 now says so, and this holds them to it, row by row.
+  const pipeline::Scenario s = pipeline::default_scenario();
+  const auto ref = pipeline::build_reference(s);
+  const flight::FlightResult r = pipeline::fly(s, ref);
+  const double T = r.summary["reference"]["duration_s"].get<double>();
+  double max_error = 0.0;
+  Eigen::Vector3d sum_p2 = Eigen::Vector3d::Zero(), sum_v2 = Eigen::Vector3d::Zero();
+  int tracked = 0, hover = 0;
+  for (const auto& row : r.log) {
+    // t, ref p, ref v, true p, true v (the log's first 13 columns, REQ-FLIGHT-009's header)
+    const Eigen::Vector3d ep(row[7] - row[1], row[8] - row[2], row[9] - row[3]);
+    const Eigen::Vector3d ev(row[10] - row[4], row[11] - row[5], row[12] - row[6]);
+    if (row[0] > T) {
+      ++hover;
+      continue;
+    }
+    max_error = std::max(max_error, ep.norm());
+    sum_p2 += ep.cwiseAbs2();
+    sum_v2 += ev.cwiseAbs2();
+    ++tracked;
+  }
+  REQUIRE(tracked > 100);
+  REQUIRE(hover > 100);  // 3 s of hover at 100 Hz: rows the figures leave out
+  CHECK(r.summary["max_position_error"].get<double>() == Approx(max_error).epsilon(1e-12));
+  for (int a = 0; a < 3; ++a) {
+    CHECK(r.summary["position_mse"][static_cast<std::size_t>(a)].get<double>() == Approx(sum_p2[a] / tracked).epsilon(1e-9));
+    CHECK(r.summary["velocity_mse"][static_cast<std::size_t>(a)].get<double>() == Approx(sum_v2[a] / tracked).epsilon(1e-9));
+  }
+  // The last row is the final state the summary judges.
+  const auto& last = r.log.back();
+  const Eigen::Vector3d final_position(last[7], last[8], last[9]);
+  CHECK(r.summary["final_position_error"].get<double>() == Approx((final_position - s.goal).norm()).epsilon(1e-12));
+}
+
+TEST_CASE("Vehicles at the ends of the motor-lag and yaw-authority ranges fly the default scenario to its goal",
+          "[REQ-FLIGHT-001][REQ-FLIGHT-007]") {
+  // Fifteenth campaign F12: vehicles inside the documented ranges (motor time constant 1 s, a
+  // torque ratio of 1e-12) left the map. The ranges now end where vehicles still fly.
+  const pipeline::Scenario base = pipeline::default_scenario();
+  const auto ref = pipeline::build_reference(base);
+  const auto yaw_limit_ratio = [](const flight::VehicleParams& v) {
+    // k_m at which 35 deg about z takes kMaxYawTime: t = 2 sqrt(theta J_z / (2 k_m span)).
+    const double span = v.thrust_coefficient * (v.rotor_speed_max * v.rotor_speed_max - v.rotor_speed_min * v.rotor_speed_min);
+    const double theta = miner::kN3MaxTiltDeg * M_PI / 180.0, t = flight::kMaxYawTime;
+    return 4.0 * theta * v.inertia.z() / (t * t * 2.0 * span) * 1.001;
+  };
+  for (int variant = 0; variant < 3; ++variant) {
+    pipeline::Scenario s = base;
+    if (variant != 1) s.vehicle.motor_time_constant_up = s.vehicle.motor_time_constant_down = flight::kMaxMotorTimeConstant;
+    if (variant != 0) s.vehicle.torque_to_thrust_ratio = yaw_limit_ratio(s.vehicle);
+    INFO("variant " << variant << ": tau " << s.vehicle.motor_time_constant_up << " s, k_m " << s.vehicle.torque_to_thrust_ratio);
+    REQUIRE_NOTHROW(flight::validate(s.vehicle, "v.json"));
+    const flight::FlightResult r = pipeline::fly(s, ref);
+    CHECK(r.goal_reached);
+    CHECK(r.collisions == 0);
+  }
+}

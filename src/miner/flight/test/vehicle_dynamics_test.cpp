@@ -89,7 +89,15 @@ TEST_CASE("Plant time constants shorter than the integrator can take are refused
     for (const double tau : {1e-9, 5e-4}) {
       miner::Json doc = vehicle_doc();
       doc[field] = tau;
-      expect_vehicle_error(doc, std::string("v.json: ") + field + ": must be a finite number in [0.001, 1] s");
+      expect_vehicle_error(doc, std::string("v.json: ") + field + ": must be a finite number in [0.001, 0.1] s");
+    }
+  // Fifteenth campaign F12: 1 s, the documented maximum then, left the map; the maximum is one a
+  // vehicle flies with (both constants at it: the test "Vehicles at the ends of their ranges fly").
+  for (const char* field : {"motor_time_constant_up_s", "motor_time_constant_down_s"})
+    for (const double tau : {0.1000001, 0.18, 1.0}) {
+      miner::Json doc = vehicle_doc();
+      doc[field] = tau;
+      expect_vehicle_error(doc, std::string("v.json: ") + field + ": must be a finite number in [0.001, 0.1] s");
     }
   miner::Json doc = vehicle_doc();
   doc["motor_time_constant_up_s"] = flight::kMinPlantTimeConstant;  // the bound itself is accepted
@@ -126,6 +134,16 @@ TEST_CASE("Plant time constants shorter than the integrator can take are refused
   expect_vehicle_error(doc, "v.json: inertia_kg_m2: the rotors' largest roll/pitch torque");
   doc = vehicle_doc();
   doc["inertia_kg_m2"] = {0.5, 0.5, 0.9};  // ~0.6 s: slow, and flyable
+  CHECK_NOTHROW(flight::vehicle_from_json(doc, "v.json"));
+  // Fifteenth campaign F12: no yaw authority (torque ratio 1e-12) was accepted and left the map.
+  // J_z 0.055 at 2 k_m (T_max - T_min) = 2 k_m 10.43 N: 3 s (kMaxYawTime) at k_m = 7.13e-4 m.
+  for (const double km : {1e-12, 1e-4, 7e-4}) {
+    doc = vehicle_doc();
+    doc["torque_to_thrust_ratio_m"] = km;
+    INFO(km);
+    expect_vehicle_error(doc, "v.json: torque_to_thrust_ratio_m: the rotors' largest yaw torque");
+  }
+  doc["torque_to_thrust_ratio_m"] = 7.2e-4;
   CHECK_NOTHROW(flight::vehicle_from_json(doc, "v.json"));
   // A light vehicle under heavy drag lags faster than 1 ms (mass 0.05 kg / 100 N s/m = 0.5 ms).
   doc = vehicle_doc();

@@ -38,8 +38,9 @@ inline constexpr double kMaxMotorTimeConstant = 0.1;
 
 /// The longest a vehicle may take to turn 35 degrees about z at full differential rotor torque
 /// (rest to rest), s: the yaw counterpart of kMaxTiltTime. Yaw authority only holds the heading,
-/// so the bound is looser; the default scenario's vehicle loses its heading and leaves the map
-/// at ~11 s (torque_to_thrust_ratio_m 5e-5 flies, 3e-5 does not; F12: 1e-12 was accepted), the
+/// so the bound is looser; the default scenario's vehicle flies at 11 s and loses its heading
+/// and the map at 15 s (torque_to_thrust_ratio_m 5e-5 flies, 3e-5 does not; F12: 1e-12 was
+/// accepted), the
 /// N3-class vehicle itself takes 0.63 s and a 0.5 x 0.5 x 0.9 kg m^2 one that flies 2.6 s. Necessary, not sufficient: a harsher scenario (wind,
 /// model mismatch) may need more, and `fly` says so by exit 3.
 inline constexpr double kMaxYawTime = 3.0;

@@ -52,6 +52,12 @@ TEST_CASE("Summaries take medians over solved runs and null the target median be
   // {10, 30, inf, inf}: median (30 + inf) / 2 is infinite -> unknown.
   CHECK(std::isnan(s.target_time_ms));
   CHECK(s.target_time_ms_mean == 20.0);
+  // The means of the target stage are over the runs that reached it, as the time's (held-out
+  // set 12, h12-plan-06: the iterations' mean took the misses' +inf and came out infinite).
+  CHECK(s.target_iterations_mean == 50.0);
+  CHECK(s.target_nodes_mean == 40.0);
+  CHECK(s.first_iterations_mean == 5.0);
+  CHECK(s.first_nodes_mean == 4.0);
   runs.push_back(fake("a", true, 2.0, 20.0));  // {10, 20, 30, inf, inf}: median 30
   const auto t = summarise("a", runs);
   CHECK(t.target_time_ms == 30.0);

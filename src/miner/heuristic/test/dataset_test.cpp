@@ -668,7 +668,14 @@ TEST_CASE("Bad dataset options are refused naming the option", "[REQ-HEUR-003]")
   CHECK_THROWS_WITH(heuristic::validate(o), Contains("swamp"));
   o = small_options();
   o.jobs = 0;
-  CHECK_THROWS_WITH(heuristic::validate(o), Contains("--jobs"));
+  CHECK_THROWS_WITH(heuristic::validate(o), Contains("--jobs must be in [1, 256]"));
+  // The range's ends are in it (held-out set 12, h12-heur-06: 256 was refused).
+  for (int jobs : {1, 256}) {
+    o.jobs = jobs;
+    CHECK_NOTHROW(heuristic::validate(o));
+  }
+  o.jobs = 257;
+  CHECK_THROWS_WITH(heuristic::validate(o), Contains("--jobs must be in [1, 256]"));
   // Bounded output, refused before any sample (issue 20: 5e14 bytes were attempted).
   o = small_options();
   o.count = 10000000;

@@ -83,6 +83,14 @@ TEST_CASE("Bad map documents are refused with the field named", "[REQ-WORLD-002]
   d = valid_doc();
   d["obstacles"][0]["max"][0] = 5;
   CHECK_THAT(error_of(d), Contains("obstacles[0]: min[0] = 10 must be less than max[0] = 5"));
+  // A box of zero thickness on an axis is no box (held-out set 12, h12-world-02: min == max
+  // was accepted with the comparison loosened), for obstacles and bounds alike.
+  d = valid_doc();
+  d["obstacles"][0]["max"][1] = d["obstacles"][0]["min"][1];
+  CHECK_THAT(error_of(d), Contains("obstacles[0]: min[1] = ") && Contains("must be less than max[1]"));
+  d = valid_doc();
+  d["bounds"]["max"][0] = d["bounds"]["min"][0];
+  CHECK_THAT(error_of(d), Contains("bounds: min[0] = 0 must be less than max[0] = 0"));
   d = valid_doc();
   d["obstacles"][0]["min"][1] = std::numeric_limits<double>::quiet_NaN();
   CHECK_THAT(error_of(d), Contains("obstacles[0].min[1]"));

@@ -285,8 +285,8 @@ std::string cell_name(const Eigen::Vector3i& dims, std::size_t i) {
 ///  - S is exactly encode_state(bounds, dims, start, goal, dilation): it is fixed by the entry;
 ///  - E is not solid on the start or goal cell (both are free for the robot radius);
 ///  - P is kPassAll on every free cell and 0 on every solid one (grid.hpp);
-///  - T holds the start and goal cells and no solid cell, and its cells are one 26-connected
-///    component (the A* path's cells joined by their free dilation).
+///  - T holds the start and goal cells and no solid cell, joins them (26-connectivity), and each
+///    of its cells lies within the dilation of the start's component of T.
 /// `grids` holds the sample's kDatasetChannels grids (E, S, T, P); `where` names the sample.
 /// Throws miner::Error naming the channel and the first offending cell.
 void check_sample_channels(const std::uint8_t* grids, const Eigen::Vector3i& dims, const world::Box& bounds,
@@ -315,8 +315,11 @@ void check_sample_channels(const std::uint8_t* grids, const Eigen::Vector3i& dim
       fail("channel target at " + cell_name(dims, i) + " marks a solid cell (the target stays clear of solid cells, "
            "REQ-HEUR-002)");
   }
-  const std::size_t ends[2] = {[&] { const Eigen::Vector3i c = cell_of(bounds, dims, start); return cell_index(dims, c.x(), c.y(), c.z()); }(),
-                               [&] { const Eigen::Vector3i c = cell_of(bounds, dims, goal); return cell_index(dims, c.x(), c.y(), c.z()); }()};
+  const auto index_of = [&](const Eigen::Vector3d& p) {
+    const Eigen::Vector3i c = cell_of(bounds, dims, p);
+    return cell_index(dims, c.x(), c.y(), c.z());
+  };
+  const std::size_t ends[2] = {index_of(start), index_of(goal)};
   const char* const end_names[2] = {"start", "goal"};
   for (int e = 0; e < 2; ++e) {
     if (E[ends[e]] == kSolid)
@@ -771,9 +774,7 @@ void verify_samples(const std::string& dir, const std::vector<Sample>& samples) 
     for (int c = 0; c < 4; ++c)
       for (std::size_t i = 0; i < want[c]->size(); ++i)
         if (i >= got[c]->size() || (*got[c])[i] != (*want[c])[i]) {
-          const Eigen::Vector3i cell = cell_coords(o.dims, i);
-          throw Error(which + "channel " + channels[c] + " at cell (" + std::to_string(cell.x()) + ", " +
-                      std::to_string(cell.y()) + ", " + std::to_string(cell.z()) + ") holds " +
+          throw Error(which + "channel " + channels[c] + " at " + cell_name(o.dims, i) + " holds " +
                       (i < got[c]->size() ? std::to_string((*got[c])[i]) : std::string("nothing")) + ", the generator " +
                       std::to_string((*want[c])[i]) + ":" + why);
         }

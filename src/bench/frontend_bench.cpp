@@ -15,6 +15,7 @@
 #include "bench/ompl_planners.hpp"
 #include "miner/core/error.hpp"
 #include "miner/core/progress.hpp"
+#include "miner/core/sha256.hpp"
 #include "miner/core/shard.hpp"
 #include "miner/core/stopwatch.hpp"
 #include "miner/core/text.hpp"
@@ -171,6 +172,13 @@ FrontendBenchResult run_frontend_bench(const world::Map& map, const std::string&
   base.goal_radius = plan::resolved_goal_radius(base, map);
   out.steer_step = base.steer_step;
   out.goal_radius = base.goal_radius;
+  // A start inside X_goal is solved by the root alone at iteration 0, by every planner: no tree,
+  // no time, a throughput of 0 iterations per second (sixteenth campaign F17). Not a campaign.
+  if ((goal - start).norm() <= base.goal_radius)
+    throw Error(map_name + ": the start " + format_point(start) + " lies within the goal radius " +
+                exact_number(base.goal_radius) + " m of the goal " + format_point(goal) +
+                ": every planner solves this query at iteration 0 without a tree, so there is nothing to measure "
+                "(lower --goal-radius, or give a start and goal farther apart)");
 
   const Clock::time_point region_start = Clock::now();
   const plan::HeuristicRegion region =
@@ -181,6 +189,7 @@ FrontendBenchResult run_frontend_bench(const world::Map& map, const std::string&
   region.require_matches(map, options.region_file.empty() ? std::string("bench frontend") : options.region_file);
   out.region_source = options.region_file.empty() ? region.source() : options.region_file;
   out.region_cells = region.cells().size();
+  out.region_sha256 = sha256_hex(region.to_json().dump());
 
   std::optional<heuristic::Sgan> sgan;
   init_ompl();
@@ -189,6 +198,7 @@ FrontendBenchResult run_frontend_bench(const world::Map& map, const std::string&
     o.planner = name;
     o.time_limit_s = options.time_limit_s;
     if (bounded_by_iterations(name)) o.max_iterations = options.max_iterations;
+    if (options.ompl_checks > 0) o.max_condition_checks = options.ompl_checks;
     o.steer_step = base.steer_step;
     o.goal_radius = base.goal_radius;
     o.goal_bias = base.goal_bias;
@@ -214,6 +224,7 @@ FrontendBenchResult run_frontend_bench(const world::Map& map, const std::string&
         ompl ? plan::PlannerKind::kRrtStar : sgan_planner ? plan::PlannerKind::kMiner : plan::planner_from_name(name);
     if (sgan_planner && !sgan) {
       sgan.emplace(heuristic::Sgan::load_or_builtin(options.weights_file));
+      out.weights_sha256 = sgan->sha256();
       // Warm-up query: the first oneDNN execution pays one-time page faults, as it would
       // once at start-up on board.
       heuristic::query_region(*sgan, map, start, goal, robot_radius, options.seed);
@@ -278,6 +289,7 @@ FrontendBenchResult run_frontend_bench(const world::Map& map, const std::string&
       if (with_ompl) {
         OmplRunOptions oo = ompl_options("ompl:RRTstar");
         oo.target_cost.reset();
+        oo.max_condition_checks.reset();  // the throughput check runs its iterations, whatever the campaign's budget
         oo.max_iterations = options.throughput_iterations;
         oo.seed = ompl_run_seed(options.seed, run);
         const plan::PlanResult t = run_ompl(problem, oo);
@@ -461,8 +473,15 @@ nlohmann::json to_json(const FrontendBenchResult& r) {
           {"goal_radius", r.goal_radius},
           {"max_iterations", r.options.max_iterations},
           {"time_limit_s", r.options.time_limit_s},
+          {"ompl_checks", r.options.ompl_checks > 0 ? nlohmann::json(r.options.ompl_checks) : nlohmann::json(nullptr)},
           {"safeguard", r.options.planner_options.safeguard},
-          {"region", {{"source", r.region_source}, {"cells", r.region_cells}, {"build_ms", r.region_ms}}},
+          {"region",
+           {{"source", r.region_source}, {"cells", r.region_cells}, {"sha256", r.region_sha256}, {"build_ms", r.region_ms}}},
+          {"weights", r.weights_sha256.empty() ? nlohmann::json(nullptr)
+                                               : nlohmann::json{{"source", r.options.weights_file.empty()
+                                                                               ? std::string("builtin")
+                                                                               : r.options.weights_file},
+                                                                {"sha256", r.weights_sha256}}},
           {"throughput",
            {{"iterations", r.options.throughput_iterations},
             {"rrtstar_iterations_per_s", num(r.rrtstar_iterations_per_s)},
@@ -491,15 +510,22 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
     // Every key of a campaign's JSON, and no other (issue 20: an added or renamed key was called
     // "a different campaign" of the other file).
     root.only_keys({"map", "start", "goal", "robot_radius", "runs", "seed", "reference_cost", "target_factor",
-                    "target_cost", "lower_bound", "steer_step", "goal_radius", "max_iterations", "time_limit_s",
-                    "safeguard", "region", "throughput", "total_s", "shard", "planners", "run_records"});
+                    "target_cost", "lower_bound", "steer_step", "goal_radius", "max_iterations", "time_limit_s", "ompl_checks",
+                    "safeguard", "region", "weights", "throughput", "total_s", "shard", "planners", "run_records"});
     for (const char* k : {"runs", "seed"}) (void)root.at(k);
     const JsonField shard = root.at("shard");
     (void)shard.at("index").integer();
     (void)shard.at("count").integer();
     if (!(root.at("total_s").number() >= 0.0)) root.at("total_s").fail("a duration must be >= 0");
     (void)root.at("map").string();
-    root.at("region").only_keys({"source", "cells", "build_ms"});
+    root.at("region").only_keys({"source", "cells", "sha256", "build_ms"});
+    (void)sha256_field(root.at("region").at("sha256"));
+    // The weights miner-sgan ran with (null when it did not run), by content.
+    if (!root.at("weights").value().is_null()) {
+      root.at("weights").only_keys({"source", "sha256"});
+      (void)root.at("weights").at("source").string();
+      (void)sha256_field(root.at("weights").at("sha256"));
+    }
     // The summaries and the throughput block have exactly the keys a campaign writes (issue 20:
     // unknown keys there were carried into the merge).
     root.at("throughput").only_keys({"iterations", "rrtstar_iterations_per_s", "ompl_rrtstar_iterations_per_s"});
@@ -536,6 +562,14 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
     // 0, which no campaign can run with, merged).
     if (!(goal_radius >= kMinGoalRadius && goal_radius <= kMaxGoalRadius))
       root.at("goal_radius").fail("the goal radius must be in [1e-6, 1e6] m (as --goal-radius)");
+    // ... and leaves the start outside X_goal, as `bench frontend` requires (F17).
+    if (lower <= goal_radius)
+      root.at("goal_radius").fail(root.at("goal_radius").value().dump() + " m reaches the start (|goal - start| = " +
+                                  root.at("lower_bound").value().dump() + " m): no campaign runs such a query");
+    if (const JsonField checks = root.at("ompl_checks"); !checks.value().is_null() &&
+        !(checks.value().is_number_unsigned() && checks.value().get<std::uint64_t>() >= 1 &&
+          checks.value().get<std::uint64_t>() <= kMaxOmplChecks))
+      checks.fail("expected null or an integer in [1, 1000000000] (as --ompl-checks), got " + checks.value().dump());
     const double time_limit = root.at("time_limit_s").number();
     if (!(time_limit >= kMinTimeLimitS && time_limit <= kMaxTimeLimitS))
       root.at("time_limit_s").fail("the time limit must be in [0.001, 86400] s (as --time-limit)");
@@ -632,6 +666,32 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
         tp.at("rrtstar_iterations_per_s").fail("a rate must be >= 0");
       if (measures && tp.at("ompl_rrtstar_iterations_per_s").value().is_number() && tp.at("ompl_rrtstar_iterations_per_s").number() < 0.0)
         tp.at("ompl_rrtstar_iterations_per_s").fail("a rate must be >= 0");
+    }
+  }
+  // An OMPL planner reports its vertex count at its first solution always or never (the count
+  // is a progress property that some planners have): one record that differs from the others of its
+  // planner was edited (sixteenth campaign F1: a first.nodes of 10 among nulls merged).
+  {
+    std::map<std::pair<std::string, std::string>, std::pair<bool, std::string>> reports;  // (planner, stage) -> (known, where)
+    for (std::size_t p = 0; p < parts.size(); ++p) {
+      const JsonField records = JsonField(parts[p], "", names[p]).at("run_records");
+      for (std::size_t k = 0; k < records.array_size(); ++k) {
+        const JsonField r = records.at(k);
+        const std::string planner = r.at("planner").string();
+        if (planner.rfind("ompl:", 0) != 0) continue;
+        // The target's count may be the run's final one (ompl_planners.cpp), so only the
+        // first solution's is the property's alone.
+        for (const char* stage : {"first"}) {
+          if (!r.at(stage).value().is_object()) continue;
+          const bool known = !r.at(stage).at("nodes").value().is_null();
+          const std::string where = names[p] + ": " + r.at(stage).at("nodes").path();
+          const auto [it, fresh] = reports.emplace(std::make_pair(planner, std::string(stage)), std::make_pair(known, where));
+          if (!fresh && it->second.first != known)
+            r.at(stage).at("nodes").fail(std::string(known ? "a count" : "null") + ", but " + it->second.second + " is " +
+                                         (it->second.first ? "a count" : "null") + ": " + planner +
+                                         " reports its vertices at its first solution in every run or in none");
+        }
+      }
     }
   }
   // Everything but the per-shard fields must agree; the throughput check's iteration count is a

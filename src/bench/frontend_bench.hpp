@@ -34,6 +34,11 @@ struct FrontendBenchOptions {
   double target_factor = 1.0;   ///< target cost = factor x A* reference cost
   std::size_t max_iterations = 200000;  ///< the project's planners (and OMPL's RRT*s)
   double time_limit_s = 10.0;   ///< per run of OMPL's planners (wall clock); ours stop on max_iterations
+  /// > 0: OMPL's planners also stop after this many evaluations of their termination condition
+  /// (one per iteration of the planner's loop), a budget that, unlike the wall clock, gives the
+  /// same records on every machine and every run (sixteenth campaign F13). The CLI's
+  /// --ompl-checks lifts time_limit_s to kMaxTimeLimitS so that the clock never binds.
+  std::size_t ompl_checks = 0;
   plan::PlannerOptions planner_options;  ///< steer step, goal radius, mu_1, mu_2, ...
   Eigen::Vector3i region_dims = plan::HeuristicRegion::default_dims();
   int region_dilation = 1;
@@ -53,6 +58,8 @@ struct FrontendBenchOptions {
 /// checks in the parts too.
 inline constexpr double kMinGoalRadius = 1e-6, kMaxGoalRadius = 1e6;
 inline constexpr double kMinTimeLimitS = 1e-3, kMaxTimeLimitS = 86400.0;
+/// The largest --ompl-checks (bounded work: a check costs at least one planner iteration).
+inline constexpr std::size_t kMaxOmplChecks = 1000000000;
 /// How far past its time limit an OMPL run may find a stage, as a factor of the limit (plus
 /// one second): OMPL's termination condition reads the clock every 64 calls and a planner's
 /// iteration (a BIT* batch) may run on after it.
@@ -122,6 +129,10 @@ struct FrontendBenchResult {
   double steer_step = 0.0, goal_radius = 0.0;
   std::string region_source;
   std::size_t region_cells = 0;
+  /// SHA-256 of the region's document (HeuristicRegion::to_json), and of the sGAN weights'
+  /// bytes ("" when miner-sgan does not run): a merge compares them, since a path names
+  /// whatever file is there when a part runs (sixteenth campaign F10).
+  std::string region_sha256, weights_sha256;
   double region_ms = 0.0;        ///< time to build the region (not in MINER's times)
   std::vector<RunRecord> runs;
   std::vector<PlannerSummary> summaries;

@@ -26,7 +26,7 @@ struct HeuristicBenchOptions {
   /// The option that set `samples`, named when the split has fewer (bench paper's own name).
   std::string samples_option = "--samples";
   std::string weights;          ///< empty: the shipped weights
-  std::uint64_t seed = 1;       ///< noise of sample k: seed + k; planner stream k
+  std::uint64_t seed = 1;       ///< noise of a sample: seed + its key (its family and map seed); planner stream: the key
   std::size_t max_iterations = 20000;
   double target_factor = 1.0;   ///< target cost = factor x the sample's A* cost
   bool planners = true;         ///< also run MINER and RRT* (false: quality only)

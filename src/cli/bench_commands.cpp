@@ -14,6 +14,7 @@
 #include "bench/backend_bench.hpp"
 #include "bench/frontend_bench.hpp"
 #include "bench/heuristic_bench.hpp"
+#include "bench/ompl_planners.hpp"
 #include "bench/paper_bench.hpp"
 #include "bench/suite_bench.hpp"
 #include "bench/voxel_bench.hpp"
@@ -146,6 +147,10 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   fc->add_option("--time-limit", f->bench.time_limit_s, "wall-clock cap per run of OMPL's planners in s (ours stop on --iterations)")
       ->check(finite_in(bench::kMinTimeLimitS, bench::kMaxTimeLimitS))
       ->capture_default_str();
+  fc->add_option("--ompl-checks", f->bench.ompl_checks,
+                 "instead of --time-limit: OMPL's planners stop after N termination checks (one per iteration), "
+                 "so their records repeat exactly")
+      ->check(integer_in(1, static_cast<long long>(bench::kMaxOmplChecks)));
   // The same ranges as plan's (issue 20: 1e308 was accepted and printed with all its digits).
   fc->add_option("--step", f->bench.planner_options.steer_step, "steering step eta in m (default 0.1 x diagonal)")
       ->check(finite_in(1e-6, 1e6));
@@ -182,6 +187,19 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
       throw CLI::ValidationError("--weights", "applies to the miner-sgan planner, which --planners leaves out");
     if (given("--no-safeguard") && !runs("miner") && !runs(bench::kMinerSgan))
       throw CLI::ValidationError("--no-safeguard", "applies to miner and miner-sgan, which --planners leaves out");
+    // Ours stop on --max-iterations only (sixteenth campaign F21: a --time-limit that bound no
+    // planner was recorded in the campaign as if it had).
+    {
+      const std::vector<std::string> ran = names.empty() ? bench::default_frontend_planners() : names;
+      const bool any_ompl = std::any_of(ran.begin(), ran.end(), [](const std::string& n) { return bench::is_ompl_planner(n); });
+      for (const char* name : {"--time-limit", "--ompl-checks"})
+        if (given(name) && !any_ompl)
+          throw CLI::ValidationError(name, "applies to OMPL's planners, which --planners leaves out (ours stop on --max-iterations)");
+      if (given("--time-limit") && given("--ompl-checks"))
+        throw CLI::ValidationError("--ompl-checks", "replaces --time-limit (a budget that repeats, not the wall clock): give one");
+      // The clock must not bind when the checks do: a day, the longest limit.
+      if (given("--ompl-checks")) f->bench.time_limit_s = bench::kMaxTimeLimitS;
+    }
     check_region_dims(fc, f->region_dims);
     run_frontend(*f, out);
   });
@@ -200,7 +218,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   hc->add_option("--samples", h->bench.samples, "first N samples of the split (0: all)")->capture_default_str()
       ->check(integer_in(0, 10000000));
   hc->add_option("--weights", h->bench.weights, "sGAN weights (default: the shipped fixtures/sgan/sgan.bin)");
-  hc->add_option("--seed", h->bench.seed, "noise seed (sample k: seed + k) and planner seed")->capture_default_str()->check(kUnsigned64);
+  hc->add_option("--seed", h->bench.seed, "noise seed (a sample: seed + its own key, whatever --data holds beside it) and planner seed")->capture_default_str()->check(kUnsigned64);
   hc->add_option("--iterations", h->bench.max_iterations, "planner iteration budget per query")
       ->check(kIterationsRange)
       ->capture_default_str();

@@ -210,9 +210,7 @@ const CLI::Validator kOutputFileNewFolder(
     "OUTPUT FILE");
 
 CLI::Validator finite_in(double lo, double hi) {
-  char range[96];
-  std::snprintf(range, sizeof range, "[%g, %g]", lo, hi);
-  const std::string text_range(range);
+  const std::string text_range = "[" + exact_number(lo) + ", " + exact_number(hi) + "]";
   return CLI::Validator(
       [lo, hi, text_range](std::string& text) -> std::string {
         double v = 0.0;

@@ -191,7 +191,11 @@ struct ConvertOptions {
 };
 
 void run_convert(const ConvertOptions& o, std::ostream& out) {
-  const Map map = Map::load(o.in);
+  const Map loaded = Map::load(o.in);
+  // --drop-query drops it whatever the output (sixteenth campaign F21: a .json output kept it).
+  const bool dropped = o.drop_query && loaded.query().has_value();
+  const Map map = dropped ? Map(loaded.bounds(), loaded.resolution(), loaded.obstacles(), std::nullopt, loaded.voxel_source())
+                          : loaded;
   // An OctoMap holds voxels only: a query would be lost without a word (issue 20, sixth campaign
   // U16: `astar` on the .bt then said "has no query"). Said and refused unless asked for.
   const bool to_octomap = ends_with(o.out, ".bt");
@@ -207,9 +211,9 @@ void run_convert(const ConvertOptions& o, std::ostream& out) {
   std::ostringstream human;
   human << "wrote " << o.out << " (" << map.obstacles().size() << " obstacles";
   if (map.voxels()) human << ", " << map.voxels()->layer().count(world::VoxelState::kOccupied) << " occupied voxels";
-  human << " from " << o.in << (to_octomap && map.query() ? "; its query was dropped, as asked" : "") << ")\n";
+  human << " from " << o.in << (dropped || (to_octomap && map.query()) ? "; its query was dropped, as asked" : "") << ")\n";
   Json doc{{"in", o.in}, {"out", o.out}, {"obstacles", map.obstacles().size()},
-           {"query_dropped", to_octomap && map.query().has_value()}};
+           {"query_dropped", dropped || (to_octomap && map.query().has_value())}};
   if (map.voxels()) doc["occupied_voxels"] = map.voxels()->layer().count(world::VoxelState::kOccupied);
   report(o.json, doc, human.str(), out);
 }
@@ -365,7 +369,7 @@ void add_map_commands(CLI::App& app, std::ostream& out) {
   g->add_option("--base", gen->base, "scan: the preset the mapping run flies over (default: drawn per map)")
       ->check(one_of("scan base", world::scan_base_names()));
   g->add_option("--seed", gen->seed, "random seed")->capture_default_str()->check(kUnsigned64);
-  g->add_option("--obstacles", gen->obstacles, "number of obstacles (default: the preset's range)")
+  g->add_option("--obstacles", gen->obstacles, "number of the family's obstacles (pillars, trees, cuboids; each may be several boxes; default: the preset's range)")
       ->check(CLI::Range(0, kMaxObstacles));
   g->add_option("--size", gen->size, "families: extents X Y Z in m instead of drawn ones")->expected(3)
       ->check(finite_in(3.0, 1000.0));  // the families' sizes (REQ-WORLD-011)
@@ -402,7 +406,7 @@ void add_map_commands(CLI::App& app, std::ostream& out) {
   c->add_option("--out", conv->out, "output map (.json or .bt)")->required()->check(kOutputFile & kMapOutput);
   c->add_flag("--json", conv->json, "print the summary as JSON");
   c->add_flag("--drop-query", conv->drop_query,
-              "writing .bt: convert a map that has a query (an OctoMap cannot hold it) without it");
+              "write the map without its query (needed for .bt, which cannot hold one)");
   c->callback([conv, &out] { run_convert(*conv, out); });
 
   auto scan = std::make_shared<ScanCliOptions>();
@@ -464,7 +468,7 @@ void add_map_commands(CLI::App& app, std::ostream& out) {
   auto import = std::make_shared<ImportOptions>();
   CLI::App* im = map->add_subcommand(
       "import", "point clouds (.ply, .pcd) to a voxel map: OctoMap traces each point's ray from the sensor (free) to the point (occupied)");
-  im->add_option("--cloud", import->clouds, "point cloud file (.ply or .pcd); repeat for several scans")->required();
+  im->add_option("--cloud", import->clouds, "point cloud file (.ply or .pcd); repeat for several scans, in the order they were taken (OctoMap clamps log-odds: the order matters)")->required();
   im->add_option("--origin", import->origin, "sensor position x y z in m (default: each PCD file's VIEWPOINT)")
       ->expected(3)->check(kFinite);
   im->add_option("--resolution", import->resolution, "voxel size in m")->capture_default_str()

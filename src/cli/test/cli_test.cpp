@@ -149,9 +149,28 @@ TEST_CASE("map gen --preset scan writes the run's voxels beside the map, and pla
   args.back() = c;
   const Run kept = miner_cli(args);
   CHECK(kept.code == 1);
-  CHECK_THAT(kept.err, Contains(c_bt) && Contains("is not the voxel file of a map at") && !Contains("unknown voxels"));
+  CHECK_THAT(kept.err, Contains(c_bt) && Contains("is not a voxel file that a save of a map at") && !Contains("unknown voxels"));
   CHECK(read(c_bt) == "someone else's OctoMap");
   CHECK_FALSE(std::filesystem::exists(c));
+  // A map JSON that references the .bt is not enough: `map convert --in d.bt --out d.json`
+  // references the user's own OctoMap, which a later save to d.json must not replace (sixteenth
+  // campaign F14: the user's scan was lost).
+  const std::string d = dir() + "/scan-d.json", d_bt = dir() + "/scan-d.bt";
+  std::filesystem::copy_file(dir() + "/scan-a.bt", d_bt, std::filesystem::copy_options::overwrite_existing);
+  {
+    // A user's OctoMap: the same voxels without the save's mark (the line after the header).
+    std::string user = read(d_bt);
+    const std::size_t first = user.find('\n') + 1;
+    user.erase(first, user.find('\n', first) + 1 - first);
+    std::ofstream(d_bt, std::ios::binary) << user;
+  }
+  const std::string user_bytes = read(d_bt);
+  REQUIRE(miner_cli({"map", "convert", "--in", d_bt, "--out", d}).code == 0);
+  args.back() = d;
+  const Run kept_user = miner_cli(args);
+  CHECK(kept_user.code == 1);
+  CHECK_THAT(kept_user.err, Contains(d_bt) && Contains("is not a voxel file that a save of a map at"));
+  CHECK(read(d_bt) == user_bytes);
   const Run info = miner_cli({"map", "info", "--map", a, "--json"});
   REQUIRE(info.code == 0);
   CHECK(miner::parse_json(info.out, "stdout")["voxels"]["counts"]["unknown"]["voxels"].get<double>() > 0);
@@ -235,6 +254,15 @@ TEST_CASE("map convert to .bt neither loses a query silently nor blames its outp
   // To JSON the query is kept, and no flag is needed.
   REQUIRE(miner_cli({"map", "convert", "--in", with_query, "--out", dir() + "/conv-query-copy.json"}).code == 0);
   CHECK(miner::read_json_file(dir() + "/conv-query-copy.json").contains("query"));
+  // ... and with --drop-query it is dropped there too (sixteenth campaign F21: the flag was
+  // ignored for a .json output).
+  const Run json_dropped = miner_cli({"map", "convert", "--in", with_query, "--out", dir() + "/conv-query-none.json",
+                                      "--drop-query", "--json"});
+  REQUIRE(json_dropped.code == 0);
+  CHECK(miner::parse_json(json_dropped.out, "stdout")["query_dropped"] == true);
+  const miner::Json none = miner::read_json_file(dir() + "/conv-query-none.json");
+  CHECK_FALSE(none.contains("query"));
+  CHECK(none["obstacles"] == miner::read_json_file(with_query)["obstacles"]);
   // A generated map written as .bt says that its query is not in it.
   const Run gen = miner_cli({"map", "gen", "--preset", "indoor", "--out", dir() + "/gen-q.bt", "--quiet"});
   REQUIRE(gen.code == 0);
@@ -791,6 +819,9 @@ TEST_CASE("Unknown options are named with the nearest one: duplicates, exclusive
       // planner options with --no-planners (third campaign: ignored).
       {{"bench", "frontend", "--map", map, "--planners", "rrtstar,guided", "--dims", "8", "8", "8"},
        "--dims: applies to the miner planner, which --planners leaves out"},
+      // Sixteenth campaign F21: a time limit no planner of the campaign obeys was recorded.
+      {{"bench", "frontend", "--map", map, "--planners", "rrtstar,miner", "--time-limit", "2"},
+       "--time-limit: applies to OMPL's planners, which --planners leaves out"},
       {{"bench", "frontend", "--map", map, "--planners", "miner-sgan", "--region", dir() + "/r.json"},
        "--region: applies to the miner planner, which --planners leaves out"},
       {{"bench", "frontend", "--map", map, "--planners", "miner", "--region", dir() + "/r.json", "--dims", "8", "8", "8"},
@@ -1576,6 +1607,9 @@ TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[RE
     doctor([](miner::Json& d) { d["goal_radius"] = -1.0; }, "goal_radius: the goal radius must be in [1e-6, 1e6] m");
     // Fifteenth campaign F7: values a campaign cannot produce, each one edit of a valid part.
     doctor([](miner::Json& d) { d["goal_radius"] = 0.0; }, "goal_radius: the goal radius must be in [1e-6, 1e6] m");
+    // Sixteenth campaign F17: a start within the goal radius is no campaign (every run solved at
+    // iteration 0, a throughput of 0).
+    doctor([](miner::Json& d) { d["goal_radius"] = d["lower_bound"].get<double>() + 1.0; }, "m reaches the start (|goal - start| = ");
     doctor([](miner::Json& d) { d["time_limit_s"] = 0.0; }, "time_limit_s: the time limit must be in [0.001, 86400] s");
     doctor([&](miner::Json& d) {
       for (auto& r : d["run_records"])
@@ -1624,7 +1658,7 @@ TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[RE
           }
       }, "more than the campaign's budget");
     }
-    if (miner::bench::ompl_available())
+    if (miner::bench::ompl_available()) {
       doctor([&](miner::Json& d) {
         for (auto& r : d["run_records"])
           if (r["planner"] == "ompl:RRTConnect" && r["first"].is_object()) {
@@ -1633,6 +1667,18 @@ TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[RE
           }
         FAIL("no solved ompl:RRTConnect record");
       }, "first.time_ms: 1000000.0 ms, past the campaign's time limit");
+      // Sixteenth campaign F1: a vertex count where the planner reports none (or the reverse)
+      // merged when the summary's median did not move.
+      for (const char* planner : {"ompl:RRTConnect", "ompl:RRTstar"})
+        doctor([&](miner::Json& d) {
+          for (auto& r : d["run_records"])
+            if (r["planner"] == planner && r["first"].is_object()) {
+              r["first"]["nodes"] = r["first"]["nodes"].is_null() ? miner::Json(10) : miner::Json(nullptr);
+              return;
+            }
+          FAIL("no solved " << planner << " record");
+        }, "reports its vertices at its first solution in every run or in none");
+    }
     doctor([](miner::Json& d) { d["steer_step"] = 0.0; }, "steer_step: the steering step must be positive and finite");
     doctor([](miner::Json& d) { d["region"]["cells"] = 1; }, "different campaigns: region.cells is 1 in the one");
     // Fifth campaign: a part of other --planners was called "incomplete".
@@ -1658,6 +1704,50 @@ TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[RE
   const std::string other = dir() + "/other-seed.json";
   REQUIRE(miner_cli(with({"--shard", "1/3", "--seed", "9", "--out", other})).code == 0);
   CHECK_THAT(miner_cli({"bench", "merge", parts[0], parts[1], other}).err, Contains("different campaign"));
+  // Parts run with other region or weights files under the same path are other campaigns: a
+  // part records their contents' SHA-256, not only the path (sixteenth campaign F10).
+  {
+    const std::string region = dir() + "/merge-region.json", weights = dir() + "/merge-weights.bin";
+    const std::vector<std::string> small{"bench", "frontend", "--map", src + "/fixtures/maps/sim-2.json", "--runs", "2",
+                                         "--planners", "miner,miner-sgan", "--throughput-iterations", "0",
+                                         "--max-iterations", "200", "--quiet", "--json",
+                                         "--region", region, "--weights", weights};
+    const auto part = [&](const std::string& shard) {
+      std::vector<std::string> run_args = small;
+      const std::string path = dir() + "/files-" + shard.substr(0, 1) + ".json";
+      for (const std::string& x : {std::string("--shard"), shard, std::string("--out"), path}) run_args.push_back(x);
+      const Run r = miner_cli(run_args);
+      INFO(r.err);
+      REQUIRE(r.code == 0);
+      return path;
+    };
+    REQUIRE(miner_cli({"region", "astar", "--map", src + "/fixtures/maps/sim-2.json", "--out", region, "--quiet"}).code == 0);
+    const auto use_weights = [&](const char* name) {
+      std::filesystem::copy_file(src + "/fixtures/sgan/lofo/" + name, weights, std::filesystem::copy_options::overwrite_existing);
+    };
+    use_weights("without-sim.bin");
+    const std::string p0 = part("0/2"), p1 = part("1/2");
+    REQUIRE(miner_cli({"bench", "merge", p0, p1}).code == 0);
+    use_weights("without-indoor.bin");
+    const std::string p1_weights = part("1/2");
+    const Run w = miner_cli({"bench", "merge", p0, p1_weights});
+    CHECK(w.code == 1);
+    CHECK_THAT(w.err, Contains("are different campaigns: weights.sha256"));
+    use_weights("without-sim.bin");
+    // The same number of cells, one moved: only the contents tell the two regions apart.
+    miner::Json r = miner::read_json_file(region);
+    auto& cells = r["probabilities"];
+    std::size_t in = 0, out = 0;
+    while (cells[in] != 1.0) ++in;
+    while (cells[out] != 0.0) ++out;
+    cells[in] = 0.0;
+    cells[out] = 1.0;
+    std::ofstream(region) << r.dump();
+    const std::string p1_region = part("1/2");
+    const Run g = miner_cli({"bench", "merge", p0, p1_region});
+    CHECK(g.code == 1);
+    CHECK_THAT(g.err, Contains("are different campaigns: region.sha256"));
+  }
   // Not a campaign at all, or a part without its records: the file and the field are named.
   const std::string a_map = write("merge-map.json", kPillarMap);
   const Run map_part = miner_cli({"bench", "merge", parts[0], parts[1], a_map});
@@ -2170,6 +2260,88 @@ TEST_CASE("miner map import turns a point cloud into a voxel map that plans", "[
   CHECK(miner_cli({"astar", "--map", bt, "--start", "0", "0", "1", "--goal", "4", "0", "1"}).code == 1);
   CHECK_THAT(miner_cli({"map", "import", "--cloud", write("c.txt", "x"), "--origin", "0", "0", "0", "--out", bt}).err,
              Contains("must be a .ply or .pcd file"));
+}
+
+TEST_CASE("bench heuristic: a family's figures do not depend on the other folders of --data or their order", "[REQ-HEUR-009]") {
+  // Sixteenth campaign F23: the noise seeds and planner streams followed a running index over
+  // every folder, so listing the families in another order changed each family's figures.
+  const std::string indoor = dir() + "/order-indoor", sim = dir() + "/order-sim";
+  for (const auto& [preset, out] : {std::pair{"indoor", indoor}, std::pair{"sim", sim}})
+    REQUIRE(miner_cli({"dataset", "--preset", preset, "--count", "1", "--test-count", "3", "--seed", "4", "--out", out,
+                       "--quiet"}).code == 0);
+  const auto families = [&](std::vector<std::string> data) {
+    std::vector<std::string> args{"bench", "heuristic", "--split", "test", "--iterations", "400", "--json", "--data"};
+    args.insert(args.end(), data.begin(), data.end());
+    const Run r = miner_cli(args);
+    INFO(r.err);
+    REQUIRE(r.code == 0);
+    miner::Json f = miner::parse_json(r.out, "stdout")["families"];
+    // The clock's figures aside, every figure of each family.
+    for (auto& [name, family] : f.items()) {
+      for (const char* who : {"miner", "rrtstar"})
+        for (const char* k : {"first_time_ms", "target_time_ms"}) family[who].erase(k);
+      for (const char* k : {"inference_ms", "filter_ms", "filter_ms_max", "region_ms"}) family.erase(k);
+    }
+    return f;
+  };
+  const miner::Json ab = families({indoor, sim}), ba = families({sim, indoor});
+  CHECK(ab == ba);
+  CHECK(families({sim})["sim"] == ab["sim"]);
+}
+
+TEST_CASE("bench frontend --ompl-checks: OMPL's time-capped planners give the same records on every run", "[REQ-PLAN-017][REQ-PLAN-010]") {
+  // Sixteenth campaign F13: BIT*, AIT* and RRT-Connect stop on the wall clock, so two runs of one
+  // command gave other iterations and costs. A budget of termination checks repeats exactly.
+  if (!miner::bench::ompl_available()) return;  // built without OMPL: nothing to repeat
+  const std::string src = MINER_SOURCE_DIR;
+  const std::vector<std::string> campaign{"bench", "frontend", "--map", src + "/fixtures/maps/sim-2.json", "--runs", "2",
+                                          "--planners", "ompl:RRTConnect,ompl:BITstar,ompl:AITstar", "--ompl-checks", "400",
+                                          "--throughput-iterations", "0", "--quiet", "--json"};
+  const auto records = [&] {
+    const Run r = miner_cli(campaign);
+    INFO(r.err);
+    REQUIRE(r.code == 0);
+    const miner::Json doc = miner::parse_json(r.out, "stdout");
+    CHECK(doc["ompl_checks"] == 400);
+    CHECK(doc["time_limit_s"] == 86400.0);  // the clock lifted: only the checks bind
+    miner::Json kept = doc["run_records"];
+    for (auto& rec : kept)
+      for (const char* stage : {"first", "target"})
+        if (rec[stage].is_object()) rec[stage].erase("time_ms");
+    return kept;
+  };
+  const miner::Json once = records(), again = records();
+  CHECK(once == again);
+  CHECK(once.size() == 6u);
+  // It replaces the wall clock: both together, or without an OMPL planner, are usage errors.
+  std::vector<std::string> both = campaign;
+  both.insert(both.end(), {"--time-limit", "1"});
+  const Run b = miner_cli(both);
+  CHECK(b.code == 2);
+  CHECK_THAT(b.err, Contains("--ompl-checks: replaces --time-limit"));
+  const Run ours = miner_cli({"bench", "frontend", "--map", src + "/fixtures/maps/sim-2.json", "--planners", "rrtstar",
+                              "--ompl-checks", "10"});
+  CHECK(ours.code == 2);
+  CHECK_THAT(ours.err, Contains("--ompl-checks: applies to OMPL's planners, which --planners leaves out"));
+}
+
+TEST_CASE("bench frontend refuses a query whose start lies within the goal radius", "[REQ-PLAN-010][REQ-CLI-001]") {
+  // Sixteenth campaign F17: every planner solved it at iteration 0 without a tree, and the
+  // throughput check reported 0 iterations per second. Refused before any run.
+  const std::string map = write("pillar-f17.json", kPillarMap);
+  const std::string out = dir() + "/f17.json";
+  const Run r = miner_cli({"bench", "frontend", "--map", map, "--planners", "rrtstar", "--start", "1", "1", "1", "--goal",
+                           "1.5", "1", "1", "--goal-radius", "0.5", "--out", out});
+  CHECK(r.code == 1);
+  CHECK_THAT(r.err, Contains("lies within the goal radius 0.5 m of the goal (1.5, 1, 1): every planner solves this query at "
+                             "iteration 0"));
+  CHECK_FALSE(std::filesystem::exists(out));
+  // Just outside the radius: a campaign.
+  const Run ok = miner_cli({"bench", "frontend", "--map", map, "--planners", "rrtstar", "--runs", "1", "--start", "1", "1", "1",
+                            "--goal", "1.5", "1", "1", "--goal-radius", "0.49", "--throughput-iterations", "10", "--quiet",
+                            "--json"});
+  INFO(ok.err);
+  CHECK(ok.code == 0);
 }
 
 TEST_CASE("A flight that leaves the map stops there: exit 3 naming when and where", "[REQ-FLIGHT-009][REQ-CLI-001]") {

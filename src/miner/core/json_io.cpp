@@ -332,11 +332,17 @@ void JsonField::require_format(const std::string& tag) const {
 
 double JsonField::number_in(double lo, double hi, const std::string& unit) const {
   const double v = number();
-  if (v < lo || v > hi) {
-    char range[128];
-    std::snprintf(range, sizeof range, "[%g, %g]", lo, hi);
-    fail("must be in " + std::string(range) + (unit.empty() ? "" : " " + unit) + ", got " + value_->dump());
-  }
+  if (v < lo || v > hi)
+    fail("must be in [" + exact_number(lo) + ", " + exact_number(hi) + "]" + (unit.empty() ? "" : " " + unit) + ", got " +
+         value_->dump());
+  return v;
+}
+
+double JsonField::number_above(double lo, double hi, const std::string& unit) const {
+  const double v = number();
+  if (!(v > lo && v <= hi))
+    fail("must be in (" + exact_number(lo) + ", " + exact_number(hi) + "]" + (unit.empty() ? "" : " " + unit) + ", got " +
+         value_->dump());
   return v;
 }
 
@@ -348,6 +354,10 @@ double JsonField::number_in_or(const std::string& key, double fallback, double l
 int JsonField::integer() const {
   const double v = number();
   if (std::floor(v) != v) fail("expected an integer, got " + value_->dump());
+  // One integer rule for every field (sixteenth campaign F5: "order": 3.0 and "dims": [8.0, ..]
+  // were read, "seed": 1.0 and "run": 1.0 refused): an integer is written as one.
+  if (!value_->is_number_integer())
+    fail("expected an integer, got " + value_->dump() + " (write it without a decimal point or exponent)");
   // issue 20: "expected an integer, got 1000000000000" read as if the value were not whole.
   if (std::fabs(v) > 2147483647.0) fail("integer " + value_->dump() + " is out of range (at most 2147483647 in magnitude)");
   return static_cast<int>(v);
@@ -364,6 +374,12 @@ Eigen::Vector3d JsonField::vec3() const {
          " elements");
   }
   return {at(std::size_t{0}).number(), at(std::size_t{1}).number(), at(std::size_t{2}).number()};
+}
+
+std::string quoted_excerpt(const std::string& text) {
+  constexpr std::size_t kShown = 64;
+  const bool cut = text.size() > kShown;
+  return Json(cut ? text.substr(0, kShown) : text).dump(-1, ' ', false, Json::error_handler_t::replace) + (cut ? "..." : "");
 }
 
 Json vec3_json(const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); }
@@ -474,7 +490,11 @@ void write_folder_atomic(const std::string& path, const std::vector<std::pair<st
   namespace fs = std::filesystem;
   require_path_without_nul(path, "output folder");
   fs::path target = fs::path(path).lexically_normal();
-  if (target.empty() || target.filename().empty()) throw Error(path + ": not a folder name");
+  // "run/" names the folder run, as the shell's completion writes it (sixteenth campaign F20:
+  // refused as "not a folder name").
+  if (!target.empty() && target.filename().empty() && target.has_relative_path()) target = target.parent_path();
+  if (target.empty() || target.filename().empty() || target.filename() == "." || target.filename() == "..")
+    throw Error(path + ": not a folder name");
   // A symbolic link is followed, as for files (fourteenth campaign C6: `dataset --out LINK`
   // replaced the user's link with a new folder and left the folder it named as it was).
   std::error_code link_ec;

@@ -67,11 +67,13 @@ class JsonField {
   /// m, got 1e9"). Every physical value a file gives has a range (issue 20: a goal tolerance
   /// of 1e9 m made every flight "reach" its goal).
   double number_in(double lo, double hi, const std::string& unit = "") const;
+  /// The same for (lo, hi]: lo itself refused, and the message says so ("must be in (0, 5] m").
+  double number_above(double lo, double hi, const std::string& unit = "") const;
   /// Member `key` as number_in(lo, hi, unit), or `fallback` when the object has no such key
   /// (an optional physical value: every file section's defaults).
   double number_in_or(const std::string& key, double fallback, double lo, double hi,
                       const std::string& unit = "") const;
-  int integer() const;                  ///< an integral number
+  int integer() const;                  ///< an integer, written as one (3, not 3.0), in int's range
   std::string string() const;
   Eigen::Vector3d vec3() const;         ///< array of 3 finite numbers
   /// An object whose keys are all in `known` (REQ-CORE-003: no ignored unknown key);
@@ -107,6 +109,10 @@ std::string first_difference(const Json& one, const Json& other);
 
 /// [x, y, z] as a JSON array: what JsonField::vec3 reads back.
 Json vec3_json(const Eigen::Vector3d& v);
+
+/// `text` quoted as JSON writes a string (a newline shown as \n, bytes that are not UTF-8
+/// replaced), cut to its first 64 bytes and "..." when longer: a bad name shown in a message.
+std::string quoted_excerpt(const std::string& text);
 
 /// Writes `content` to `path` via a temporary file in the same folder and a rename,
 /// so readers see either the old file or the complete new one, never a mix.

@@ -3,6 +3,8 @@
 #include <array>
 #include <cstdint>
 
+#include "miner/core/json_io.hpp"
+
 namespace miner {
 
 namespace {
@@ -77,6 +79,13 @@ std::uint64_t fnv1a64(const void* data, std::size_t size, std::uint64_t h) {
     h *= 0x100000001b3ULL;
   }
   return h;
+}
+
+std::string sha256_field(const JsonField& f) {
+  const std::string hex = f.string();
+  if (hex.size() != 64 || hex.find_first_not_of("0123456789abcdef") != std::string::npos)
+    f.fail("must be 64 lower-case hexadecimal digits (a SHA-256 as `sha256sum` prints it), got \"" + hex + "\"");
+  return hex;
 }
 
 }  // namespace miner

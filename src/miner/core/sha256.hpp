@@ -12,6 +12,12 @@ namespace miner {
 
 std::string sha256_hex(const std::string& bytes);
 
+class JsonField;
+/// A recorded SHA-256 read from a file: 64 lower-case hex digits (as `sha256sum` prints them),
+/// else the field is refused, so a malformed hash is named as such rather than as "the file
+/// changed".
+std::string sha256_field(const JsonField& f);
+
 /// FNV-1a, 64 bit, of `size` bytes, continuing from `h` (the offset basis by default), so a
 /// checksum of several pieces is one call per piece. Not cryptographic: a tensor file's data
 /// check and a map's fingerprint (world::Map::fingerprint).

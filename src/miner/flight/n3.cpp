@@ -30,7 +30,7 @@ void validate(const Config& c) {
   // a few seconds of flight (issue 20, unbounded work); 10 kHz x the 1000 s flight cap is 1e7.
   constexpr double kMaxRateHz = 10000.0;
   if (!(c.rate_hz >= 400.0 && c.rate_hz <= kMaxRateHz))
-    fail("rate_hz must be in [400, 10000] (the N3's inner loop), got " + short_number(c.rate_hz));
+    fail("rate_hz must be in [400, 10000] (the N3's inner loop), got " + exact_number(c.rate_hz));
   if (!(c.latency_s >= 0.0) || !std::isfinite(c.latency_s)) fail("latency_s must be finite and >= 0");
   if (!(c.timeout_s > 0.0) || !std::isfinite(c.timeout_s)) fail("timeout_s must be positive");
   if (!(c.max_tilt_deg > 0.0 && c.max_tilt_deg < 90.0)) fail("max_tilt_deg must be in (0, 90)");

@@ -6,6 +6,7 @@
 #include <Eigen/LU>
 
 #include "miner/core/error.hpp"
+#include "miner/core/text.hpp"
 #include "miner/core/units.hpp"
 
 namespace miner::flight {
@@ -40,6 +41,8 @@ void validate(const VehicleParams& v, const std::string& origin) {
       bad(origin, field, text + (std::isfinite(x) ? Json(x).dump() : std::string(std::isnan(x) ? "nan" : (x > 0 ? "inf" : "-inf"))));
     }
   };
+  // A struct's name, by the file's rule (the Python module and C++ callers set it directly).
+  if (!is_plain_name(v.name)) bad(origin, "name", std::string(kPlainNameRule) + ", got " + quoted_excerpt(v.name));
   positive(v.mass, "mass_kg", 1000.0);
   for (int i = 0; i < 3; ++i) positive(v.inertia[i], "inertia_kg_m2", 1000.0);
   positive(v.arm_length, "arm_length_m", 10.0);
@@ -146,7 +149,12 @@ VehicleParams vehicle_from_json(const Json& doc, const std::string& origin) {
                   "motor_time_constant_up_s", "motor_time_constant_down_s", "linear_drag_N_s_per_m", "radius_m",
                   "rotor_drag_N_s_per_m_rad", "quadratic_drag_N_s2_per_m2"});
   VehicleParams v;
-  if (root.has("name")) v.name = root.at("name").string();
+  if (root.has("name")) {
+    v.name = root.at("name").string();
+    // Copied into summaries and reports: the scenario name's rule (sixteenth campaign F24: an
+    // empty name, a NUL, newlines or 100 kB were copied as they were).
+    if (!is_plain_name(v.name)) root.at("name").fail(std::string(kPlainNameRule) + ", got " + quoted_excerpt(v.name));
+  }
   v.mass = root.at("mass_kg").number();
   v.inertia = root.at("inertia_kg_m2").vec3();
   v.arm_length = root.at("arm_length_m").number();

@@ -104,14 +104,6 @@ Json format_fields() {
           {"map_seed_rule", "splitmix64(seed ^ k); train and val: k < count, test: k >= count"}};
 }
 
-/// A SHA-256 as dataset.json records it: 64 lower-case hex digits.
-std::string sha256_field(const JsonField& f) {
-  std::string hex = f.string();
-  if (hex.size() != 64 || hex.find_first_not_of("0123456789abcdef") != std::string::npos)
-    f.fail("expected 64 lower-case hex digits");
-  return hex;
-}
-
 DatasetLayout read_layout(const Json& doc, const std::string& origin) {
   const JsonField root(doc, "", origin);
   root.only_keys({"format", "preset", "seed", "dims", "bounds", "channels", "environment_levels", "passability_bits",

@@ -333,6 +333,7 @@ HeuristicQuery query_region(const Sgan& sgan, const world::Map& map, const Eigen
   const double filter_ms = elapsed_ms(t0);
   plan::HeuristicRegion region(b, dims, std::move(probabilities), filter ? 0.5 : threshold,
                                filter ? "sgan-filtered" : "sgan-raw");
+  region.set_map_fingerprint(map.fingerprint());
   return {std::move(region), std::move(prob), std::move(env), f.report, std::move(witness), encode_ms, inference_ms,
           filter_ms};
 }

@@ -12,6 +12,7 @@
 
 #include "miner/core/error.hpp"
 #include "miner/core/rng.hpp"
+#include "miner/core/sha256.hpp"
 #include "miner/core/text.hpp"
 #include "miner/heuristic/grid.hpp"
 #include "miner/heuristic/sgan_kernels.hpp"
@@ -239,6 +240,7 @@ struct Sgan::Impl {
   /// 16 regions wrong, silently).
   std::mutex busy;
   std::string path;
+  std::string sha256;  // of the weights file's bytes
   Json meta;
   SganArchitecture arch;
   dnnl::engine engine{dnnl::engine::kind::cpu, 0};
@@ -413,7 +415,7 @@ void Sgan::Impl::build(const TensorFile& f, Sgan::Kernels which) {
   // 0 then "must be positive").
   arch.environment_scale = ar.at("environment_scale").number();
   if (!(arch.environment_scale > 0.0 && arch.environment_scale <= 1.0))
-    ar.at("environment_scale").fail("must be in (0, 1], got " + short_number(arch.environment_scale));
+    ar.at("environment_scale").fail("must be in (0, 1], got " + exact_number(arch.environment_scale));
   arch.threshold = ar.at("threshold").number();
   if (!(arch.threshold > 0.0 && arch.threshold < 1.0)) ar.at("threshold").fail("must be in (0, 1)");
   // Absent in the files written before the widest rule (REQ-HEUR-016): fixed.
@@ -642,6 +644,7 @@ Sgan Sgan::from_bytes(const std::string& blob, const std::string& origin, Kernel
   const TensorFile f = parse_tensor_file(blob, origin, "sgan-weights");
   auto impl = std::make_unique<Impl>();
   impl->path = origin;
+  impl->sha256 = sha256_hex(blob);
   impl->meta = f.meta;
   try {
     const OneOpenMpThread one_thread;  // the primitives keep the thread count they are made with
@@ -664,6 +667,7 @@ Sgan Sgan::builtin() {
 const SganArchitecture& Sgan::architecture() const { return live().arch; }
 const Json& Sgan::meta() const { return live().meta; }
 const std::string& Sgan::path() const { return live().path; }
+const std::string& Sgan::sha256() const { return live().sha256; }
 bool Sgan::own_kernels() const { return live().own_kernels; }
 
 namespace {
@@ -724,7 +728,7 @@ std::vector<float> scale_input(const world::Box& bounds, const Eigen::Vector3i& 
   if (!(std::isfinite(robot_radius) && robot_radius >= 0.0))
     throw Error("sgan: the robot radius must be >= 0 and finite for the scale input");
   if (!(std::isfinite(divisor) && divisor > 0.0))
-    throw Error("sgan: the scale divisor must be positive and finite, got " + short_number(divisor));
+    throw Error("sgan: the scale divisor must be positive and finite, got " + exact_number(divisor));
   if ((dims.array() < 1).any()) throw Error("sgan: every grid dimension must be at least 1 for the scale input");
   std::vector<float> sigma(3);
   for (int a = 0; a < 3; ++a) {

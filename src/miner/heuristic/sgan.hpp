@@ -84,6 +84,9 @@ class Sgan {
   /// The file's "meta" object (architecture, training command, seeds, metrics).
   const Json& meta() const;
   const std::string& path() const;
+  /// SHA-256 of the weights file's bytes (64 hex digits): what a campaign or a run folder records,
+  /// since a path alone names whatever file is there later.
+  const std::string& sha256() const;
   /// Whether MINER's own kernels run enc1 and dec1 (see Kernels).
   bool own_kernels() const;
 

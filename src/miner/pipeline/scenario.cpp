@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "miner/core/error.hpp"
+#include "miner/core/sha256.hpp"
 #include "miner/core/stopwatch.hpp"
 #include "miner/core/text.hpp"
 #include "miner/flight/flatness.hpp"
@@ -65,6 +66,48 @@ void apply_speed_limit(flight::FlightSetup& f, const traj::Limits& limits) {
 /// Everything of a scenario document but its format and map (s.map is set): every field's
 /// range and the cross-checks. scenario_from_json reads files with it, and check_scenario
 /// checks a struct by writing it back as a document, so one set of rules holds both.
+/// The field a cross-field rule blames: the first of `paths` ("block.key" or "key") the file sets,
+/// else the top level (sixteenth campaign F12: every such rule blamed "(top level)", and named
+/// the user's own change only as "the N3's").
+JsonField blamed(const JsonField& root, std::initializer_list<const char*> paths) {
+  for (const char* path : paths) {
+    const std::string p(path);
+    const std::size_t dot = p.find('.');
+    if (dot == std::string::npos) {
+      if (root.has(p)) return root.at(p);
+    } else if (root.has(p.substr(0, dot)) && root.at(p.substr(0, dot)).value().is_object() &&
+               root.at(p.substr(0, dot)).has(p.substr(dot + 1))) {
+      return root.at(p.substr(0, dot)).at(p.substr(dot + 1));
+    }
+  }
+  return root;
+}
+
+/// A value in a cross-field message: exact, marked "(default)" when the file does not set it.
+std::string value_of(const JsonField& root, const char* path, double v, const char* unit) {
+  const JsonField f = blamed(root, {path});
+  return std::string(path) + " " + exact_number(v) + " " + unit + (&f.value() == &root.value() ? " (default)" : "");
+}
+
+/// A file the scenario names by path, against the SHA-256 that a run folder's scenario.json
+/// records beside it (`<key>_sha256`): a file changed since the flight would fly another
+/// flight without a word (sixteenth campaign F11: sGAN weights recorded by path only).
+void check_recorded_sha256(const JsonField& block, const std::string& key, const std::string& path,
+                           const std::string& what) {
+  const std::string hash_key = key + "_sha256";
+  if (!block.has(hash_key)) return;
+  const std::string recorded = sha256_field(block.at(hash_key));
+  std::string bytes;
+  try {
+    bytes = read_file_bytes(path, what);
+  } catch (const Error& e) {
+    block.at(key).fail(e.what());
+  }
+  if (const std::string now = sha256_hex(bytes); now != recorded)
+    block.at(hash_key).fail("the " + what + " " + path + " has SHA-256 " + now +
+                            ", not the recorded one: the file changed since this scenario was written");
+}
+
 /// `trajectory_given`: the route is a trajectory already in s (a file's, or a struct's).
 void read_scenario_fields(const JsonField& root, const std::string& origin, const std::string& base_dir,
                           bool trajectory_given, Scenario& s) {
@@ -72,12 +115,9 @@ void read_scenario_fields(const JsonField& root, const std::string& origin, cons
     // The name becomes the default run folder runs/<name>-seed<seed>: one plain, visible name
     // (issue 20: "../../x" wrote outside runs/, "" made runs/-seed1).
     s.name = root.at("name").string();
-    if (s.name.empty() || s.name.size() > 128 || s.name[0] == '.' ||
-        s.name.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789._+-") !=
-            std::string::npos)
+    if (!is_plain_name(s.name))
       // Quoted as JSON writes it, so a newline in the name is shown as \n (seventh campaign C7).
-      root.at("name").fail("must be 1 to 128 letters, digits or . _ + - not starting with '.', got " +
-                           root.at("name").value().dump());
+      root.at("name").fail(std::string(kPlainNameRule) + ", got " + quoted_excerpt(s.name));
   }
 
   if (root.has("vehicle")) {
@@ -146,15 +186,23 @@ void read_scenario_fields(const JsonField& root, const std::string& origin, cons
     // (fifteenth campaign F3: a 1e-9 m route was refused as "must start and end at rest").
     constexpr double kCoincident = 1e-6;
     for (std::size_t i = 1; i < route.size(); ++i)
-      if ((route[i].first - route[i - 1].first).norm() < kCoincident)
-        root.fail(route[i].second + " " + format_point(route[i].first) + " coincides with " + route[i - 1].second +
+      if ((route[i].first - route[i - 1].first).norm() < kCoincident) {
+        const std::string& name = route[i].second;
+        const JsonField at = name == "goal"    ? blamed(root, {"goal"})
+                             : name == "start" ? blamed(root, {"start"})
+                                               : root.at("waypoints").at(static_cast<std::size_t>(i - 1));
+        at.fail(route[i].second + " " + format_point(route[i].first) + " coincides with " + route[i - 1].second +
                   " (closer than " + short_number(kCoincident) + " m): remove the repeated point");
+      }
   }
   if (root.has("trajectory")) {
     const JsonField t = root.at("trajectory");
     if (t.has("file")) {
       const std::string path = resolve(base_dir, t.at("file").string());
+      check_recorded_sha256(t, "file", path, "trajectory file");
       s.trajectory_file = traj::trajectory_from_answer_json(read_json_file(path), path);
+    } else if (t.has("file_sha256")) {
+      t.at("file_sha256").fail("the hash of trajectory.file, which is not given");
     }
     if (t.has("order")) {
       s.order = t.at("order").integer();
@@ -171,11 +219,11 @@ void read_scenario_fields(const JsonField& root, const std::string& origin, cons
       if (s.allocation != "optimise") t.at("rho").fail("only used with \"allocation\": \"optimise\"");
       s.rho = t.at("rho").number_in(1e-9, 1e9);
     }
-    t.only_keys({"file", "order", "v_max", "a_max", "allocation", "rho"});
+    t.only_keys({"file", "file_sha256", "order", "v_max", "a_max", "allocation", "rho"});
   }
   if (root.has("planner")) {
     const JsonField p = root.at("planner");
-    p.only_keys({"region", "weights", "iterations"});
+    p.only_keys({"region", "weights", "weights_sha256", "iterations"});
     if (p.has("region")) {
       s.region = p.at("region").string();
       if (s.region != "sgan" && s.region != "astar") p.at("region").fail("must be \"sgan\" or \"astar\"");
@@ -183,6 +231,9 @@ void read_scenario_fields(const JsonField& root, const std::string& origin, cons
     if (p.has("weights")) {
       if (s.region != "sgan") p.at("weights").fail("applies to \"region\": \"sgan\" only, not \"" + s.region + "\"");
       s.weights = resolve(base_dir, p.at("weights").string());
+      check_recorded_sha256(p, "weights", s.weights, "sGAN weights file");
+    } else if (p.has("weights_sha256")) {
+      p.at("weights_sha256").fail("the hash of planner.weights, which is not given");
     }
     if (p.has("iterations")) {
       const long long n = p.at("iterations").integer();
@@ -217,8 +268,7 @@ void read_scenario_fields(const JsonField& root, const std::string& origin, cons
                                     Json(s.hover_after_s).dump());
   }
   if (root.has("goal_tolerance_m")) {
-    s.goal_tolerance = root.at("goal_tolerance_m").number_in(0.0, kMaxGoalTolerance, "m");
-    if (!(s.goal_tolerance > 0.0)) root.at("goal_tolerance_m").fail("must be positive");
+    s.goal_tolerance = root.at("goal_tolerance_m").number_above(0.0, kMaxGoalTolerance, "m");
   }
   if (root.has("planning_margin_m")) {
     s.planning_margin = root.at("planning_margin_m").number_in(0.0, kMaxPlanningMargin, "m");
@@ -243,8 +293,7 @@ void read_scenario_fields(const JsonField& root, const std::string& origin, cons
     // (m, m/s) or a half turn (rad).
     const auto sigma = [&](const char* key, double hi, const char* unit, double& to) {
       if (!e.has(key)) return;
-      to = e.at(key).number_in(0.0, hi, unit);
-      if (!(to > 0.0)) e.at(key).fail("must be positive");
+      to = e.at(key).number_above(0.0, hi, unit);
     };
     sigma("initial_position_sigma", 100.0, "m", s.ekf.initial_position_sigma);
     sigma("initial_velocity_sigma", 100.0, "m/s", s.ekf.initial_velocity_sigma);
@@ -265,7 +314,10 @@ void read_scenario_fields(const JsonField& root, const std::string& origin, cons
   if (root.has("yaw")) s.yaw = yaw_params_from_json(root.at("yaw"));
   apply_speed_limit(s, s.limits);  // the controller's cap is infinite unless the file gave one
   if (s.controller.max_tilt_deg > s.n3.max_tilt_deg)
-    root.fail("controller.max_tilt_deg exceeds the N3's max_tilt_deg");
+    blamed(root, {"n3.max_tilt_deg", "controller.max_tilt_deg"})
+        .fail(value_of(root, "n3.max_tilt_deg", s.n3.max_tilt_deg, "deg") + " is below " +
+              value_of(root, "controller.max_tilt_deg", s.controller.max_tilt_deg, "deg") +
+              ": the controller may not command more tilt than the N3 allows");
   // A controller capped below the reference's speed falls behind it and cuts corners into
   // obstacles (issue 20, ninth campaign C4: 0.1 m/s under a 0.8 m/s v_max collided twice).
   if (s.controller.max_speed < s.limits.v_max)
@@ -283,13 +335,15 @@ void read_scenario_fields(const JsonField& root, const std::string& origin, cons
   // controller's period less one N3 tick.
   const double longest_silence = 1.0 / s.controller.rate_hz - 1.0 / s.n3.rate_hz;
   if (s.n3.timeout_s < longest_silence)
-    root.fail("n3.timeout_s " + std::to_string(s.n3.timeout_s) + " s is shorter than the " +
-              std::to_string(longest_silence) +
-              " s the N3 sees between commands (controller.rate_hz's period less one n3 tick): every command would "
-              "time out");
+    blamed(root, {"n3.timeout_s", "controller.rate_hz", "n3.rate_hz"})
+        .fail(value_of(root, "n3.timeout_s", s.n3.timeout_s, "s") + " is shorter than the " + exact_number(longest_silence) +
+              " s the N3 sees between commands (" + value_of(root, "controller.rate_hz", s.controller.rate_hz, "Hz") +
+              ": its period less one n3 tick): every command would time out");
   if (s.n3.latency_s > s.n3.timeout_s)
-    root.fail("n3.latency_s " + std::to_string(s.n3.latency_s) + " s is above n3.timeout_s " +
-              std::to_string(s.n3.timeout_s) + " s: the first command would arrive after the N3 dropped API control");
+    blamed(root, {"n3.latency_s", "n3.timeout_s"})
+        .fail(value_of(root, "n3.latency_s", s.n3.latency_s, "s") + " is above " +
+              value_of(root, "n3.timeout_s", s.n3.timeout_s, "s") +
+              ": the first command would arrive after the N3 dropped API control");
   if (root.has("command_dropout_s")) {
     const JsonField d = root.at("command_dropout_s");
     if (d.array_size() != 2) d.fail("expected [t0, t1]");
@@ -301,10 +355,11 @@ void read_scenario_fields(const JsonField& root, const std::string& origin, cons
   // The limits themselves must be flyable: a horizontal a_max needs atan(a_max / g) of tilt.
   const double tilt_needed = std::atan(s.limits.a_max / kGravity);
   if (tilt_needed > kEnvelopeMargin * deg2rad(s.controller.max_tilt_deg))
-    root.fail("trajectory.a_max " + std::to_string(s.limits.a_max) + " m/s^2 needs " +
-              std::to_string(tilt_needed * 180.0 / kPi) + " deg of tilt, more than " +
-              std::to_string(kEnvelopeMargin * s.controller.max_tilt_deg) + " deg (" +
-              std::to_string(kEnvelopeMargin) + " of the tilt limit)");
+    blamed(root, {"trajectory.a_max", "controller.max_tilt_deg"})
+        .fail(value_of(root, "trajectory.a_max", s.limits.a_max, "m/s^2") + " needs " + short_number(tilt_needed * 180.0 / kPi) +
+              " deg of tilt, more than " + short_number(kEnvelopeMargin * s.controller.max_tilt_deg) + " deg (" +
+              short_number(kEnvelopeMargin) + " of " + value_of(root, "controller.max_tilt_deg", s.controller.max_tilt_deg, "deg") +
+              ")");
 }
 
 }  // namespace
@@ -446,9 +501,17 @@ Json self_contained_scenario(Json doc, const std::string& base_dir) {
       // left as the path: scenario_from_json names the fault through the scenario's field
     }
   }
+  // ... and recorded by content: a run folder flies again only with the same files (F11).
   for (const auto& [block, key] : {std::pair{"trajectory", "file"}, std::pair{"planner", "weights"}}) {
-    if (doc.contains(block) && doc[block].is_object() && doc[block].contains(key) && doc[block][key].is_string())
-      doc[block][key] = absolute(doc[block][key].get<std::string>());
+    if (doc.contains(block) && doc[block].is_object() && doc[block].contains(key) && doc[block][key].is_string()) {
+      const std::string path = absolute(doc[block][key].get<std::string>());
+      doc[block][key] = path;
+      try {
+        doc[block][std::string(key) + "_sha256"] = sha256_hex(read_file_bytes(path));
+      } catch (const Error&) {
+        // left unrecorded: scenario_from_json names the missing file
+      }
+    }
   }
   return doc;
 }
@@ -701,7 +764,16 @@ ReferencePlan build_reference(const Scenario& s) {
       a.rho = s.rho;
       options.optimise = a;
     }
-    auto repaired = traj::repair_collisions(*s.map, path, options);
+    traj::RepairResult repaired;
+    try {
+      repaired = traj::repair_collisions(*s.map, path, options);
+    } catch (const NoSolution&) {
+      throw;
+    } catch (const Error& e) {
+      // Named through the scenario (sixteenth campaign F15: "this problem has 65" named no file
+      // and no key); the planned or given route is free, so what fails here is the allocation.
+      throw Error(s.origin + ": trajectory.allocation: \"" + s.allocation + "\": " + e.what());
+    }
     r.allocation = repaired.allocation;
     r.trajectory = std::move(repaired.trajectory);
     r.path = std::move(repaired.waypoints);

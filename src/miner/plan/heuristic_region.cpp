@@ -1,11 +1,14 @@
 #include "miner/plan/heuristic_region.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <sstream>
 #include <utility>
 
 #include "miner/core/error.hpp"
+#include "miner/core/json_io.hpp"
+#include "miner/core/text.hpp"
 #include "miner/core/rng.hpp"
 #include "miner/world/map.hpp"
 
@@ -13,6 +16,24 @@ namespace miner::plan {
 
 namespace {
 
+/// Provenance shown in reports and run folders: one printable line of at most this many bytes
+/// (issue 20, S7).
+constexpr std::size_t kMaxSourceBytes = 512;
+
+/// A map fingerprint as a region file records it: 16 lower-case hex digits.
+std::string fingerprint_hex(std::uint64_t f) {
+  char text[17];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(f));
+  return text;
+}
+
+/// Why `source` is not a region's source, or "" when it is one.
+std::string source_problem(const std::string& source) {
+  if (source.size() > kMaxSourceBytes ||
+      std::any_of(source.begin(), source.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; }))
+    return "must be one line of at most " + std::to_string(kMaxSourceBytes) + " bytes without control characters";
+  return "";
+}
 
 // Bounds are compared relative to the map's extent: files written with 17 significant
 // digits round-trip exactly, so anything above this is a different map, not rounding.
@@ -44,6 +65,9 @@ HeuristicRegion::HeuristicRegion(world::Box bounds, Eigen::Vector3i dims,
       probabilities_(std::move(probabilities)),
       threshold_(threshold),
       source_(std::move(source)) {
+  // The loader's rule, here, so a region made in code saves into a file that loads (sixteenth
+  // campaign F7: a source with a newline saved, then was refused).
+  if (const std::string why = source_problem(source_); !why.empty()) throw Error("region source: " + why);
   require_finite(bounds_.min, "region bounds.min");
   require_finite(bounds_.max, "region bounds.max");
   // A map's range (REQ-WORLD-002): a region of +-1e300 m has cells of 1e300 m and a volume of
@@ -61,7 +85,7 @@ HeuristicRegion::HeuristicRegion(world::Box bounds, Eigen::Vector3i dims,
   }
   if (!(threshold_ > 0.0 && threshold_ <= 1.0)) {
     std::ostringstream s;
-    s << "region threshold: must be in (0, 1], got " << threshold_;
+    s << "region threshold: must be in (0, 1], got " << exact_number(threshold_);
     throw Error(s.str());
   }
   cell_size_ = (bounds_.max - bounds_.min).cwiseQuotient(dims_.cast<double>());
@@ -69,7 +93,7 @@ HeuristicRegion::HeuristicRegion(world::Box bounds, Eigen::Vector3i dims,
     const double p = probabilities_[i];
     if (!(p >= 0.0 && p <= 1.0)) {
       std::ostringstream s;
-      s << "region probabilities[" << i << "]: must be a number in [0, 1], got " << p;
+      s << "region probabilities[" << i << "]: must be a number in [0, 1], got " << exact_number(p);
       throw Error(s.str());
     }
     if (p >= threshold_) cells_.push_back(i);
@@ -79,7 +103,7 @@ HeuristicRegion::HeuristicRegion(world::Box bounds, Eigen::Vector3i dims,
 HeuristicRegion HeuristicRegion::from_json(const Json& doc, const std::string& origin) {
   const JsonField root(doc, "", origin);
   root.require_format(kRegionFormat);
-  root.only_keys({"format", "bounds", "dims", "threshold", "source", "probabilities"});  // issue 20: no ignored key
+  root.only_keys({"format", "bounds", "dims", "threshold", "source", "map_fingerprint", "probabilities"});  // issue 20: no ignored key
   const JsonField jb = root.at("bounds");
   jb.only_keys({"min", "max"});
   world::Box bounds{jb.at("min").vec3(), jb.at("max").vec3()};
@@ -94,13 +118,19 @@ HeuristicRegion HeuristicRegion::from_json(const Json& doc, const std::string& o
   // campaign); every region MINER writes records it.
   const double threshold = root.at("threshold").number();
   const std::string source = root.has("source") ? root.at("source").string() : "";
-  // Provenance shown in reports and run folders: one printable line (issue 20, S7).
-  constexpr std::size_t kMaxSourceBytes = 512;
-  if (source.size() > kMaxSourceBytes ||
-      std::any_of(source.begin(), source.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; }))
-    root.at("source").fail("must be one line of at most 512 bytes without control characters");
+  if (const std::string why = source_problem(source); !why.empty()) root.at("source").fail(why);
+  std::uint64_t fingerprint = 0;
+  if (root.has("map_fingerprint")) {
+    const std::string hex = root.at("map_fingerprint").string();
+    if (hex.size() != 16 || hex.find_first_not_of("0123456789abcdef") != std::string::npos || hex == std::string(16, '0'))
+      root.at("map_fingerprint").fail("must be 16 lower-case hexadecimal digits, not all 0 (a map's fingerprint), got " +
+                                      quoted_excerpt(hex));
+    fingerprint = std::stoull(hex, nullptr, 16);
+  }
   try {
-    return HeuristicRegion(bounds, dims, std::move(probabilities), threshold, source);
+    HeuristicRegion region(bounds, dims, std::move(probabilities), threshold, source);
+    region.set_map_fingerprint(fingerprint);
+    return region;
   } catch (const Error& e) {
     throw Error(origin + ": " + e.what());
   }
@@ -117,12 +147,14 @@ Json HeuristicRegion::to_json() const {
     if (v == 0.0 || v == 1.0) p.push_back(static_cast<int>(v));
     else p.push_back(v);
   }
-  return {{"format", kRegionFormat},
+  Json doc{{"format", kRegionFormat},
           {"bounds", {{"min", vec3_json(bounds_.min)}, {"max", vec3_json(bounds_.max)}}},
           {"dims", Json::array({dims_.x(), dims_.y(), dims_.z()})},
           {"threshold", threshold_},
           {"source", source_},
           {"probabilities", p}};
+  if (map_fingerprint_ != 0) doc["map_fingerprint"] = fingerprint_hex(map_fingerprint_);
+  return doc;
 }
 
 void HeuristicRegion::save(const std::string& path) const {
@@ -198,6 +230,16 @@ HeuristicRegion HeuristicRegion::from_path(const world::Box& bounds, const Eigen
     if (region.probabilities_[i] >= region.threshold_) region.cells_.push_back(i);
   }
   return region;
+}
+
+std::size_t HeuristicRegion::index(int i, int j, int k) const {
+  if (i < 0 || j < 0 || k < 0 || i >= dims_.x() || j >= dims_.y() || k >= dims_.z())
+    throw Error("region cell (" + std::to_string(i) + ", " + std::to_string(j) + ", " + std::to_string(k) +
+                ") lies outside the region's " + std::to_string(dims_.x()) + " x " + std::to_string(dims_.y()) + " x " +
+                std::to_string(dims_.z()) + " grid");
+  return (static_cast<std::size_t>(k) * static_cast<std::size_t>(dims_.y()) + static_cast<std::size_t>(j)) *
+             static_cast<std::size_t>(dims_.x()) +
+         static_cast<std::size_t>(i);
 }
 
 Eigen::Vector3i HeuristicRegion::coords(std::size_t index) const {
@@ -318,6 +360,10 @@ void HeuristicRegion::require_matches(const world::Map& map, const std::string& 
     throw Error(what + ": region bounds " + format_point(bounds_.min) + " - " + format_point(bounds_.max) +
                 " do not match the map's bounds " + format_point(mb.min) + " - " + format_point(mb.max));
   }
+  if (map_fingerprint_ != 0 && map_fingerprint_ != map.fingerprint())
+    throw Error(what + ": the region was built for another map (fingerprint " + fingerprint_hex(map_fingerprint_) +
+                ", this map's " + fingerprint_hex(map.fingerprint()) + ": other obstacles, voxels or unknown-space policy " +
+                "within the same bounds)");
   if (cells_.empty()) {
     std::ostringstream s;
     s << what << ": region has no cell with probability >= threshold " << threshold_;

@@ -10,11 +10,13 @@
 ///    "dims": [nx, ny, nz],
 ///    "threshold": 0.5,                               // cell in H iff probability >= threshold
 ///    "probabilities": [p_0, ..., p_{nx ny nz - 1}],  // in [0,1], x fastest, then y, then z
-///    "source": "astar-dilated"}                      // optional, free text
+///    "source": "astar-dilated",                      // optional, one printable line
+///    "map_fingerprint": "0123456789abcdef"}          // optional: world::Map::fingerprint of its map
 /// Cell (i, j, k) covers bounds.min + ([i, i+1] x [j, j+1] x [k, k+1]) * cell_size with
 /// cell_size = (bounds.max - bounds.min) / dims; its index is (k ny + j) nx + i.
 
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -72,13 +74,19 @@ class HeuristicRegion {
   const Eigen::Vector3d& cell_size() const { return cell_size_; }
   double threshold() const { return threshold_; }
   const std::string& source() const { return source_; }
+  /// The world::Map::fingerprint of the map the region was built for, or 0 when unknown (a
+  /// region made from numbers, or a file written before it was recorded). require_matches
+  /// refuses another map even with the same bounds (sixteenth campaign F4).
+  std::uint64_t map_fingerprint() const { return map_fingerprint_; }
+  /// The region built for `map` (its fingerprint recorded), or for no known map with 0.
+  void set_map_fingerprint(std::uint64_t fingerprint) { map_fingerprint_ = fingerprint; }
   const std::vector<double>& probabilities() const { return probabilities_; }
   /// Indices of the cells in H (probability >= threshold), ascending.
   const std::vector<std::size_t>& cells() const { return cells_; }
   bool empty() const { return cells_.empty(); }
-  std::size_t index(int i, int j, int k) const {
-    return (static_cast<std::size_t>(k) * dims_.y() + j) * dims_.x() + i;
-  }
+  /// The index of cell (i, j, k), x fastest; throws miner::Error for a cell outside the grid
+  /// (sixteenth campaign F9: (40, 0, 0) of a 32^3 grid answered another row's cell).
+  std::size_t index(int i, int j, int k) const;
   Eigen::Vector3i coords(std::size_t index) const;
   world::Box cell_box(std::size_t index) const;
   /// Index of the cell holding p, or -1 for a point outside the bounds (the max faces
@@ -104,7 +112,7 @@ class HeuristicRegion {
   Eigen::Vector3d sample(Rng& rng) const;
 
   /// Throws miner::Error unless this region fits `map`: same bounds (to 1e-9 of the
-  /// extent) and at least one cell in H.
+  /// extent), the same map when its fingerprint is recorded, and at least one cell in H.
   void require_matches(const world::Map& map, const std::string& what) const;
 
  private:
@@ -114,6 +122,7 @@ class HeuristicRegion {
   std::vector<double> probabilities_;
   double threshold_;
   std::string source_;
+  std::uint64_t map_fingerprint_ = 0;
   std::vector<std::size_t> cells_;
 };
 

@@ -14,7 +14,9 @@ ReferencePath astar_reference(const PlanningProblem& problem) {
 
 HeuristicRegion astar_dilated_region(const PlanningProblem& problem, const ReferencePath& reference,
                                      const Eigen::Vector3i& dims, int dilation) {
-  return HeuristicRegion::from_path(problem.map->bounds(), dims, reference.points, dilation, "astar-dilated");
+  HeuristicRegion region = HeuristicRegion::from_path(problem.map->bounds(), dims, reference.points, dilation, "astar-dilated");
+  region.set_map_fingerprint(problem.map->fingerprint());
+  return region;
 }
 
 double straight_line_bound(const PlanningProblem& problem) { return (problem.goal - problem.start).norm(); }

@@ -44,7 +44,7 @@ using Clock = std::chrono::steady_clock;
 void require_probability(double p, const std::string& name, bool below_one) {
   if (!(p >= 0.0 && (below_one ? p < 1.0 : p <= 1.0))) {
     std::ostringstream s;
-    s << name << ": must be in [0, 1" << (below_one ? ")" : "]") << ", got " << p;
+    s << name << ": must be in [0, 1" << (below_one ? ")" : "]") << ", got " << exact_number(p);
     throw Error(s.str());
   }
 }
@@ -420,7 +420,7 @@ void validate(const PlanningProblem& p) {
   // Lemma 2's radius uses the sampled volume: it must be a volume (tenth campaign L11: 0 and
   // NaN planned with a rewiring radius of 0 and NaN).
   if (!(std::isfinite(p.sampled_volume) && p.sampled_volume > 0.0))
-    throw Error("sampled_volume: must be a positive finite volume in m^3, got " + short_number(p.sampled_volume));
+    throw Error("sampled_volume: must be a positive finite volume in m^3, got " + exact_number(p.sampled_volume));
 }
 
 PlanningProblem PlanningProblem::make(const world::Map& map, const Eigen::Vector3d& start,
@@ -475,7 +475,7 @@ PlanResult plan(const PlanningProblem& problem, const PlannerOptions& options, c
   // A path's length is >= 0: a negative target could never be met and only hid a sign error
   // (tenth campaign recheck).
   if (options.target_cost && !(std::isfinite(*options.target_cost) && *options.target_cost >= 0.0))
-    throw Error("target_cost: must be a finite path length >= 0 m, got " + short_number(*options.target_cost));
+    throw Error("target_cost: must be a finite path length >= 0 m, got " + exact_number(*options.target_cost));
   if (options.safeguard_iterations < 1) throw Error("safeguard_iterations: must be >= 1 (k_0 of the safeguard)");
   if (options.planner == PlannerKind::kMiner) {
     if (region == nullptr) throw Error("planner miner: needs a heuristic region");
@@ -486,7 +486,7 @@ PlanResult plan(const PlanningProblem& problem, const PlannerOptions& options, c
 }
 
 void add_setup_time(PlanResult& result, double ms) {
-  if (!(std::isfinite(ms) && ms >= 0.0)) throw Error("setup time: must be a finite time >= 0 ms, got " + short_number(ms));
+  if (!(std::isfinite(ms) && ms >= 0.0)) throw Error("setup time: must be a finite time >= 0 ms, got " + exact_number(ms));
   result.time_ms += ms;
   if (result.first) result.first->time_ms += ms;
   if (result.target) result.target->time_ms += ms;

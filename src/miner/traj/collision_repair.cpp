@@ -12,7 +12,7 @@ std::vector<int> colliding_segments(const PolynomialTrajectory& t, const world::
                                     double step) {
   // Tenth campaign L10: a NaN or negative radius answered "no colliding segment".
   world::check_robot_radius(radius, "robot radius");
-  if (!(std::isfinite(step) && step > 0.0)) throw Error("step: must be a positive finite length in m, got " + short_number(step));
+  if (!(std::isfinite(step) && step > 0.0)) throw Error("step: must be a positive finite length in m, got " + exact_number(step));
   std::vector<int> hits;
   for (int i = 0; i < t.segments(); ++i) {
     const double T = t.durations()[i];
@@ -55,7 +55,7 @@ RepairResult repair_collisions(const world::Map& map, const Eigen::MatrixX3d& pa
   world::check_robot_radius(o.robot_radius, "robot radius");
   if (o.max_iterations < 0) throw Error("max_iterations: must not be negative");
   if (!(std::isfinite(o.sample_step) && o.sample_step >= 0.0))
-    throw Error("sample_step: must be a finite length >= 0 m (0: collision_sample_step), got " + short_number(o.sample_step));
+    throw Error("sample_step: must be a finite length >= 0 m (0: collision_sample_step), got " + exact_number(o.sample_step));
   const double step = o.sample_step > 0.0 ? o.sample_step : collision_sample_step(map, o.robot_radius);
   for (Eigen::Index i = 1; i < path.rows(); ++i) {
     const Eigen::Vector3d a = path.row(i - 1).transpose(), b = path.row(i).transpose();
@@ -101,6 +101,16 @@ RepairResult repair_collisions(const world::Map& map, const Eigen::MatrixX3d& pa
         next.row(row++) = 0.5 * (r.waypoints.row(i) + r.waypoints.row(i + 1));
         ++h;
       }
+    }
+    // "optimise" takes at most kMaxOptimisedSegments: said here, with what the repair did, not
+    // as a bare segment count of a problem the caller never wrote (sixteenth campaign F15).
+    if (o.optimise && next.rows() - 1 > kMaxOptimisedSegments) {
+      std::ostringstream os;
+      os << "collision repair: " << hits.size() << " segment(s) of the " << r.waypoints.rows() - 1
+         << "-segment trajectory collide (first: segment " << hits.front() << "); a midpoint in each gives "
+         << next.rows() - 1 << " segments, more than allocation \"optimise\" takes (" << kMaxOptimisedSegments
+         << "): use \"trapezoid\", or a path of fewer points";
+      throw Error(os.str());
     }
     r.inserted += static_cast<int>(hits.size());
     r.waypoints = std::move(next);

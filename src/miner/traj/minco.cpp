@@ -8,6 +8,7 @@
 #include <Eigen/LU>
 
 #include "miner/core/error.hpp"
+#include "miner/core/text.hpp"
 
 namespace miner::traj {
 
@@ -546,7 +547,7 @@ void validate(const MincoProblem& p) {
   for (std::size_t i = 0; i < M; ++i) {
     if (!std::isfinite(p.durations[i]) || !(p.durations[i] > 0.0)) {
       std::ostringstream os;
-      os << "durations[" << i << "]: must be positive and finite, got " << p.durations[i];
+      os << "durations[" << i << "]: must be positive and finite, got " << exact_number(p.durations[i]);
       throw Error(os.str());
     }
   }

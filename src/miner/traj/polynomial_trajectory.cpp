@@ -37,7 +37,7 @@ PolynomialTrajectory::PolynomialTrajectory(int order, std::vector<double> durati
   check_order(order_, "trajectory");
   for (std::size_t i = 0; i < durations_.size(); ++i)
     if (!(std::isfinite(durations_[i]) && durations_[i] > 0.0))
-      throw Error("trajectory: durations[" + std::to_string(i) + "] must be a positive finite time in s, got " + short_number(durations_[i]));
+      throw Error("trajectory: durations[" + std::to_string(i) + "] must be a positive finite time in s, got " + exact_number(durations_[i]));
   if (!coefficients_.allFinite()) throw Error("trajectory: coefficients must be finite numbers");
   if (coefficients_.rows() != 2 * order_ * static_cast<Eigen::Index>(durations_.size())) {
     throw Error("trajectory: expected " + std::to_string(2 * order_ * durations_.size()) +
@@ -54,7 +54,7 @@ void PolynomialTrajectory::check_consistent(const std::string& who) const {
   check_order(order_, who);
   for (std::size_t i = 0; i < durations_.size(); ++i)
     if (!(std::isfinite(durations_[i]) && durations_[i] > 0.0))
-      throw Error(who + ": durations[" + std::to_string(i) + "] must be a positive finite time in s, got " + short_number(durations_[i]));
+      throw Error(who + ": durations[" + std::to_string(i) + "] must be a positive finite time in s, got " + exact_number(durations_[i]));
   if (coefficients_.rows() != 2 * order_ * static_cast<Eigen::Index>(durations_.size()))
     throw Error(who + ": the trajectory has " + std::to_string(durations_.size()) + " durations and " +
                 std::to_string(coefficients_.rows()) + " coefficient rows, not 2s = " + std::to_string(2 * order_) +
@@ -62,6 +62,12 @@ void PolynomialTrajectory::check_consistent(const std::string& who) const {
 }
 
 double PolynomialTrajectory::total_duration() const {
+  // Sixteenth campaign F9: durations edited through mutable_durations() were summed as they
+  // were (a negative one shortened the trajectory, a NaN one made it NaN s long).
+  for (std::size_t j = 0; j < durations_.size(); ++j)
+    if (!(durations_[j] > 0.0 && std::isfinite(durations_[j])))
+      throw Error("trajectory: durations[" + std::to_string(j) + "] must be a positive finite time in s, got " +
+                  short_number(durations_[j]));
   return std::accumulate(durations_.begin(), durations_.end(), 0.0);
 }
 
@@ -71,6 +77,8 @@ Eigen::Vector3d PolynomialTrajectory::evaluate_segment(int i, double tau, int k)
     throw Error("trajectory: segment " + std::to_string(i) + " does not exist (the trajectory has " +
                 std::to_string(segments()) + ")");
   if (k < 0) throw Error("k: the derivative order must be >= 0, got " + std::to_string(k));
+  // Sixteenth campaign F8: a NaN local time answered NaN.
+  if (!std::isfinite(tau)) throw Error("tau: must be a finite local time in s, got " + exact_number(tau));
   const int n = 2 * order_;
   const Eigen::Index rows = coefficients_.rows();
   // mutable_coefficients() may have been resized: the segment's rows must be there.
@@ -97,7 +105,8 @@ Eigen::Vector3d PolynomialTrajectory::evaluate(double t, int k) const {
   // A negative order read coefficients before the segment's own, a NaN time answered the start
   // (issue 20, ninth campaign P1, P12: from Python, garbage, NaN and a segmentation fault).
   if (k < 0) throw Error("k: the derivative order must be >= 0, got " + std::to_string(k));
-  if (std::isnan(t)) throw Error("t: must be a time in s, got nan");
+  // ... and an infinite one was clamped to an end (sixteenth campaign F8): a time is finite.
+  if (!std::isfinite(t)) throw Error("t: must be a finite time in s, got " + exact_number(t));
   int i = 0;
   const int last = segments() - 1;
   t = std::max(0.0, t);
@@ -106,7 +115,7 @@ Eigen::Vector3d PolynomialTrajectory::evaluate(double t, int k) const {
   // duration set through mutable_durations() was evaluated).
   for (int j = 0; j <= i; ++j)
     if (!(durations_[j] > 0.0 && std::isfinite(durations_[j])))
-      throw Error("trajectory: durations[" + std::to_string(j) + "] must be a positive finite time in s, got " + short_number(durations_[j]));
+      throw Error("trajectory: durations[" + std::to_string(j) + "] must be a positive finite time in s, got " + exact_number(durations_[j]));
   return evaluate_segment(i, std::min(t, durations_[i]), k);
 }
 
@@ -114,7 +123,7 @@ Eigen::MatrixXd monomial_cost_matrix(int order, double duration) {
   // Tenth campaign L17: a negative duration gave a negative energy, NaN a NaN matrix.
   check_order(order, "monomial_cost_matrix");
   if (!(std::isfinite(duration) && duration >= 0.0))
-    throw Error("monomial_cost_matrix: duration must be a finite time >= 0 s, got " + short_number(duration));
+    throw Error("monomial_cost_matrix: duration must be a finite time >= 0 s, got " + exact_number(duration));
   const int n = 2 * order;
   Eigen::MatrixXd q = Eigen::MatrixXd::Zero(n, n);
   for (int a = order; a < n; ++a)

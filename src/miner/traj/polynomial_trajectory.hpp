@@ -30,6 +30,8 @@ class PolynomialTrajectory {
   int order() const { return order_; }  ///< s
   int segments() const { return static_cast<int>(durations_.size()); }
   const std::vector<double>& durations() const { return durations_; }
+  /// Sum of the durations; throws miner::Error naming one that is not positive and finite
+  /// (mutable_durations() may have changed it).
   double total_duration() const;
   const Eigen::MatrixX3d& coefficients() const { return coefficients_; }
   /// c_i, 2s x 3 (segment index i from 0).
@@ -51,10 +53,10 @@ class PolynomialTrajectory {
 
   /// The k-th derivative (k = 0 position ... 4 snap, any k >= 0) of segment i at local
   /// time tau (Horner's rule on the differentiated coefficients). Throws miner::Error for a
-  /// segment index outside [0, segments()) or k < 0.
+  /// segment index outside [0, segments()), k < 0 or a tau that is not finite.
   Eigen::Vector3d evaluate_segment(int i, double tau, int k = 0) const;
   /// The k-th derivative at global time t, clamped to [0, total_duration()]; at a
-  /// junction the later segment is used.
+  /// junction the later segment is used. Throws miner::Error for a t that is not finite.
   Eigen::Vector3d evaluate(double t, int k = 0) const;
 
   /// J = sum_i c_i^T Q(T_i) c_i (summed over axes), Q_ab = int_0^T (d^s t^a)(d^s t^b) dt.

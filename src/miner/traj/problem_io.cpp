@@ -85,6 +85,15 @@ TrajectoryRequest request_from_json(const Json& doc, const std::string& origin, 
   if (method == "trapezoid") {
     // A command-line option the run would not use is a usage error (exit 2).
     if (rho_override) throw Error("--rho: only used with --allocate optimise", ExitCode::kUsage);
+    // Given durations are the timing: an allocation request beside them would not be applied
+    // (sixteenth campaign F6: `--allocate trapezoid` was ignored, while optimise was refused).
+    if (root.has("durations")) {
+      if (!allocation_override.empty())
+        throw Error("--allocate: " + origin + " gives durations, so there is nothing to allocate: drop --allocate or the durations",
+                    ExitCode::kUsage);
+      if (root.has("allocation"))
+        root.at("allocation").fail("durations are given, so there is nothing to allocate: drop one of them");
+    }
     if (root.has("rho")) {
       // Overridden on the command line, the file's own request is not at fault: say which
       // option made its rho unused (issue 20, fifth campaign: the advice blamed the file).

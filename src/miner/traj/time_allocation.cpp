@@ -317,7 +317,7 @@ std::string short_number(double v) {
 
 void validate(const AllocationOptions& o) {
   validate(o.limits);
-  if (!std::isfinite(o.rho) || !(o.rho > 0.0)) throw Error("rho: must be positive and finite, got " + short_number(o.rho));
+  if (!std::isfinite(o.rho) || !(o.rho > 0.0)) throw Error("rho: must be positive and finite, got " + exact_number(o.rho));
   if (o.max_iterations < 1 || o.max_iterations > kMaxAllocationIterations)
     throw Error("allocation iterations: must be in [1, " + std::to_string(kMaxAllocationIterations) + "], got " +
                 std::to_string(o.max_iterations));
@@ -489,7 +489,7 @@ AllocationResult optimise_allocation(const MincoProblem& problem, const Allocati
 std::pair<double, double> trajectory_extremes(const traj::PolynomialTrajectory& t, double step) {
   // Tenth campaign L13: a step of 0, -1, NaN or 1e-300 was silently replaced by one sample per
   // segment; the count is bounded before any evaluation.
-  if (!(std::isfinite(step) && step > 0.0)) throw Error("step: must be a positive finite time in s, got " + short_number(step));
+  if (!(std::isfinite(step) && step > 0.0)) throw Error("step: must be a positive finite time in s, got " + exact_number(step));
   t.check_consistent("trajectory_extremes");
   if (!t.coefficients().allFinite()) throw Error("trajectory_extremes: the trajectory's coefficients must be finite numbers");
   double count = 0.0;

@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "miner/core/error.hpp"
+#include "miner/core/text.hpp"
 
 namespace miner::traj {
 
@@ -32,7 +33,7 @@ double trapezoidal_duration(double d, const Limits& limits) {
   validate(limits);
   if (!(std::isfinite(d) && d >= 0.0)) {
     std::ostringstream os;
-    os << "distance: must be a finite length >= 0 m, got " << d;
+    os << "distance: must be a finite length >= 0 m, got " << exact_number(d);
     throw Error(os.str());
   }
   const double t = trapezoid_time(d, limits);

@@ -114,7 +114,7 @@ void require_within_range(const Eigen::Vector3d& p, const char* what, const char
 }
 
 void check_query_radius(double radius, const char* field) {
-  if (!(radius >= 0.0)) throw Error(std::string(field) + ": must be a number >= 0, got " + short_number(radius));
+  if (!(radius >= 0.0)) throw Error(std::string(field) + ": must be a number >= 0, got " + exact_number(radius));
 }
 
 }  // namespace miner::world

@@ -35,6 +35,12 @@ void validate_box(const Box& b, const std::string& what) {
 
 
 /// Below this many boxes a ray tests them all: the bucket walk costs more than it saves.
+/// The comment line Map::save writes into the .bt beside a voxel map's JSON (after OctoMap's
+/// header line, which readers require first): the file is that save's own, and a later save to
+/// the same JSON may replace it. Looked for in the file's first kSideFileHeadBytes.
+constexpr const char* kSideFileMark = "# MINER Map::save:";
+constexpr std::size_t kSideFileHeadBytes = 4096;
+
 constexpr std::size_t kRayWalkMinObstacles = 64;
 /// At most this many pieces per ray (a diagonal of the 32-bucket grid is ~56 buckets long).
 constexpr int kMaxRayPieces = 256;
@@ -69,7 +75,7 @@ Eigen::Vector3i grid_dims(const Box& bounds, double resolution) {
   require_finite(bounds.min, "bounds.min");
   require_finite(bounds.max, "bounds.max");
   if (!(std::isfinite(resolution) && resolution > 0.0))
-    throw Error("resolution: must be a positive finite length, got " + short_number(resolution));
+    throw Error("resolution: must be a positive finite length, got " + exact_number(resolution));
   // Snaps in the cell count: a face within this many cells of a whole number is on it.
   constexpr double kGridSnapTolerance = 1e-9;
   const Eigen::Vector3d extent = bounds.extent();
@@ -330,12 +336,7 @@ Map Map::from_json(const Json& doc, const std::string& origin) {
     // (fifth campaign: "in/: not a regular file"; an upper-case or short hash called "the file
     // changed").
     if (jv.at("file").string().empty()) jv.at("file").fail("is empty: name the voxel file (.bt or .ot)");
-    if (jv.has("sha256")) {
-      const std::string h = jv.at("sha256").string();
-      if (h.size() != 64 || h.find_first_not_of("0123456789abcdef") != std::string::npos)
-        jv.at("sha256").fail("must be 64 lower-case hexadecimal digits (a SHA-256 as `sha256sum` prints it), got \"" +
-                             h + "\"");
-    }
+    if (jv.has("sha256")) (void)sha256_field(jv.at("sha256"));
     const std::string file = voxel_file_path(origin, jv.at("file").string());
     VoxelSource source{nullptr, UnknownPolicy::kOccupied, file, {}};
     // The fault of a voxel file is named through the map that references it: "/dev/zero: not a
@@ -529,9 +530,20 @@ void Map::check_voxel_side_file(const std::string& path) {
   } catch (const Error&) {
     earlier_output = false;  // no map there (or not one): the .bt is someone else's file
   }
+  // ... and the file is one a save wrote: a .bt that `map convert --in x.bt --out x.json`
+  // referenced is the user's input, which the JSON names just the same (sixteenth campaign F14:
+  // `map gen --preset scan --out x.json` then replaced the user's scan).
+  if (earlier_output) {
+    try {
+      const std::string head = read_file_bytes(bt.string(), "voxel file").substr(0, kSideFileHeadBytes);
+      earlier_output = head.find(kSideFileMark) != std::string::npos;
+    } catch (const Error&) {
+      earlier_output = false;
+    }
+  }
   if (!earlier_output)
-    throw Error(bt.string() + ": exists and is not the voxel file of a map at " + path +
-                ": a voxel map's JSON is written with its voxels beside it as " + bt.filename().string() +
+    throw Error(bt.string() + ": exists and is not a voxel file that a save of a map at " + path +
+                " wrote: a voxel map's JSON is written with its voxels beside it as " + bt.filename().string() +
                 ", which would replace that file (remove it, or choose another output name)");
 }
 
@@ -546,7 +558,10 @@ void Map::save(const std::string& path) const {
     // file that is not there yet.
     check_voxel_side_file(path);
     const std::filesystem::path bt = std::filesystem::path(path).replace_extension(".bt");
-    const std::string bytes = octree_bt_bytes(*source_->layer);
+    // Marked as this save's own (a comment line after OctoMap's first line), so a later save to
+    // `path` may replace it and nothing else.
+    std::string bytes = octree_bt_bytes(*source_->layer);
+    bytes.insert(bytes.find('\n') + 1, std::string(kSideFileMark) + " the map JSON beside it\n");
     write_file_atomic(bt.string(), bytes);
     VoxelSource saved = *source_;
     saved.file = std::filesystem::absolute(bt).lexically_normal().string();

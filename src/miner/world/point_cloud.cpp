@@ -505,7 +505,7 @@ std::shared_ptr<const VoxelLayer> integrate_clouds(const std::vector<CloudScan>&
   // "If positive": 0 is no limit; a NaN or negative range was also taken as none (eleventh
   // campaign L3).
   if (!(std::isfinite(max_range) && max_range >= 0.0))
-    throw Error("max_range: must be a finite range >= 0 m (0: no limit), got " + short_number(max_range));
+    throw Error("max_range: must be a finite range >= 0 m (0: no limit), got " + exact_number(max_range));
   octomap::OcTree tree(resolution);
   const double reach = 32767.0 * resolution;
   const auto point = [](const Eigen::Vector3d& p) {

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "miner/core/error.hpp"
+#include "miner/core/text.hpp"
 #include "miner/world/map.hpp"
 
 namespace miner::world {
@@ -106,7 +107,7 @@ VoxelLayer::VoxelLayer(Eigen::Vector3i origin_cells, double resolution, Eigen::V
     : origin_cells_(origin_cells), resolution_(resolution), dims_(dims), states_(std::move(states)) {
   if (!std::isfinite(resolution_) || !(resolution_ > 0.0)) {
     std::ostringstream os;
-    os << "voxel resolution: must be positive and finite, got " << resolution_;
+    os << "voxel resolution: must be positive and finite, got " << exact_number(resolution_);
     throw Error(os.str());
   }
   check_resolution(resolution_, "voxel resolution");

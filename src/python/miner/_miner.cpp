@@ -452,13 +452,14 @@ PYBIND11_MODULE(_miner, m) {
       .def_property_readonly("cost", &PolynomialTrajectory::cost, "J = integral of |d^s p / dt^s|^2")
       .def("evaluate", [](const PolynomialTrajectory& t, py::object time, py::object k) {
             return t.evaluate(number(time, "t"), derivative_of(k));
-          }, py::arg("t"), py::arg("k") = 0, "the k-th derivative (k >= 0) at time t (clamped to the trajectory)")
+          }, py::arg("t"), py::arg("k") = 0, "the k-th derivative (k >= 0) at a finite time t (clamped to [0, duration])")
       .def("sample", [](const PolynomialTrajectory& t, py::object times_arg, py::object k_arg) {
             const std::vector<double> times = vector_of(times_arg, "times");
             const int k = derivative_of(k_arg);
             Eigen::MatrixX3d out(static_cast<Eigen::Index>(times.size()), 3);
             for (std::size_t i = 0; i < times.size(); ++i) {
-              if (std::isnan(times[i])) throw miner::Error("times[" + std::to_string(i) + "]: must be a time in s, got nan");
+              if (!std::isfinite(times[i]))
+                throw miner::Error("times[" + std::to_string(i) + "]: must be a finite time in s, got " + miner::short_number(times[i]));
               out.row(static_cast<Eigen::Index>(i)) = t.evaluate(times[i], k);
             }
             return out;

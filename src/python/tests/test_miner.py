@@ -67,6 +67,12 @@ def test_baselines_and_the_oracle_region():
     for planner in ("rrtstar", "informed", "guided"):
         assert miner.plan(m, planner=planner, seed=2, iterations=3000).solved
     assert miner.plan(m, planner="miner", region=oracle, seed=2, iterations=3000).solved
+    # Sixteenth campaign F4: a region of another map with the same bounds is refused (indoor-1 and
+    # indoor-2 share theirs), not sampled as if it were this map's.
+    indoor1 = miner.Map.load(SIM1.replace("sim-1.json", "indoor-1.json"))
+    other = miner.astar_region(miner.Map.load(SIM1.replace("sim-1.json", "indoor-2.json")), dims=(8, 8, 4))
+    with pytest.raises(miner.Error, match="the region was built for another map"):
+        miner.plan(indoor1, planner="miner", region=other, iterations=300)
 
 
 def test_minco_waypoints_and_durations():
@@ -112,10 +118,15 @@ def test_trajectory_derivative_order_and_time_are_checked():
             t.sample(np.linspace(0, 1, 5), k=k)
     with pytest.raises(miner.Error, match="k: "):
         t.evaluate(1.0, k=2**40)
-    with pytest.raises(miner.Error, match="t: must be a time"):  # NaN answered the start (P12)
+    with pytest.raises(miner.Error, match="t: must be a finite time"):  # NaN answered the start (P12)
         t.evaluate(float("nan"))
-    with pytest.raises(miner.Error, match=r"times\[0\]"):
+    for end in (float("inf"), float("-inf")):  # clamped to an end (sixteenth campaign F8)
+        with pytest.raises(miner.Error, match="t: must be a finite time"):
+            t.evaluate(end)
+    with pytest.raises(miner.Error, match=r"times\[0\]: must be a finite time"):
         t.sample(np.array([float("nan"), 1.0]))
+    with pytest.raises(miner.Error, match=r"times\[1\]: must be a finite time"):
+        t.sample(np.array([0.5, float("inf")]))
     assert np.allclose(t.evaluate(1e9), t.evaluate(t.total_duration))  # finite times clamp, as documented
     assert np.allclose(t.evaluate(1.0, k=20), 0.0)
 

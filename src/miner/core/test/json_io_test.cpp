@@ -164,6 +164,14 @@ TEST_CASE("Field access names the dotted path and the type found", "[REQ-CORE-00
   CHECK_THROWS_WITH(root.at("missing"), Contains("m.json: missing: missing required field"));
   CHECK_THROWS_WITH(root.at("r").positive_number(), Contains("r: must be positive, got -1"));
   CHECK_THROWS_WITH(root.at("n").integer(), Contains("n: expected an integer, got 2.5"));
+  // One rule for every integer field: a whole number written as a real is refused as such
+  // (sixteenth campaign F5: "order": 3.0 was read while "seed": 1.0 was refused).
+  for (const char* text : {"3.0", "3e0", "-2.0"}) {
+    const Json whole = miner::parse_json(std::string("{\"order\": ") + text + "}", "w.json");
+    CHECK_THROWS_WITH(JsonField(whole, "", "w.json").at("order").integer(),
+                      Contains("w.json: order: expected an integer, got ") && Contains("(write it without a decimal point or exponent)"));
+  }
+  CHECK(JsonField(miner::parse_json(R"({"order": 3})", "w.json"), "", "w.json").at("order").integer() == 3);
   Json with_inf = doc;  // a document built in code (not parsed) can hold an infinity
   with_inf["big"] = std::numeric_limits<double>::infinity();
   CHECK_THROWS_WITH(JsonField(with_inf, "", "m.json").at("big").number(), Contains("big: must be a finite number"));
@@ -261,6 +269,13 @@ TEST_CASE("A folder write replaces only an earlier output of the same kind", "[R
   miner::write_folder_atomic(run, {{"summary.json", "{\"again\": 1}\n"}, {"other.csv", "x\n"}});
   CHECK(read_all(run + "/summary.json") == "{\"again\": 1}\n");
   CHECK_FALSE(fs::exists(run + "/log.csv"));
+  // A trailing slash names the same folder (sixteenth campaign F20: "run/: not a folder name").
+  miner::write_folder_atomic(run + "/", first);
+  CHECK(read_all(run + "/log.csv") == "t\n");
+  miner::write_folder_atomic((dir / "fresh").string() + "//", first);
+  CHECK(read_all((dir / "fresh" / "summary.json").string()) == "{}\n");
+  for (const std::string& bad : {std::string("/"), std::string("."), std::string(".."), std::string("../")})
+    CHECK_THROWS_WITH(miner::write_folder_atomic(bad, first), Contains("not a folder name"));
   // A user's folder is not: a file of another kind, a subfolder, or no name in common.
   const auto refused = [&](const std::string& name, const std::function<void(const fs::path&)>& make,
                            const std::string& why) {

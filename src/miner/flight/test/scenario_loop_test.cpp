@@ -14,6 +14,8 @@
 #include <unistd.h>
 
 #include "miner/core/error.hpp"
+#include "miner/core/json_io.hpp"
+#include "miner/core/sha256.hpp"
 #include "miner/flight/closed_loop.hpp"
 #include "miner/flight/disturbances.hpp"
 #include "miner/flight/n3.hpp"
@@ -114,7 +116,8 @@ TEST_CASE("Bad scenarios are refused before flight with the fault named", "[REQ-
   // Between 0.8 of the tilt limit (28 deg of 35) and the limit itself: refused as well; below
   // 0.8 read (held-out audit 8, h8-flight-02: the margin was dropped and 29 deg flew).
   doc["trajectory"]["a_max"] = 5.5;  // atan(5.5 / 9.81) = 29.3 deg
-  expect_scenario_error(doc, "deg of tilt");
+  expect_scenario_error(doc, "s.json: trajectory.a_max: trajectory.a_max 5.5 m/s^2 needs 29.2773 deg of tilt, more than "
+                             "28 deg (0.8 of controller.max_tilt_deg 35 deg (default))");
   doc["trajectory"]["a_max"] = 5.0;  // 27.0 deg
   CHECK_NOTHROW(pipeline::scenario_from_json(doc, "s.json", kScenarios));
   // Seventh campaign C3: a vehicle file that cannot be read is named through the field; C7: a
@@ -123,6 +126,21 @@ TEST_CASE("Bad scenarios are refused before flight with the fault named", "[REQ-
   doc["vehicle"] = "no-such-vehicle.json";
   expect_scenario_error(doc, ": vehicle: ");
   expect_scenario_error(doc, "no-such-vehicle.json: cannot open");
+  // Sixteenth campaign F3: the offending value exactly as written (399.9999999 was shown as
+  // "got 400"), and ranges with the ends the rule has ((0, 5]: 0 is refused too).
+  doc = default_doc();
+  doc["n3"]["rate_hz"] = 399.9999999;
+  expect_scenario_error(doc, "n3: rate_hz must be in [400, 10000] (the N3's inner loop), got 399.9999999");
+  doc = default_doc();
+  doc["goal_tolerance_m"] = 0.0;
+  expect_scenario_error(doc, "goal_tolerance_m: must be in (0, 5] m, got 0.0");
+  doc["goal_tolerance_m"] = 5.000000000001;
+  expect_scenario_error(doc, "goal_tolerance_m: must be in (0, 5] m, got 5.000000000001");
+  doc = default_doc();
+  doc["ekf"] = {{"initial_attitude_sigma", 3.1415926535897936}};
+  expect_scenario_error(doc, "ekf.initial_attitude_sigma: must be in (0, 3.141592653589793] rad, got 3.1415926535897936");
+  doc["ekf"] = {{"initial_attitude_sigma", 3.141592653589793}};
+  CHECK_NOTHROW(pipeline::scenario_from_json(doc, "s.json", kScenarios));
   doc = default_doc();
   doc["name"] = "two\nlines";
   expect_scenario_error(doc, "name: must be 1 to 128 letters, digits or . _ + - not starting with '.', got \"two\\nlines\"");
@@ -202,11 +220,18 @@ TEST_CASE("Bad scenarios are refused before flight with the fault named", "[REQ-
   // 2^64 - 1 (issue 20, sixth campaign).
   doc = default_doc();
   doc["n3"]["timeout_s"] = 0.005;
-  expect_scenario_error(doc, "n3.timeout_s 0.005000 s is shorter than the 0.007500 s the N3 sees between commands");
+  // Blamed on the field the file set, values exact (sixteenth campaign F12: "(top level)", %f).
+  expect_scenario_error(doc, "s.json: n3.timeout_s: n3.timeout_s 0.005 s is shorter than the 0.0075 s the N3 sees between "
+                             "commands (controller.rate_hz 100 Hz: its period less one n3 tick)");
   doc = default_doc();
   doc["n3"]["latency_s"] = 0.5;
   doc["n3"]["timeout_s"] = 0.1;
-  expect_scenario_error(doc, "n3.latency_s 0.500000 s is above n3.timeout_s 0.100000 s");
+  expect_scenario_error(doc, "s.json: n3.latency_s: n3.latency_s 0.5 s is above n3.timeout_s 0.1 s:");
+  // The N3's tilt limit below the controller's: the field the user changed, not "(top level)",
+  // and the default it contradicts marked as such.
+  doc = default_doc();
+  doc["n3"]["max_tilt_deg"] = 1.0;
+  expect_scenario_error(doc, "s.json: n3.max_tilt_deg: n3.max_tilt_deg 1 deg is below controller.max_tilt_deg");
   doc = default_doc();
   doc["seed"] = 18446744073709551616.0;
   expect_scenario_error(doc, "seed: must be an integer in [0, 2^64 - 1], got 1.8446744073709552e+19");
@@ -227,7 +252,7 @@ TEST_CASE("Bad scenarios are refused before flight with the fault named", "[REQ-
   // Issue 20: every value has a range; outside it the field and the range are named (a goal
   // tolerance of 1e9 m made any flight "reach" its goal).
   const std::vector<std::tuple<const char*, const char*, miner::Json, std::string>> ranged{
-      {"goal_tolerance_m", nullptr, 1e9, "goal_tolerance_m: must be in [0, 5] m, got"},
+      {"goal_tolerance_m", nullptr, 1e9, "goal_tolerance_m: must be in (0, 5] m, got"},
       {"trajectory", "v_max", 1e308, "trajectory.v_max: must be in [0.01, 50] m/s"},
       {"trajectory", "a_max", 1e-6, "trajectory.a_max: must be in [0.01, 50] m/s^2"},
       {"controller", "kp", miner::Json::array({1e300, 1e300, 1e300}), "controller.kp: gains must be at most 1000"},
@@ -235,7 +260,7 @@ TEST_CASE("Bad scenarios are refused before flight with the fault named", "[REQ-
       {"pose", "delay_s", 1e6, "pose.delay_s: must be in [0, 1] s"},
       {"n3", "latency_s", 100.0, "n3.latency_s: must be in [0, 1] s"},
       {"planning_margin_m", nullptr, 100.0, "planning_margin_m: must be in [0, 10] m"},
-      {"ekf", "initial_position_sigma", 1e9, "ekf.initial_position_sigma: must be in [0, 100] m"}};
+      {"ekf", "initial_position_sigma", 1e9, "ekf.initial_position_sigma: must be in (0, 100] m"}};
   for (const auto& [section, key, value, message] : ranged) {
     doc = default_doc();
     if (key) doc[section][key] = value;
@@ -261,6 +286,7 @@ TEST_CASE("Bad scenarios are refused before flight with the fault named", "[REQ-
   doc = default_doc();
   doc["start"] = start;
   doc["goal"] = start;
+  expect_scenario_error(doc, "s.json: goal: goal (");
   expect_scenario_error(doc, "coincides with start (closer than 1e-06 m): remove the repeated point");
   doc = default_doc();
   doc["start"] = start;
@@ -268,7 +294,7 @@ TEST_CASE("Bad scenarios are refused before flight with the fault named", "[REQ-
   // Given waypoints are the route: the planner block would go unused (issue 20).
   expect_scenario_error(doc, "s.json: planner: unused: the route is given by \"waypoints\"");
   doc.erase("planner");
-  expect_scenario_error(doc, "waypoints[0] (");
+  expect_scenario_error(doc, "s.json: waypoints[0]: waypoints[0] (");
   expect_scenario_error(doc, "coincides with start");
   // An empty list is not "no waypoints": it flew a straight line through the map (issue 20).
   doc["waypoints"] = miner::Json::array();
@@ -387,7 +413,10 @@ miner::Json with_value(const RangeRow& row, double v) {
   for (std::size_t dot; (dot = row.field.find('.', start)) != std::string::npos; start = dot + 1)
     at = &(*at)[row.field.substr(start, dot - start)];
   miner::Json& value = (*at)[row.field.substr(start)];
-  value = row.each_axis ? miner::Json::array({v, v, v}) : miner::Json(v);
+  // An integer field as a file writes one (JsonField::integer refuses 13.0: sixteenth campaign F5).
+  value = row.each_axis ? miner::Json::array({v, v, v})
+          : row.integer ? miner::Json(static_cast<long long>(std::llround(v)))
+                        : miner::Json(v);
   return doc;
 }
 
@@ -493,6 +522,16 @@ TEST_CASE("A scenario's trajectory.allocation optimise gives a lower J + rho T w
   CHECK(F_optimised < F_trapezoid);
   CHECK(optimised.max_speed <= s.limits.v_max * (1 + 1e-6));
   CHECK(optimised.max_acceleration <= s.limits.a_max * (1 + 1e-6));
+  // More segments than "optimise" takes: refused naming the scenario and the key (sixteenth
+  // campaign F15: "allocation: ... this problem has 65" named neither).
+  {
+    Eigen::MatrixX3d zigzag(miner::traj::kMaxOptimisedSegments + 2, 3);
+    for (Eigen::Index i = 0; i < zigzag.rows(); ++i) zigzag.row(i) << 2.0 + 0.2 * static_cast<double>(i), 5.0 + static_cast<double>(i % 2), 3.0;
+    pipeline::Scenario many = miner::testing::open_room_scenario(zigzag);
+    many.allocation = "optimise";
+    CHECK_THROWS_WITH(pipeline::build_reference(many),
+                      Contains("<test scenario>: trajectory.allocation: \"optimise\": allocation: \"optimise\" takes at most 64 segments"));
+  }
   // Bad requests are refused naming the field.
   doc["trajectory"]["allocation"] = "optimize";
   expect_scenario_error(doc, "trajectory.allocation: must be \"trapezoid\" or \"optimise\"");
@@ -873,6 +912,46 @@ TEST_CASE("A run folder's scenario names an OctoMap map by the absolute path the
     const miner::Json doc{{"format", pipeline::kScenarioFormat}, {"map", map}};
     CHECK(pipeline::self_contained_scenario(doc, base)["map"].get<std::string>() == meant.lexically_normal().string());
   }
+}
+
+TEST_CASE("A run folder's scenario records its files by SHA-256 and refuses them once changed", "[REQ-REPORT-001]") {
+  // Sixteenth campaign F11: the sGAN weights were recorded by path only, so a changed file flew
+  // another flight from the same run folder without a word. The trajectory file likewise.
+  namespace fs = std::filesystem;
+  const std::string dir = temp_dir() + "/hashed", weights = dir + "/w.bin", lofo = std::string(MINER_SOURCE_DIR) + "/fixtures/sgan/lofo/";
+  fs::create_directories(dir);
+  fs::copy_file(lofo + "without-sim.bin", weights, fs::copy_options::overwrite_existing);
+  miner::Json doc = pipeline::default_scenario_document();
+  doc["planner"] = {{"region", "sgan"}, {"weights", "w.bin"}};
+  const miner::Json flown = pipeline::self_contained_scenario(doc, dir);
+  CHECK(flown["planner"]["weights"] == weights);
+  CHECK(flown["planner"]["weights_sha256"] == miner::sha256_hex(miner::read_file_bytes(weights)));
+  CHECK(pipeline::scenario_from_json(flown, "run/scenario.json", "run").weights == weights);
+  fs::copy_file(lofo + "without-indoor.bin", weights, fs::copy_options::overwrite_existing);
+  CHECK_THROWS_WITH(pipeline::scenario_from_json(flown, "run/scenario.json", "run"),
+                    Contains("run/scenario.json: planner.weights_sha256: the sGAN weights file " + weights + " has SHA-256 ") &&
+                        Contains("not the recorded one: the file changed"));
+  // A hash that is not one, and a hash of no file, are refused as such.
+  miner::Json bad = flown;
+  bad["planner"]["weights_sha256"] = "ABC";
+  CHECK_THROWS_WITH(pipeline::scenario_from_json(bad, "s.json", "run"), Contains("planner.weights_sha256: must be 64 lower-case"));
+  bad = flown;
+  bad["planner"].erase("weights");
+  CHECK_THROWS_WITH(pipeline::scenario_from_json(bad, "s.json", "run"),
+                    Contains("planner.weights_sha256: the hash of planner.weights, which is not given"));
+  // A trajectory file: recorded and checked the same way.
+  const pipeline::Scenario s = pipeline::default_scenario();
+  const std::string traj_file = dir + "/t.json";
+  miner::write_file_atomic(traj_file, miner::traj::answer_to_json(pipeline::build_reference(s).trajectory).dump());
+  miner::Json given = pipeline::default_scenario_document();
+  given.erase("planner");
+  given["trajectory"] = {{"file", "t.json"}};
+  const miner::Json flown_traj = pipeline::self_contained_scenario(given, dir);
+  CHECK(flown_traj["trajectory"]["file_sha256"] == miner::sha256_hex(miner::read_file_bytes(traj_file)));
+  CHECK_NOTHROW(pipeline::scenario_from_json(flown_traj, "run/scenario.json", "run"));
+  miner::write_file_atomic(traj_file, miner::read_file_bytes(traj_file) + "\n");
+  CHECK_THROWS_WITH(pipeline::scenario_from_json(flown_traj, "run/scenario.json", "run"),
+                    Contains("trajectory.file_sha256: the trajectory file " + traj_file + " has SHA-256"));
 }
 
 TEST_CASE("flight::fly refuses a reference that does not start where the vehicle hovers", "[REQ-LIB-003][REQ-FLIGHT-007]") {

@@ -54,6 +54,31 @@ TEST_CASE("Missing or non-physical vehicle parameters are refused naming the par
     INFO("thrust-to-weight " << ratio);
     expect_vehicle_error(doc, "thrust-to-weight ratio of " + std::to_string(ratio).substr(0, 4));
   }
+  // Sixteenth campaign F24: the name is copied into summaries, so the scenario name's rule
+  // holds (an empty name, a NUL, newlines and 100 kB were copied as they were); a long one is
+  // shown cut.
+  for (const std::string& bad : {std::string(), std::string("a\nb"), std::string("nul\0x", 5), std::string(100000, 'v'),
+                                 std::string(".hidden")}) {
+    doc = vehicle_doc();
+    doc["name"] = bad;
+    expect_vehicle_error(doc, "v.json: name: must be 1 to 128 letters, digits or . _ + - not starting with '.', got \"");
+  }
+  doc = vehicle_doc();
+  doc["name"] = std::string(100000, 'v');
+  try {
+    (void)flight::vehicle_from_json(doc, "v.json");
+  } catch (const miner::Error& e) {
+    CHECK(std::string(e.what()).size() < 300);
+    CHECK_THAT(e.what(), Contains("\"" + std::string(64, 'v') + "\"..."));
+  }
+  {
+    flight::VehicleParams v;
+    v.name = "bad name";
+    CHECK_THROWS_WITH(flight::validate(v), Contains("vehicle: name: must be 1 to 128 letters"));
+  }
+  doc = vehicle_doc();
+  doc["name"] = std::string(128, 'v');
+  CHECK_NOTHROW(flight::vehicle_from_json(doc, "v.json"));
   doc = vehicle_doc();
   doc["mass_kg"] = 1e300;  // issue 20: values near the largest double flew
   expect_vehicle_error(doc, "mass_kg: must be a finite number in (0, 1000], got 1e+300");

@@ -496,7 +496,7 @@ TEST_CASE("A dataset folder that contradicts itself is refused naming the file a
   }, "splits.val.index_sha256: missing required field");
   refused([&](const std::string& q0, const std::string&) {
     edit_json(q0 + "/dataset.json", [](miner::Json& d) { d["splits"]["val"]["index_sha256"] = "ABC"; });
-  }, "splits.val.index_sha256: expected 64 lower-case hex digits");
+  }, "splits.val.index_sha256: must be 64 lower-case hexadecimal digits");
   // A folder of the format before the hashes is named as such, not read with its index unchecked.
   refused([&](const std::string& q0, const std::string&) {
     edit_json(q0 + "/dataset.json", [](miner::Json& d) { d["format"] = "miner-dataset-v2"; });

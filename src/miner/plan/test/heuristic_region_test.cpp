@@ -8,6 +8,8 @@
 #include "miner/core/error.hpp"
 #include "miner/core/rng.hpp"
 #include "miner/plan/heuristic_region.hpp"
+#include "miner/plan/reference.hpp"
+#include "miner/plan/rrt_star.hpp"
 #include "plan_test_maps.hpp"
 
 using miner::plan::HeuristicRegion;
@@ -100,6 +102,22 @@ TEST_CASE("A region round-trips through miner-region-v1 and bad files name the f
   doc = r.to_json();
   doc["source"] = std::string(512, 'x');
   CHECK_NOTHROW(HeuristicRegion::from_json(doc, "r.json"));
+  // The constructor keeps the same rule, so what saves also loads (sixteenth campaign F7: a
+  // region made in code with a newline in its source saved and then did not load).
+  for (const std::string& bad : {std::string("a\nb"), std::string(513, 'x')})
+    CHECK_THROWS_WITH(HeuristicRegion(r.bounds(), r.dims(), r.probabilities(), r.threshold(), bad),
+                      Contains("region source: must be one line of at most 512 bytes"));
+  CHECK(HeuristicRegion::from_json(HeuristicRegion(r.bounds(), r.dims(), r.probabilities(), r.threshold(),
+                                                   std::string(512, 'y')).to_json(), "r.json").source() == std::string(512, 'y'));
+  // The offending threshold exactly (F3: 1.0000001 was shown as "got 1", in range to the eye).
+  CHECK_THROWS_WITH(HeuristicRegion(r.bounds(), r.dims(), r.probabilities(), 1.0000001),
+                    Contains("region threshold: must be in (0, 1], got 1.0000001"));
+  // A cell outside the grid has no index (F9: (dims.x, 0, 0) answered the next row's first cell).
+  const Eigen::Vector3i d = r.dims();
+  CHECK(r.index(d.x() - 1, d.y() - 1, d.z() - 1) == r.probabilities().size() - 1);
+  CHECK(r.coords(r.index(d.x() - 1, 0, 0)) == I(d.x() - 1, 0, 0));
+  for (const Eigen::Vector3i& out : {I(d.x(), 0, 0), I(0, d.y(), 0), I(0, 0, d.z()), I(-1, 0, 0), I(0, -1, 0), I(0, 0, -1)})
+    CHECK_THROWS_WITH(r.index(out.x(), out.y(), out.z()), Contains("lies outside the region's"));
   CHECK_THROWS_WITH(HeuristicRegion(Box{{0, 0, 0}, {1, 1, 1}}, I(8192, 8192, 1), {}, 0.5),
                     Contains("more than the limit"));
   // Dims whose product wraps 64 bits (2^31 - 1 cubed ~ 2^93; a wrapped product could pass a
@@ -206,6 +224,30 @@ TEST_CASE("A region must match the map's bounds and hold at least one cell", "[R
                     Contains("do not match the map's bounds") && Contains("(10, 10, 3)"));
   const HeuristicRegion empty(map.bounds(), I(2, 2, 2), std::vector<double>(8, 0.2), 0.5);
   CHECK_THROWS_WITH(empty.require_matches(map, "planner miner"), Contains("no cell with probability >= threshold"));
+  // Sixteenth campaign F4: a region of another map with the same bounds planned without a word.
+  // The A*-dilated region records its map's fingerprint; another map is refused, the same map
+  // (rebuilt, or read back from the region's file) is not.
+  const auto closed = miner::testing::closed_wall_map();
+  REQUIRE(closed.bounds().min == map.bounds().min);
+  REQUIRE(closed.bounds().max == map.bounds().max);
+  const auto problem = miner::plan::PlanningProblem::make(map, V(2, 5, 1.5), V(8, 5, 1.5), 0.1);
+  const HeuristicRegion own = miner::plan::astar_dilated_region(problem, miner::plan::astar_reference(problem), I(8, 8, 4), 1);
+  CHECK(own.map_fingerprint() == map.fingerprint());
+  CHECK_NOTHROW(own.require_matches(miner::testing::wall_with_door_map(), "planner miner"));
+  CHECK_THROWS_WITH(own.require_matches(closed, "r.json"),
+                    Contains("r.json: the region was built for another map (fingerprint ") && Contains("same bounds"));
+  const HeuristicRegion back = HeuristicRegion::from_json(own.to_json(), "r.json");
+  CHECK(back.map_fingerprint() == map.fingerprint());
+  CHECK_THROWS_WITH(back.require_matches(closed, "r.json"), Contains("built for another map"));
+  // Without one (a region made from numbers, or an older file) the bounds are all it is checked by.
+  miner::Json older = own.to_json();
+  older.erase("map_fingerprint");
+  CHECK_NOTHROW(HeuristicRegion::from_json(older, "r.json").require_matches(closed, "r.json"));
+  for (const char* bad : {"0000000000000000", "ABCDEF0123456789", "12345"}) {
+    miner::Json doc = own.to_json();
+    doc["map_fingerprint"] = bad;
+    CHECK_THROWS_WITH(HeuristicRegion::from_json(doc, "r.json"), Contains("r.json: map_fingerprint: must be 16 lower-case hexadecimal"));
+  }
   CHECK_THROWS_AS(empty.sample(*std::make_unique<miner::Rng>(1)), miner::Error);
 }
 

@@ -41,6 +41,30 @@ TEST_CASE("Repair inserts halfway points until the trajectory clears the obstacl
   CHECK(r.waypoints.row(r.waypoints.rows() - 1) == corner_path().row(2));
 }
 
+TEST_CASE("With allocation optimise, a repair past its segment limit says what the repair did", "[REQ-TRAJ-008][REQ-TRAJ-011]") {
+  // Sixteenth campaign F15: a 63-segment path whose repair added 2 midpoints failed with
+  // "this problem has 65", a problem the caller never wrote. Here: the corner path with the
+  // second leg cut into pieces, kMaxOptimisedSegments segments in all; the first leg bulges
+  // into the box as before, and its midpoint would make one segment too many.
+  const Map map = corner_map();
+  const int m = kMaxOptimisedSegments;
+  Eigen::MatrixX3d p(m + 1, 3);
+  p.row(0) << 0, 0, 1;
+  p.row(1) << 5, 0, 1;
+  for (int i = 2; i <= m; ++i) p.row(i) << 5, 5.0 * (i - 1) / (m - 1), 1;
+  RepairOptions o;
+  o.limits = Limits{2.0, 1.0};
+  o.optimise = AllocationOptions{};
+  CHECK_THROWS_WITH(repair_collisions(map, p, o),
+                    Contains("segment(s) of the " + std::to_string(m) + "-segment trajectory collide (first: segment 0)") &&
+                        Contains("segments, more than allocation \"optimise\" takes (" + std::to_string(m) + ")"));
+  // Room for the midpoints (a quarter of the points): repaired within the limit.
+  const RepairResult r = repair_collisions(map, p.topRows(m / 4), o);
+  CHECK(r.inserted >= 1);
+  CHECK(r.waypoints.rows() - 1 <= m);
+  CHECK(colliding_segments(r.trajectory, map, 0.0, 0.01).empty());
+}
+
 TEST_CASE("A repaired trajectory keeps the robot radius between its samples too, on coarse maps", "[REQ-TRAJ-008]") {
   // Random free 4-point polylines among 12 small boxes on a 3 m grid (cells 10-30 times the
   // boxes). Chords half a cell apart (1.5 m) let 2 of these 300 curves touch a box between

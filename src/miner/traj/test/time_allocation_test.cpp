@@ -236,6 +236,21 @@ TEST_CASE("Allocation requests in problem files are checked", "[REQ-TRAJ-011]") 
   bad = doc;
   bad["durations"] = {1.0, 1.0};
   CHECK_THROWS_WITH(request_from_json(bad, "p.json"), Contains("durations are given"));
+  // Sixteenth campaign F6: trapezoid beside given durations was ignored, from the command line
+  // or the file; durations alone are the timing.
+  {
+    auto timed = doc;
+    timed.erase("limits");
+    timed.erase("rho");
+    timed.erase("allocation");
+    timed["durations"] = {1.0, 1.0};
+    CHECK_NOTHROW(request_from_json(timed, "p.json"));
+    CHECK_THROWS_WITH(request_from_json(timed, "p.json", "trapezoid", std::nullopt),
+                      Contains("--allocate: p.json gives durations, so there is nothing to allocate"));
+    timed["allocation"] = "trapezoid";
+    CHECK_THROWS_WITH(request_from_json(timed, "p.json"),
+                      Contains("p.json: allocation: durations are given, so there is nothing to allocate"));
+  }
   bad = doc;
   bad["rhoo"] = 1;
   CHECK_THROWS_WITH(request_from_json(bad, "p.json"), Contains("p.json: rhoo: unknown key"));

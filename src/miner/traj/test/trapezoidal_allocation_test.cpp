@@ -182,7 +182,17 @@ TEST_CASE("A trajectory changed through its mutable accessors is checked where i
     CHECK_THROWS_WITH(changed.evaluate(0.5), Contains("durations[0] must be a positive finite time"));
     CHECK_THROWS_WITH(changed.cost(), Contains("durations[0]"));
     CHECK_THROWS_WITH(exact_extremes(changed), Contains("durations[0]"));
+    // Sixteenth campaign F9: summed as it was (-1 gave a 1 s trajectory, NaN a NaN one).
+    CHECK_THROWS_WITH(changed.total_duration(), Contains("trajectory: durations[0] must be a positive finite time"));
   }
+  // F8: a local time that is not finite answered NaN, a global one +-inf was clamped to an end.
+  for (const double bad : {std::nan(""), HUGE_VAL, -HUGE_VAL}) {
+    INFO("time " << bad);
+    CHECK_THROWS_WITH(t.evaluate_segment(0, bad), Contains("tau: must be a finite local time in s"));
+    CHECK_THROWS_WITH(t.evaluate(bad), Contains("t: must be a finite time in s"));
+  }
+  CHECK(t.evaluate(-1e300) == t.evaluate(0.0));  // finite times are clamped, as documented
+  CHECK(t.evaluate(1e300) == t.evaluate(t.total_duration()));
   auto poisoned = t;
   poisoned.mutable_coefficients()(4, 1) = std::nan("");
   CHECK_THROWS_WITH(exact_extremes(poisoned), Contains("exact_extremes: the trajectory's coefficients must be finite"));

@@ -127,6 +127,13 @@ TEST_CASE("The SE(3) controller turns a feed-forward acceleration into attitude 
   const Eigen::Vector3d z = flight::rotation_zyx({sat.command.x, sat.command.y, 0.0}).col(2);
   CHECK(std::acos(z.z()) == Approx(flight::deg2rad(35)));
   CHECK(sat.command.x < 0.0);  // roll negative tilts thrust toward +y
+  // Level, but more thrust than the rotors give: saturated as well (held-out 13, h13-flight-01:
+  // only a negative thrust was reported, so the integrator wound up in a heavy climb).
+  flight::Se3Controller climb(v, flight::ControllerParams{});
+  ref.a = Eigen::Vector3d(0.0, 0.0, 2.0 * v.max_thrust() / v.mass);  // needs m (g + a) > max thrust
+  CHECK(climb.update(ref, at_ref, 0.01).saturated);
+  ref.a = Eigen::Vector3d(0.0, 0.0, 0.5 * (v.max_thrust() / v.mass - flight::kGravity));  // within it
+  CHECK_FALSE(climb.update(ref, at_ref, 0.01).saturated);
 }
 
 TEST_CASE("On a moving reference the controller feeds the vehicle's drag forward", "[REQ-FLIGHT-006]") {

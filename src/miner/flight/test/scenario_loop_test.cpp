@@ -967,6 +967,19 @@ TEST_CASE("flight::fly refuses a reference that does not start where the vehicle
   CHECK_NOTHROW(flight::fly(setup, r));
 }
 
+TEST_CASE("The flight envelope check counts the vehicle's quadratic drag", "[REQ-FLIGHT-007]") {
+  // Held-out 13, h13-flight-05: the quadratic body drag was left out of the thrust the reference
+  // needs, so a vehicle that could only fly the reference without that drag was accepted. A
+  // 10 m leg at 1 m/s: 50 N s^2/m^2 of drag is 50 N at full speed, 33 m/s^2 against a 1.5 kg
+  // vehicle, far past 0.8 of its 35 deg tilt limit; without it the leg is easy.
+  Eigen::MatrixX3d points(2, 3);
+  points << 5, 5, 3, 15, 5, 3;
+  pipeline::Scenario s = miner::testing::open_room_scenario(points, 1.0, 1.0);
+  CHECK_NOTHROW(pipeline::build_reference(s));
+  s.vehicle.quadratic_drag = 50.0;
+  CHECK_THROWS_WITH(pipeline::build_reference(s), Contains("N of drag at") && Contains("or the vehicle's drag"));
+}
+
 TEST_CASE("A collision is counted once per entry into an obstacle, not once per tick inside it",
           "[REQ-FLIGHT-009][REQ-FLIGHT-007]") {
   // Held-out audit 8, h8-flight-06: the count rose by one every N3 tick in contact (137 for a

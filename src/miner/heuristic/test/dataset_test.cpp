@@ -97,7 +97,7 @@ TEST_CASE("Environment cells are free, partial where a grown obstacle meets them
   }
 }
 
-TEST_CASE("A cell covered only by the union of two boxes is covered: a gap of any width is found", "[REQ-HEUR-002]") {
+TEST_CASE("A cell covered only by the union of two boxes is covered: a gap of any width is found", "[REQ-HEUR-002][REQ-HEUR-012]") {
   using miner::world::Box;
   const Box cell{{0, 0, 0}, {1, 1, 1}};
   CHECK(heuristic::box_covered(cell, {Box{{-1, -1, -1}, {0.4, 2, 2}}, Box{{0.4, -1, -1}, {2, 2, 2}}}));

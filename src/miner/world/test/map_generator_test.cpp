@@ -123,6 +123,18 @@ TEST_CASE("Map families draw their size per map, carry a free query and repeat t
     }
     CHECK(extents[0] != extents[1]);  // the size is drawn per map
   }
+  // The drawn resolution keeps the whole grid small too, not only each axis (held-out 13,
+  // h13-world-03: 60 x 60 x 30 m at 0.25 m, 240 x 240 x 120 = 6.9e6 cells, was taken; the
+  // next resolution, 0.5 m, gives 8.6e5).
+  {
+    GeneratorOverrides big;
+    big.size = Eigen::Vector3d(60, 60, 30);
+    const Map map = generate_map(generator_preset("cluttered"), 3, big);
+    const Eigen::Vector3d cells = (map.bounds().extent() / map.resolution()).array().ceil();
+    CHECK(cells.maxCoeff() <= kMaxFamilyCells);
+    CHECK(cells.prod() <= 6e6);
+    CHECK(map.resolution() == 0.5);
+  }
   for (const auto& [name, seed] : std::vector<std::pair<std::string, std::uint64_t>>{{"cluttered", 2}, {"forest", 1}}) {
     const GeneratorPreset p = generator_preset(name);
     const Map map = generate_map(p, seed);

@@ -387,3 +387,25 @@ TEST_CASE("A voxel layer built in code is refused by its resolution, size, origi
   CHECK_THROWS_WITH(layer(0.5, Eigen::Vector3i(2, 3, 4), 24, 0, Eigen::Vector3i(0, std::numeric_limits<int>::max() - 2, 0)),
                     Contains("along axis 1 leaves the range of cell indices"));
 }
+
+TEST_CASE("Voxels answer exactly as boxes at the boundary: at the radius, and a face at the ray's range",
+          "[REQ-WORLD-012][REQ-WORLD-004]") {
+  // Held-out 13, h13-world-04 and h13-world-06: a point or segment exactly the radius from a
+  // blocked voxel's closed cube was reported free (dist < r), and a ray stopped before the voxel
+  // whose face lies exactly at max_range, where a box at the same place is hit (dist <= r). The
+  // voxel (2, 2, 2) is the cube [2, 3]^3; the box map holds that cube as a box.
+  const Map voxels = Map::from_voxels({small_layer(), UnknownPolicy::kFree, "", ""});
+  const Map boxes(Box{{0, 0, 0}, {4, 4, 4}}, 1.0, {Box{{2, 2, 2}, {3, 3, 3}}});
+  for (const Map* m : {&voxels, &boxes}) {
+    INFO((m == &voxels ? "voxels" : "boxes"));
+    CHECK(m->point_collision(V(2.5, 2.5, 3.5), 0.5));    // 0.5 above the top face: touches
+    CHECK_FALSE(m->point_collision(V(2.5, 2.5, 3.5), 0.25));
+    CHECK(m->point_collision(V(2.5, 3.0, 2.5), 0.0));    // on a face, radius 0
+    CHECK(m->segment_collision(V(0.5, 2.5, 3.5), V(3.5, 2.5, 3.5), 0.5));
+    CHECK_FALSE(m->segment_collision(V(0.5, 2.5, 3.5), V(3.5, 2.5, 3.5), 0.25));
+    const auto at_range = m->raycast(V(0.5, 2.5, 2.5), V(1, 0, 0), 1.5);  // the face x = 2 at 1.5 m
+    REQUIRE(at_range);
+    CHECK(*at_range == 1.5);
+    CHECK_FALSE(m->raycast(V(0.5, 2.5, 2.5), V(1, 0, 0), 1.25));
+  }
+}

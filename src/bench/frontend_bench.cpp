@@ -492,6 +492,14 @@ nlohmann::json to_json(const FrontendBenchResult& r) {
           {"run_records", runs}};
 }
 
+namespace {
+/// The SHA-256 of the shipped sGAN weights, as a part records them for "builtin".
+const std::string& builtin_weights_sha256() {
+  static const std::string hash = heuristic::Sgan::builtin().sha256();
+  return hash;
+}
+}  // namespace
+
 nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, const std::vector<std::string>& files) {
   if (parts.empty()) throw Error("merge: no shard files");
   // Each part must be a campaign's JSON before anything is compared (REQ-REPORT-006): a map
@@ -517,14 +525,45 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
     (void)shard.at("index").integer();
     (void)shard.at("count").integer();
     if (!(root.at("total_s").number() >= 0.0)) root.at("total_s").fail("a duration must be >= 0");
-    (void)root.at("map").string();
+    // The settings as `bench frontend` writes them (seventeenth campaign F1, F2): integers
+    // written as integers (a seed of 1.0 beside 1 compared equal, and the merged bytes followed
+    // the order of the parts), the options' ranges, a boolean safeguard, a named map, a region of
+    // at least one cell.
+    const auto whole = [&](const JsonField& f, std::uint64_t lo, std::uint64_t hi, const std::string& as) {
+      if (!f.value().is_number_unsigned() || f.value().get<std::uint64_t>() < lo || f.value().get<std::uint64_t>() > hi)
+        f.fail("expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "] (as " + as + "), got " +
+               f.value().dump());
+    };
+    whole(root.at("seed"), 0, std::numeric_limits<std::uint64_t>::max(), "--seed");
+    whole(root.at("runs"), 1, std::numeric_limits<int>::max(), "--runs");
+    whole(root.at("max_iterations"), 1, plan::kMaxIterations, "--max-iterations");
+    whole(root.at("throughput").at("iterations"), 0, std::numeric_limits<std::uint64_t>::max(), "--throughput-iterations");
+    whole(root.at("region").at("cells"), 1, plan::HeuristicRegion::kMaxCells, "a region's cells");
+    if (!root.at("safeguard").value().is_boolean()) root.at("safeguard").fail("expected true or false, got " + root.at("safeguard").value().dump());
+    if (root.at("map").string().empty()) root.at("map").fail("names no map");
+    (void)root.at("region").at("source").string();
+    if (const double f = root.at("target_factor").number(); !(f >= kMinTargetFactor && f <= kMaxTargetFactor))
+      root.at("target_factor").fail("must be in [0.01, 100] (as --target-factor), got " + root.at("target_factor").value().dump());
     root.at("region").only_keys({"source", "cells", "sha256", "build_ms"});
     (void)sha256_field(root.at("region").at("sha256"));
-    // The weights miner-sgan ran with (null when it did not run), by content.
-    if (!root.at("weights").value().is_null()) {
-      root.at("weights").only_keys({"source", "sha256"});
-      (void)root.at("weights").at("source").string();
-      (void)sha256_field(root.at("weights").at("sha256"));
+    // The weights miner-sgan ran with, by content: given exactly when miner-sgan ran, and the
+    // shipped ones' own hash for "builtin" (seventeenth campaign F3, F20: null beside miner-sgan
+    // records, weights without them, "builtin" with any hash were merged).
+    {
+      bool sgan_ran = false;
+      const JsonField listed = root.at("planners");
+      for (std::size_t i = 0; i < listed.array_size(); ++i)
+        sgan_ran = sgan_ran || listed.at(i).at("planner").string() == kMinerSgan;
+      const JsonField w = root.at("weights");
+      if (sgan_ran && w.value().is_null()) w.fail("null, but miner-sgan ran: its weights are recorded");
+      if (!sgan_ran && !w.value().is_null()) w.fail("weights, but miner-sgan did not run (null without it)");
+      if (!w.value().is_null()) {
+        w.only_keys({"source", "sha256"});
+        const std::string source = w.at("source").string(), hash = sha256_field(w.at("sha256"));
+        if (source.empty()) w.at("source").fail("names no weights (\"builtin\" for the shipped ones)");
+        if (source == "builtin" && hash != builtin_weights_sha256())
+          w.at("sha256").fail("is not the shipped weights' SHA-256 " + builtin_weights_sha256());
+      }
     }
     // The summaries and the throughput block have exactly the keys a campaign writes (issue 20:
     // unknown keys there were carried into the merge).

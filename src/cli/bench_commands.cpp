@@ -139,7 +139,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   fc->add_option("--runs", f->bench.runs, "runs per planner")->check(kRunsRange)->capture_default_str();
   fc->add_option("--seed", f->bench.seed, "master seed (run k uses stream k)")->capture_default_str()->check(kUnsigned64);
   fc->add_option("--target-factor", f->bench.target_factor, "target cost = this x the A* reference cost")
-      ->check(finite_in(0.01, 100.0))
+      ->check(finite_in(bench::kMinTargetFactor, bench::kMaxTargetFactor))
       ->capture_default_str();
   fc->add_option("--iterations,--max-iterations", f->bench.max_iterations, "iteration budget per run (as plan --iterations)")
       ->check(kIterationsRange)

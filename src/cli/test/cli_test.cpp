@@ -1681,6 +1681,17 @@ TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[RE
     }
     doctor([](miner::Json& d) { d["steer_step"] = 0.0; }, "steer_step: the steering step must be positive and finite");
     doctor([](miner::Json& d) { d["region"]["cells"] = 1; }, "different campaigns: region.cells is 1 in the one");
+    // Seventeenth campaign F1, F2, F3: settings as bench frontend writes them (a seed of 1.0
+    // beside 1 made the merged bytes follow the order of the parts), weights only with miner-sgan.
+    doctor([](miner::Json& d) { d["seed"] = 1.0; }, "seed: expected an integer in [0, 18446744073709551615] (as --seed), got 1.0");
+    doctor([](miner::Json& d) { d["max_iterations"] = 800.5; }, "max_iterations: expected an integer in [1, 1000000]");
+    doctor([](miner::Json& d) { d["max_iterations"] = -1; }, "max_iterations: expected an integer in [1, 1000000]");
+    doctor([](miner::Json& d) { d["safeguard"] = 1; }, "safeguard: expected true or false, got 1");
+    doctor([](miner::Json& d) { d["map"] = ""; }, "map: names no map");
+    doctor([](miner::Json& d) { d["region"]["cells"] = 0; }, "region.cells: expected an integer in [1, 16777216]");
+    doctor([](miner::Json& d) { d["target_factor"] = 1000.0; }, "target_factor: must be in [0.01, 100]");
+    doctor([](miner::Json& d) { d["weights"] = {{"source", "builtin"}, {"sha256", std::string(64, 'a')}}; },
+           "weights: weights, but miner-sgan did not run");
     // Fifth campaign: a part of other --planners was called "incomplete".
     doctor([](miner::Json& d) {
       const std::string last = d["planners"].back()["planner"].get<std::string>();
@@ -1733,6 +1744,19 @@ TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[RE
     const Run w = miner_cli({"bench", "merge", p0, p1_weights});
     CHECK(w.code == 1);
     CHECK_THAT(w.err, Contains("are different campaigns: weights.sha256"));
+    // The weights are recorded whenever miner-sgan ran, and "builtin" has the shipped weights' own
+    // hash (seventeenth campaign F20: null, or "builtin" with any hash, were merged).
+    for (const auto& [edit, why] : std::vector<std::pair<std::function<void(miner::Json&)>, std::string>>{
+             {[](miner::Json& d) { d["weights"] = nullptr; }, "weights: null, but miner-sgan ran"},
+             {[](miner::Json& d) { d["weights"]["source"] = "builtin"; }, "weights.sha256: is not the shipped weights' SHA-256"}}) {
+      miner::Json d = miner::read_json_file(p1);
+      edit(d);
+      const std::string edited = dir() + "/files-edited.json";
+      std::ofstream(edited) << d.dump();
+      const Run e = miner_cli({"bench", "merge", p0, edited});
+      CHECK(e.code == 1);
+      CHECK_THAT(e.err, Contains(why));
+    }
     use_weights("without-sim.bin");
     // The same number of cells, one moved: only the contents tell the two regions apart.
     miner::Json r = miner::read_json_file(region);

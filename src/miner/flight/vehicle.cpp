@@ -154,6 +154,10 @@ VehicleParams vehicle_from_json(const Json& doc, const std::string& origin) {
     // Copied into summaries and reports: the scenario name's rule (sixteenth campaign F24: an
     // empty name, a NUL, newlines or 100 kB were copied as they were).
     if (!is_plain_name(v.name)) root.at("name").fail(std::string(kPlainNameRule) + ", got " + quoted_excerpt(v.name));
+  } else {
+    // A file without a name is not the default vehicle: it is not reported under that vehicle's
+    // name (seventeenth campaign F24: a 2 kg vehicle was "n3-class-1.5kg" in summary.json).
+    v.name = kUnnamedVehicle;
   }
   v.mass = root.at("mass_kg").number();
   v.inertia = root.at("inertia_kg_m2").vec3();

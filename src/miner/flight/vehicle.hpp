@@ -52,8 +52,11 @@ inline constexpr double kMaxTiltTime = 1.0;
 /// Standard gravity used by the dynamics, the N3 and the estimator alike (m/s^2).
 using miner::kGravity;
 
+/// The name a vehicle file without "name" is read with (never the default vehicle's).
+inline constexpr const char* kUnnamedVehicle = "unnamed";
+
 struct VehicleParams {
-  std::string name = "n3-class-1.5kg";
+  std::string name = "n3-class-1.5kg";  ///< a file without "name" reads as kUnnamedVehicle
   double mass = 1.5;                                        ///< kg
   Eigen::Vector3d inertia{0.029, 0.029, 0.055};             ///< kg m^2, principal axes
   double arm_length = 0.23;                                 ///< m, centre to rotor axis

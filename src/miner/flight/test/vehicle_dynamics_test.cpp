@@ -79,6 +79,12 @@ TEST_CASE("Missing or non-physical vehicle parameters are refused naming the par
   doc = vehicle_doc();
   doc["name"] = std::string(128, 'v');
   CHECK_NOTHROW(flight::vehicle_from_json(doc, "v.json"));
+  // Without a name it is not the default vehicle (seventeenth campaign F24: a 2 kg vehicle was
+  // reported as "n3-class-1.5kg").
+  doc = vehicle_doc();
+  doc.erase("name");
+  doc["mass_kg"] = 2.0;
+  CHECK(flight::vehicle_from_json(doc, "v.json").name == flight::kUnnamedVehicle);
   doc = vehicle_doc();
   doc["mass_kg"] = 1e300;  // issue 20: values near the largest double flew
   expect_vehicle_error(doc, "mass_kg: must be a finite number in (0, 1000], got 1e+300");

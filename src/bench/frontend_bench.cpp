@@ -605,10 +605,7 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
     if (lower <= goal_radius)
       root.at("goal_radius").fail(root.at("goal_radius").value().dump() + " m reaches the start (|goal - start| = " +
                                   root.at("lower_bound").value().dump() + " m): no campaign runs such a query");
-    if (const JsonField checks = root.at("ompl_checks"); !checks.value().is_null() &&
-        !(checks.value().is_number_unsigned() && checks.value().get<std::uint64_t>() >= 1 &&
-          checks.value().get<std::uint64_t>() <= kMaxOmplChecks))
-      checks.fail("expected null or an integer in [1, 1000000000] (as --ompl-checks), got " + checks.value().dump());
+    if (!root.at("ompl_checks").value().is_null()) whole(root.at("ompl_checks"), 1, kMaxOmplChecks, "--ompl-checks");
     const double time_limit = root.at("time_limit_s").number();
     if (!(time_limit >= kMinTimeLimitS && time_limit <= kMaxTimeLimitS))
       root.at("time_limit_s").fail("the time limit must be in [0.001, 86400] s (as --time-limit)");
@@ -711,25 +708,22 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
   // is a progress property that some planners have): one record that differs from the others of its
   // planner was edited (sixteenth campaign F1: a first.nodes of 10 among nulls merged).
   {
-    std::map<std::pair<std::string, std::string>, std::pair<bool, std::string>> reports;  // (planner, stage) -> (known, where)
+    // The target's count may be the run's final one (ompl_planners.cpp), so only the first
+    // solution's is the progress property's alone.
+    std::map<std::string, std::pair<bool, std::string>> reports;  // planner -> (count known, where first seen)
     for (std::size_t p = 0; p < parts.size(); ++p) {
       const JsonField records = JsonField(parts[p], "", names[p]).at("run_records");
       for (std::size_t k = 0; k < records.array_size(); ++k) {
         const JsonField r = records.at(k);
         const std::string planner = r.at("planner").string();
-        if (planner.rfind("ompl:", 0) != 0) continue;
-        // The target's count may be the run's final one (ompl_planners.cpp), so only the
-        // first solution's is the property's alone.
-        for (const char* stage : {"first"}) {
-          if (!r.at(stage).value().is_object()) continue;
-          const bool known = !r.at(stage).at("nodes").value().is_null();
-          const std::string where = names[p] + ": " + r.at(stage).at("nodes").path();
-          const auto [it, fresh] = reports.emplace(std::make_pair(planner, std::string(stage)), std::make_pair(known, where));
-          if (!fresh && it->second.first != known)
-            r.at(stage).at("nodes").fail(std::string(known ? "a count" : "null") + ", but " + it->second.second + " is " +
-                                         (it->second.first ? "a count" : "null") + ": " + planner +
-                                         " reports its vertices at its first solution in every run or in none");
-        }
+        if (planner.rfind("ompl:", 0) != 0 || !r.at("first").value().is_object()) continue;
+        const JsonField nodes = r.at("first").at("nodes");
+        const bool known = !nodes.value().is_null();
+        const auto [it, fresh] = reports.emplace(planner, std::make_pair(known, names[p] + ": " + nodes.path()));
+        if (!fresh && it->second.first != known)
+          nodes.fail(std::string(known ? "a count" : "null") + ", but " + it->second.second + " is " +
+                     (it->second.first ? "a count" : "null") + ": " + planner +
+                     " reports its vertices at its first solution in every run or in none");
       }
     }
   }

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include <filesystem>
+#include <fstream>
 
 #include "miner/core/error.hpp"
 #include "miner/core/text.hpp"
@@ -534,12 +535,13 @@ void Map::check_voxel_side_file(const std::string& path) {
   // referenced is the user's input, which the JSON names just the same (sixteenth campaign F14:
   // `map gen --preset scan --out x.json` then replaced the user's scan).
   if (earlier_output) {
-    try {
-      const std::string head = read_file_bytes(bt.string(), "voxel file").substr(0, kSideFileHeadBytes);
-      earlier_output = head.find(kSideFileMark) != std::string::npos;
-    } catch (const Error&) {
-      earlier_output = false;
-    }
+    // The mark sits in the header: its first bytes are read, not the whole (maybe large) file.
+    // A file that cannot be read gives no bytes, so no mark: it is not replaced.
+    std::ifstream in(bt, std::ios::binary);
+    std::string head(kSideFileHeadBytes, '\0');
+    in.read(head.data(), static_cast<std::streamsize>(head.size()));
+    head.resize(static_cast<std::size_t>(in.gcount()));
+    earlier_output = head.find(kSideFileMark) != std::string::npos;
   }
   if (!earlier_output)
     throw Error(bt.string() + ": exists and is not a voxel file that a save of a map at " + path +

@@ -99,7 +99,7 @@ PlannerSummary summarise(const std::string& planner, const std::vector<RunRecord
   s.first_nodes_mean = mean(fn);
   s.first_cost_mean = mean(fc);
   s.first_time_ms_mean = mean(ft);
-  // A median that lands on a missed run (fewer than half reached) is infinite: median()
+  // A median that lands on a missed run (no more than half reached) is infinite: median()
   // reports it as unknown (null).
   s.target_iterations = median(ti);
   s.target_nodes = median(tn);
@@ -524,7 +524,11 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
     const JsonField shard = root.at("shard");
     (void)shard.at("index").integer();
     (void)shard.at("count").integer();
-    if (!(root.at("total_s").number() >= 0.0)) root.at("total_s").fail("a duration must be >= 0");
+    // A part's wall clock: no campaign part runs a year (seventeenth campaign F27: two parts of
+    // 1e308 s summed to inf, written as null).
+    if (!(root.at("total_s").number() >= 0.0 && root.at("total_s").number() <= kMaxPartSeconds))
+      root.at("total_s").fail("a part's duration must be in [0, " + exact_number(kMaxPartSeconds) + "] s (a year), got " +
+                              exact_number(root.at("total_s").number()));
     // The settings as `bench frontend` writes them (seventeenth campaign F1, F2): integers
     // written as integers (a seed of 1.0 beside 1 compared equal, and the merged bytes followed
     // the order of the parts), the options' ranges, a boolean safeguard, a named map, a region of
@@ -609,6 +613,12 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
     const double time_limit = root.at("time_limit_s").number();
     if (!(time_limit >= kMinTimeLimitS && time_limit <= kMaxTimeLimitS))
       root.at("time_limit_s").fail("the time limit must be in [0.001, 86400] s (as --time-limit)");
+    // --ompl-checks lifts the clock to a day, and a campaign with it writes that (seventeenth
+    // campaign F6: a part with ompl_checks and a time limit of 2 s merged).
+    const bool by_checks = !root.at("ompl_checks").value().is_null();
+    if (by_checks && time_limit != kMaxTimeLimitS)
+      root.at("time_limit_s").fail(exact_number(time_limit) + ", but a campaign with ompl_checks runs with the clock lifted to " +
+                                   exact_number(kMaxTimeLimitS) + " s (as --ompl-checks writes it)");
     if (!(std::isfinite(robot_radius) && robot_radius >= 0.0)) root.at("robot_radius").fail("the robot radius must be >= 0 and finite");
     const double reference = root.at("reference_cost").number();
     if (reference < lower * (1.0 - kRoundoff))
@@ -680,6 +690,14 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
           bounded_by_iterations(r.at("planner").string()) && r.at("iterations").number() > budget)
         r.at("iterations").fail("ran " + r.at("iterations").value().dump() + " iterations, more than the campaign's budget " +
                                 root.at("max_iterations").value().dump());
+      // With ompl_checks an OMPL planner stops after that many termination checks, one per
+      // iteration (seventeenth campaign F11: a BIT* record of 10^6 iterations in a campaign of
+      // 3000 checks merged).
+      if (by_checks && r.at("planner").string().rfind("ompl:", 0) == 0 && r.has("iterations") &&
+          r.at("iterations").value().is_number() && r.at("iterations").number() > root.at("ompl_checks").number())
+        r.at("iterations").fail("ran " + r.at("iterations").value().dump() +
+                                " iterations, more than the campaign's ompl_checks " +
+                                root.at("ompl_checks").value().dump() + " (OMPL's runs stop there)");
       check_run_record(r, lower);
       try {
         runs.push_back(run_from(parts[p]["run_records"][k]));
@@ -872,7 +890,7 @@ void print_table(const FrontendBenchResult& r, std::ostream& out) {
         << cell(100 * s.target_rate, 0) << "%" << std::setw(10) << cell(s.target_iterations, 0) << std::setw(10)
         << cell(s.target_nodes, 0) << std::setw(10) << cell(s.target_time_ms, 2) << "\n";
   }
-  out << "(medians; opt = until cost <= target, '-' where fewer than half the runs got there)\n";
+  out << "(medians; opt = until cost <= target, '-' unless more than half the runs got there)\n";
   if (std::isfinite(r.rrtstar_iterations_per_s)) {
     out << "throughput over " << r.options.throughput_iterations << " iterations: rrtstar "
         << cell(r.rrtstar_iterations_per_s, 0) << " it/s, ompl:RRTstar " << cell(r.ompl_rrtstar_iterations_per_s, 0)

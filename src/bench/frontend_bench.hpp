@@ -58,6 +58,9 @@ struct FrontendBenchOptions {
 /// checks in the parts too.
 inline constexpr double kMinGoalRadius = 1e-6, kMaxGoalRadius = 1e6;
 inline constexpr double kMinTimeLimitS = 1e-3, kMaxTimeLimitS = 86400.0;
+/// The longest wall clock a merged part may record (a year, s): the sum of any number of parts
+/// a merge takes stays finite.
+inline constexpr double kMaxPartSeconds = 365.0 * 86400.0;
 /// The range of --target-factor (the target cost is this times the A* reference).
 inline constexpr double kMinTargetFactor = 0.01, kMaxTargetFactor = 100.0;
 /// The largest --ompl-checks (bounded work: a check costs at least one planner iteration).

@@ -1,5 +1,6 @@
 #include "bench/heuristic_bench.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <iomanip>
 #include <limits>
@@ -99,8 +100,15 @@ HeuristicBenchResult run_heuristic_bench(const HeuristicBenchOptions& o, std::os
       throw Error(data + ": the dataset's grid differs from the weights' grid (" + sgan.path() + ")");
     total += f.split.size();
     out.families.push_back(f.preset);
-    out.data_label += (out.data_label.empty() ? "" : ", ") + data;
     families.push_back(std::move(f));
+  }
+  // The folders sorted, like the families: the output does not depend on the order --data
+  // names them in (seventeenth campaign F10).
+  {
+    std::vector<std::string> folders;
+    for (const Family& f : families) folders.push_back(f.data);
+    std::sort(folders.begin(), folders.end());
+    for (const std::string& folder : folders) out.data_label += (out.data_label.empty() ? "" : ", ") + folder;
   }
 
   ProgressBar bar(progress, "heuristic", total);

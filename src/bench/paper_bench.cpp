@@ -357,7 +357,7 @@ std::string results_markdown(const PaperBenchResult& r, const std::string& figur
      << "Columns as in the paper: initial = first solution, optimal = first time the cost is at or below the "
         "target (the A* path's length on the map's own grid, its resolution in each map's heading; the paper's "
         "\"asymptotic optimal cost\" is not given). \"Ours\" is MINER RRT* sampling the sGAN's filtered region with "
-        "the region's time (encoding, inference, filter) included. A dash: no value (fewer than half the runs got there, "
+        "the region's time (encoding, inference, filter) included. A dash: no value (no more than half the runs got there, "
         "or OMPL does not report it). OMPL's planners run under a " << f(r.options.time_limit_s, 1)
      << " s limit per run.\n\n";
   for (std::size_t i = 0; i < r.frontend.size(); ++i) {

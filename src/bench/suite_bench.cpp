@@ -131,7 +131,7 @@ std::string cell_headline(const FrontendBenchResult& fr, const std::vector<std::
     h << "Fastest to the target (median, oracle aside): `" << best << "` " << f(best_v, 1) << " ms.";
     if (const PlannerSummary* s = find_summary(fr, kMinerSgan); s && best != kMinerSgan)
       h << " `miner-sgan`: " << (std::isfinite(s->target_time_ms) ? f(s->target_time_ms / best_v, 2) + "x the fastest"
-                                                                      : std::string("fewer than half its runs reached it"))
+                                                                      : std::string("no more than half its runs reached it"))
         << ".";
   }
   for (const auto& [ours, theirs] : kCounterparts) {

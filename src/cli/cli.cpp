@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <iterator>
@@ -166,17 +167,12 @@ CLI::Validator output_folder_for(const FolderMarker& marker, const std::vector<s
         // The command's own rule (write_folder_atomic) needs the names it writes, known only
         // after the work; this is its part that can be told now, so that a user's folder is
         // refused before the work rather than after it (issue 20).
-        const std::string refused = text + " exists and holds ";
-        const std::string not_ours = "it is not an earlier output of this command, so it is not replaced (remove it "
-                                     "or choose another folder)";
-        const std::string why = ", which this command does not write: " + not_ours;
-        for (const auto& entry : fs::directory_iterator(p, ec)) {
-          const std::string name = entry.path().filename().string();
-          if (!entry.is_regular_file(ec) ||
-              std::find(extensions.begin(), extensions.end(), entry.path().extension().string()) == extensions.end())
-            return refused + "\"" + name + "\"" + why;
-        }
-        // What the folder is goes by its marker's content, not its name (seventh campaign D1).
+        // Nothing in it may be a file the command never writes (seventeenth campaign F31) ...
+        if (std::string problem =
+                foreign_entry_problem(text, marker, {}, std::set<std::string>(extensions.begin(), extensions.end()));
+            !problem.empty())
+          return problem;
+        // ... and what the folder is goes by its marker's content, not its name (seventh campaign D1).
         return folder_marker_problem(text, marker);
       },
       "OUTPUT FOLDER");
@@ -428,6 +424,11 @@ void check_outputs_against_inputs(CLI::App* app) {
       if (is_same_or_inside(out, in))
         throw CLI::ValidationError(out_name, out + " is, or holds, the input " + in + " (" + in_name +
                                                  "): the command would replace its own input");
+      // ... nor lies inside an input folder (seventeenth campaign F15: `dataset --merge p0 p1
+      // --out p0/sub` put the merged dataset inside a part folder).
+      if (fs::is_directory(fs::path(in), ec) && is_same_or_inside(in, out))
+        throw CLI::ValidationError(out_name, out + " lies inside the input folder " + in + " (" + in_name +
+                                                 "): the command would write into its own input");
     }
 }
 
@@ -479,7 +480,7 @@ void check_no_option_as_value(CLI::App* app) {
 
 /// CLI11's count messages in plain words (issue 20, third campaign: "--radius: At Most 1
 /// required but received 2", "--planners: 1 required TEXT:PLANNER missing").
-std::string plain_usage_text(const std::string& text) {
+std::string plain_usage_text(const std::string& text, bool separator) {
   static const std::regex at_most(R"(^(\S+): At Most (\d+) required but received (\d+)$)");
   static const std::regex at_least(R"(^(\S+): At least (\d+) required but received (\d+)$)");
   static const std::regex missing(R"(^(\S+): (\d+) required (\S+) missing$)");
@@ -498,9 +499,22 @@ std::string plain_usage_text(const std::string& text) {
   if (std::regex_match(text, m, extras)) {
     std::istringstream words(m[1].str());
     std::vector<std::string> list{std::istream_iterator<std::string>(words), std::istream_iterator<std::string>()};
-    std::string line;
-    for (auto it = list.rbegin(); it != list.rend(); ++it) line += (line.empty() ? "" : " ") + *it;
-    return "the command takes no argument \"" + line + "\" (after \"--\" every word is an argument, not an option)";
+    // Each word quoted alone, and "--" not blamed when the line has none (seventeenth campaign
+    // F30); a word led by a dash look-alike (an autocorrected en dash, em dash or minus sign) is
+    // shown as the option it was meant to be.
+    std::string line, hint;
+    for (auto it = list.rbegin(); it != list.rend(); ++it) {
+      line += (line.empty() ? "\"" : ", \"") + *it + "\"";
+      for (const char* dash : {"\xE2\x80\x93", "\xE2\x80\x94", "\xE2\x88\x92"})
+        if (hint.empty() && it->rfind(dash, 0) == 0) {
+          std::string meant = *it;
+          while (!meant.empty() && (meant[0] == '-' || meant.rfind(dash, 0) == 0))
+            meant.erase(0, meant[0] == '-' ? 1 : std::strlen(dash));
+          hint = "; " + *it + " starts with a dash look-alike, not \"-\": did you mean --" + meant + "?";
+        }
+    }
+    return std::string("unexpected argument") + (list.size() > 1 ? "s " : " ") + line + ": the command takes none" +
+           (separator ? " (after \"--\" every word is an argument, not an option)" : "") + hint;
   }
   return text;
 }
@@ -822,7 +836,8 @@ int parse_line(CLI::App& app, const std::vector<std::string>& args, std::ostream
     } catch (const CLI::ParseError& first) {
       text = first.what();
     }
-    err << "miner: usage error: " << plain_usage_text(text) << "\n";
+    err << "miner: usage error: "
+        << plain_usage_text(text, std::find(args.begin(), args.end(), "--") != args.end()) << "\n";
     err << "run 'miner --help' (or 'miner <command> --help') for usage\n";
     return static_cast<int>(ExitCode::kUsage);
   } catch (const Error& e) {

@@ -129,7 +129,7 @@ extern const CLI::Validator kOutputFolder;
 CLI::Validator output_folder_for(const FolderMarker& marker, const std::vector<std::string>& extensions);
 /// The format of the manifest (figures.json) a figure folder carries: its files and the command.
 inline constexpr const char* kFiguresFormat = "miner-figures-v1";
-inline const FolderMarker kFiguresMarker{"figures.json", kFiguresFormat, true};
+inline const FolderMarker kFiguresMarker{"figures.json", kFiguresFormat, true, {}, nullptr, "files"};
 /// An output that must end in `suffix`, exactly (checked when the line is parsed, exit 2): the
 /// file's content is what the suffix says (issue 20: `--map-out x.bt` was given JSON, `--out
 /// x.bt` of a region JSON, `--out s.json` of a report Markdown). `what` says why.

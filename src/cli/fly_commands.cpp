@@ -142,7 +142,7 @@ void add_fly_commands(CLI::App& app, std::ostream& out) {
   auto o = std::make_shared<FlyCliOptions>();
   CLI::App* fly = app.add_subcommand("fly", "fly a scenario in closed loop: reference -> SE(3) PID -> N3 -> CVODE -> EKF");
   add_scenario_options(fly, o->scenario);
-  fly->add_option("--out", o->out, "run folder (default runs/<scenario>-seed<seed>)")->check(output_folder_for(FolderMarker{"summary.json", flight::kSummaryFormat}, {".json", ".csv", ".html"}));
+  fly->add_option("--out", o->out, "run folder (default runs/<scenario>-seed<seed>)")->check(output_folder_for(pipeline::run_folder_marker(), {".json", ".csv", ".html"}));
   fly->add_flag("--ground-truth", o->ground_truth, "diagnostic: the controller reads the true state, not the EKF");
   fly->add_flag("--json", o->json, "print the summary as JSON");
   fly->add_flag("--timing", o->timing,

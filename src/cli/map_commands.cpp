@@ -385,8 +385,6 @@ void add_map_commands(CLI::App& app, std::ostream& out) {
     } catch (const Error& e) {
       throw CLI::ValidationError(std::string("--") + e.what());
     }
-    // A scan map's JSON carries its voxels beside it: that file is an output too, checked first.
-    if (gen->preset == "scan" && ends_with(gen->out, ".json")) Map::check_voxel_side_file(gen->out);
     run_gen(*gen, out);
   });
 

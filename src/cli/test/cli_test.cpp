@@ -140,37 +140,40 @@ TEST_CASE("map gen --preset scan writes the run's voxels beside the map, and pla
   CHECK_THAT(r.out, Contains("a mapping run over a rooms map") && Contains("unknown voxels"));
   args.back() = b;
   REQUIRE(miner_cli(args).code == 0);
-  CHECK(read(dir() + "/scan-a.bt") == read(dir() + "/scan-b.bt"));  // same seed, same bytes
-  // The .bt beside the JSON is an output: an earlier save's pair is replaced, another file never
-  // is (issue 20, sixth campaign: an unrelated c.bt was overwritten), refused before the work.
-  REQUIRE(miner_cli(args).code == 0);  // b again: its own earlier output
+  // The voxels go beside the JSON under a name of their content: same seed, same name and bytes.
+  const auto voxels = [](const std::string& json) {
+    return dir() + "/" + miner::parse_json(read(json), json)["voxels"]["file"].get<std::string>();
+  };
+  CHECK(voxels(a).substr(voxels(a).size() - 20) == voxels(b).substr(voxels(b).size() - 20));
+  CHECK(read(voxels(a)) == read(voxels(b)));
+  REQUIRE(miner_cli(args).code == 0);  // b again: the same files
+  // A user's file beside the JSON under the old naming (c.bt) is not the save's: left alone
+  // (issue 20, sixth campaign: an unrelated c.bt was overwritten).
   const std::string c = dir() + "/scan-c.json", c_bt = dir() + "/scan-c.bt";
   std::ofstream(c_bt) << "someone else's OctoMap";
   args.back() = c;
-  const Run kept = miner_cli(args);
-  CHECK(kept.code == 1);
-  CHECK_THAT(kept.err, Contains(c_bt) && Contains("is not a voxel file that a save of a map at") && !Contains("unknown voxels"));
+  REQUIRE(miner_cli(args).code == 0);
   CHECK(read(c_bt) == "someone else's OctoMap");
-  CHECK_FALSE(std::filesystem::exists(c));
-  // A map JSON that references the .bt is not enough: `map convert --in d.bt --out d.json`
-  // references the user's own OctoMap, which a later save to d.json must not replace (sixteenth
-  // campaign F14: the user's scan was lost).
+  CHECK(voxels(c) != c_bt);
+  // `map convert --in d.bt --out d.json` references the user's own OctoMap; a later save to
+  // d.json writes its own voxel file and leaves the user's as it was (sixteenth campaign F14).
   const std::string d = dir() + "/scan-d.json", d_bt = dir() + "/scan-d.bt";
-  std::filesystem::copy_file(dir() + "/scan-a.bt", d_bt, std::filesystem::copy_options::overwrite_existing);
-  {
-    // A user's OctoMap: the same voxels without the save's mark (the line after the header).
-    std::string user = read(d_bt);
-    const std::size_t first = user.find('\n') + 1;
-    user.erase(first, user.find('\n', first) + 1 - first);
-    std::ofstream(d_bt, std::ios::binary) << user;
-  }
+  std::filesystem::copy_file(voxels(a), d_bt, std::filesystem::copy_options::overwrite_existing);
   const std::string user_bytes = read(d_bt);
   REQUIRE(miner_cli({"map", "convert", "--in", d_bt, "--out", d}).code == 0);
   args.back() = d;
-  const Run kept_user = miner_cli(args);
-  CHECK(kept_user.code == 1);
-  CHECK_THAT(kept_user.err, Contains(d_bt) && Contains("is not a voxel file that a save of a map at"));
+  REQUIRE(miner_cli(args).code == 0);
   CHECK(read(d_bt) == user_bytes);
+  // Seventeenth campaign F9: a scan of another seed over a.json leaves the voxels that other
+  // map files name (keep.json, made by map convert) where they were, so those still load.
+  const std::string keep = dir() + "/scan-keep.json";
+  REQUIRE(miner_cli({"map", "convert", "--in", a, "--out", keep}).code == 0);
+  std::vector<std::string> other_seed = gen;
+  other_seed[other_seed.size() - 2] = "5";  // --seed 5
+  other_seed.push_back(a);
+  REQUIRE(miner_cli(other_seed).code == 0);
+  CHECK(miner_cli({"map", "info", "--map", keep}).code == 0);
+  CHECK(voxels(a) != voxels(b));
   const Run info = miner_cli({"map", "info", "--map", a, "--json"});
   REQUIRE(info.code == 0);
   CHECK(miner::parse_json(info.out, "stdout")["voxels"]["counts"]["unknown"]["voxels"].get<double>() > 0);
@@ -407,7 +410,11 @@ TEST_CASE("Options a run would not read, clamped values and mismatched suffixes 
       // An empty value names nothing.
       {{"astar", "--map", ""}, 2, "--map: needs a value, got an empty one"},
       {{"astar", "--map", map, "--", "--radius", "5"}, 2,
-       "the command takes no argument \"--radius 5\" (after \"--\" every word is an argument"},
+       "unexpected arguments \"--radius\", \"5\": the command takes none (after \"--\" every word is an argument"},
+      // Seventeenth campaign F30: no "--" blamed where there is none; a dash look-alike named.
+      {{"astar", "--map", map, "x"}, 2, "unexpected argument \"x\": the command takes none\nrun"},
+      {{"astar", "--map", map, "\xE2\x80\x93-radius", "5"}, 2,
+       "\xE2\x80\x93-radius starts with a dash look-alike, not \"-\": did you mean --radius?"},
       // A stored query's fault names the file and the field.
       {{"astar", "--map", write("query-in-4th.json", R"({"format": "miner-map-v1", "bounds": {"min": [0,0,0], "max": [10,10,10]},
          "resolution": 1, "obstacles": [{"type": "box", "min": [4,4,0], "max": [6,6,10]}],
@@ -886,7 +893,9 @@ TEST_CASE("No output replaces an input, and outputs are probed for writing befor
   // An output folder that holds an input (the parts of a merge, a scenario in the run folder).
   const std::string holder = dir() + "/holder";
   std::filesystem::create_directories(holder);
-  const std::string scenario = holder + "/s.json";
+  // scenario.json, a name a run folder holds (flying a run's scenario into its own folder); any
+  // other name is refused as a file the command never writes (seventeenth campaign F31).
+  const std::string scenario = holder + "/scenario.json";
   std::ofstream(scenario) << "{}\n";  // refused before it is read
   // An earlier run folder (its summary.json carries the run's format), or the folder rule answers first.
   std::ofstream(holder + "/summary.json") << R"({"format": "miner-flight-summary-v1"})" << "\n";
@@ -894,6 +903,11 @@ TEST_CASE("No output replaces an input, and outputs are probed for writing befor
   CHECK(inside.code == 2);
   CHECK_THAT(inside.err, Contains("is, or holds, the input"));
   CHECK(std::filesystem::exists(scenario));
+  // An output inside an input folder (seventeenth campaign F15: a merged dataset inside a part).
+  const Run in_part = miner_cli({"dataset", "--merge", holder, "--out", holder + "/sub"});
+  CHECK(in_part.code == 2);
+  CHECK_THAT(in_part.err, Contains("lies inside the input folder " + holder + " (--merge)"));
+  CHECK_FALSE(std::filesystem::exists(holder + "/sub"));
   // A run folder holding a file the scenario reads (its map): refused before the flight, the
   // map kept (issue 20: the run's path.json replaced it).
   const std::string data = dir() + "/fly-data";
@@ -1261,6 +1275,22 @@ TEST_CASE("plan: bad input is named, an unreachable goal exits 3", "[REQ-CLI-004
   CHECK(sgan_none.code == 3);
 }
 
+TEST_CASE("plan --region astar beside a file named astar is refused as ambiguous", "[REQ-CLI-002][REQ-PLAN-005]") {
+  // Seventeenth campaign F25: the keyword was taken and the user's region file ignored.
+  const std::string map = write("pillar-keyword.json", kPillarMap);
+  const std::filesystem::path here = std::filesystem::current_path();
+  const std::string folder = dir() + "/keyword";
+  std::filesystem::create_directories(folder);
+  std::filesystem::current_path(folder);
+  std::ofstream("astar") << "{}";
+  const Run ambiguous = miner_cli({"plan", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5", "--region", "astar"});
+  const Run elsewhere = miner_cli({"plan", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5", "--region", "sgan"});
+  std::filesystem::current_path(here);
+  CHECK(ambiguous.code == 2);
+  CHECK_THAT(ambiguous.err, Contains("astar names the astar source, and a file astar is here too: write ./astar"));
+  CHECK(elsewhere.code == 0);  // no file named sgan here: the keyword
+}
+
 TEST_CASE("miner fly with no argument flies the default scenario and writes the run folder", "[REQ-FLIGHT-009]") {
   const std::string run = dir() + "/fly-run";
   const Run r = miner_cli({"fly", "--out", run, "--json"});
@@ -1279,10 +1309,26 @@ TEST_CASE("miner fly with no argument flies the default scenario and writes the 
   const Run human = miner_cli({"fly", "--out", run});
   CHECK(human.code == 0);
   CHECK_THAT(human.out, Contains("Pos. Err. x") && Contains("wrote " + run) && Contains("report: " + run + "/report.html"));
-  // Same seed, same bytes.
-  const std::string first = read(run + "/flight_log.csv");
-  REQUIRE(miner_cli({"fly", "--out", run, "--seed", "1"}).code == 0);
-  CHECK(read(run + "/flight_log.csv") == first);
+  // Same seed, same bytes; "run/" and "run/." name the same folder, recorded alike (seventeenth
+  // campaign F7: summary.json said "run//report.html").
+  const std::string first = read(run + "/flight_log.csv"), first_summary = read(run + "/summary.json");
+  for (const std::string& spelled : {run + "/", run + "//", run + "/."}) {
+    const Run again = miner_cli({"fly", "--out", spelled, "--seed", "1"});
+    INFO(spelled << ": " << again.err);
+    REQUIRE(again.code == 0);
+    CHECK(read(run + "/flight_log.csv") == first);
+    CHECK(read(run + "/summary.json") == first_summary);
+    CHECK_THAT(again.out, Contains("wrote " + run + "/ (") && Contains("report: " + run + "/report.html\n"));
+  }
+  // Seventeenth campaign F31: a user's notes.json and measurements.csv kept in the run folder
+  // were deleted by the next run (their extensions are the outputs'). Now the run is refused
+  // before the work, naming the file, and the folder is left as it was.
+  write("fly-run/notes.json", "{\"my\": \"precious notes\"}");
+  const Run kept = miner_cli({"fly", "--out", run, "--seed", "2"});
+  CHECK(kept.code == 2);
+  CHECK_THAT(kept.err, Contains("notes.json") && Contains("never writes"));
+  CHECK(read(run + "/notes.json") == "{\"my\": \"precious notes\"}");
+  CHECK(read(run + "/summary.json") == first_summary);
 }
 
 TEST_CASE("miner fly runs sGAN region, MINER RRT*, MINCO and flight and keeps every product", "[REQ-REPORT-001]") {
@@ -1572,7 +1618,8 @@ TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[RE
       r["first"]["iteration"] = r["iterations"].get<std::uint64_t>() + 1;
     }, "comes after the run's last iteration");
     doctor([&](miner::Json& d) { solved(d)["solved"] = false; }, "an unsolved run has no cost");
-    doctor([](miner::Json& d) { d["total_s"] = -5.0; }, "total_s: a duration must be >= 0");
+    doctor([](miner::Json& d) { d["total_s"] = -5.0; }, "total_s: a part's duration must be in [0, 3.1536e+07] s");
+    doctor([](miner::Json& d) { d["total_s"] = 1e308; }, "(a year), got 1e+308");  // seventeenth campaign F27
     doctor([](miner::Json& d) { d["throughput"]["foo"] = 1; }, "throughput");
     doctor([](miner::Json& d) { d["planners"][0]["foo"] = 1; }, "planners[0]");
     doctor([](miner::Json& d) { d["foo"] = 1; }, "foo: unknown key");
@@ -2076,6 +2123,14 @@ TEST_CASE("miner bench heuristic measures raw and filtered quality and the plann
   const double sim_rate = both["families"]["sim"]["connectivity_rate_raw"].get<double>();
   const double indoor_rate = both["families"]["indoor"]["connectivity_rate_raw"].get<double>();
   CHECK(both["connectivity_rate_raw"].get<double>() == Approx(0.5 * (sim_rate + indoor_rate)));
+  // The same folders in the other order: the same record of them (seventeenth campaign F10: the
+  // "data" field echoed the order) and the same figures.
+  const Run swapped = miner_cli({"bench", "heuristic", "--data", indoor, data, "--samples", "1", "--no-planners", "--json"});
+  REQUIRE(swapped.code == 0);
+  const miner::Json other_order = miner::parse_json(swapped.out, "stdout");
+  CHECK(other_order["data"] == both["data"]);
+  CHECK(other_order["connectivity_rate_raw"] == both["connectivity_rate_raw"]);
+  CHECK(other_order["families"]["indoor"]["connectivity_rate_raw"] == both["families"]["indoor"]["connectivity_rate_raw"]);
   const Run twice = miner_cli({"bench", "heuristic", "--data", data, data + "/.", "--no-planners"});
   CHECK(twice.code == 2);  // one folder by two spellings: a usage error (REQ-CLI-002)
   CHECK_THAT(twice.err, Contains("--data: lists " + data + " and " + data + "/., one file twice"));
@@ -2321,12 +2376,23 @@ TEST_CASE("bench frontend --ompl-checks: OMPL's time-capped planners give the sa
   const std::vector<std::string> campaign{"bench", "frontend", "--map", src + "/fixtures/maps/sim-2.json", "--runs", "2",
                                           "--planners", "ompl:RRTConnect,ompl:BITstar,ompl:AITstar", "--ompl-checks", "400",
                                           "--throughput-iterations", "0", "--quiet", "--json"};
+  miner::Json part;
   const auto records = [&] {
     const Run r = miner_cli(campaign);
     INFO(r.err);
     REQUIRE(r.code == 0);
     const miner::Json doc = miner::parse_json(r.out, "stdout");
+    part = doc;
     CHECK(doc["ompl_checks"] == 400);
+    // One termination check per iteration: no run goes past the budget (a planner that reports
+    // no iteration count records null).
+    std::size_t counted = 0;
+    for (const auto& rec : doc["run_records"])
+      if (rec["iterations"].is_number()) {
+        CHECK(rec["iterations"].get<double>() <= 400.0);
+        ++counted;
+      }
+    CHECK(counted > 0);
     CHECK(doc["time_limit_s"] == 86400.0);  // the clock lifted: only the checks bind
     miner::Json kept = doc["run_records"];
     for (auto& rec : kept)
@@ -2337,6 +2403,15 @@ TEST_CASE("bench frontend --ompl-checks: OMPL's time-capped planners give the sa
   const miner::Json once = records(), again = records();
   CHECK(once == again);
   CHECK(once.size() == 6u);
+  // A merge holds a part to it (seventeenth campaign F11, F6: a record past the checks, or a part
+  // with the checks and a time limit they do not write, merged).
+  CHECK_NOTHROW(miner::bench::merge_frontend_shards({part}));
+  miner::Json over = part;
+  over["run_records"][0]["iterations"] = 1000000;
+  CHECK_THROWS_WITH(miner::bench::merge_frontend_shards({over}), Contains("more than the campaign's ompl_checks 400"));
+  miner::Json clock = part;
+  clock["time_limit_s"] = 2.0;
+  CHECK_THROWS_WITH(miner::bench::merge_frontend_shards({clock}), Contains("time_limit_s") && Contains("lifted to 86400 s"));
   // It replaces the wall clock: both together, or without an OMPL planner, are usage errors.
   std::vector<std::string> both = campaign;
   both.insert(both.end(), {"--time-limit", "1"});

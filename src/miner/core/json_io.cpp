@@ -485,6 +485,57 @@ std::string folder_marker_problem(const std::string& path, const FolderMarker& m
          (format.empty() ? std::string("no such \"format\"") : "format \"" + format + "\"") + ")" + not_ours;
 }
 
+namespace {
+/// The file names marker.listed gives in the folder's marker file (none when it is missing or
+/// not such a list: folder_marker_problem judges the marker itself).
+std::set<std::string> listed_names(const std::filesystem::path& folder, const FolderMarker& marker) {
+  namespace fs = std::filesystem;
+  std::set<std::string> listed;
+  if (marker.listed.empty() || marker.file.empty()) return listed;
+  constexpr std::uintmax_t kMaxMarkerBytes = 64u << 20;
+  const fs::path file = folder / marker.file;
+  std::error_code ec;
+  if (!fs::is_regular_file(file, ec) || fs::file_size(file, ec) > kMaxMarkerBytes) return listed;
+  try {
+    const Json doc = parse_json(read_file_bytes(file.string()), file.string());
+    if (doc.is_object() && doc.contains(marker.listed) && doc[marker.listed].is_array())
+      for (const Json& name : doc[marker.listed])
+        if (name.is_string()) listed.insert(name.get<std::string>());
+  } catch (const Error&) {
+    listed.clear();
+  }
+  return listed;
+}
+}  // namespace
+
+std::string foreign_entry_problem(const std::string& path, const FolderMarker& marker,
+                                  const std::set<std::string>& new_names, const std::set<std::string>& extensions) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path folder(path);
+  const std::set<std::string> listed = listed_names(folder, marker);
+  // The kind's names judge a folder that carries its marker; the names rule stays for one
+  // without (refused by folder_marker_problem unless by_name_fallback, which then judges by
+  // extensions: a figure folder written before its manifest listed its files).
+  const bool marked = !marker.file.empty() && fs::is_regular_file(folder / marker.file, ec);
+  const bool by_names = marked && (marker.own_name || !listed.empty());
+  const std::string not_ours =
+      "it is not an earlier output of this command, so it is not replaced (remove it or choose another folder)";
+  for (const auto& entry : fs::directory_iterator(folder, ec)) {
+    const std::string name = entry.path().filename().string();
+    const bool plain = entry.is_regular_file(ec);
+    if (plain && by_names &&
+        (new_names.count(name) || name == marker.file || listed.count(name) || (marker.own_name && marker.own_name(name))))
+      continue;
+    if (plain && !by_names && extensions.count(entry.path().extension().string())) continue;
+    if (plain && by_names)
+      return path + ": the folder exists and holds \"" + name + "\", a file this command never writes (replacing " +
+             "the folder would delete it): " + not_ours;
+    return path + ": the folder exists and holds \"" + name + "\", which this command does not write: " + not_ours;
+  }
+  return {};
+}
+
 void write_folder_atomic(const std::string& path, const std::vector<std::pair<std::string, std::string>>& files,
                          const FolderMarker& marker) {
   namespace fs = std::filesystem;
@@ -524,15 +575,11 @@ void write_folder_atomic(const std::string& path, const std::vector<std::pair<st
       names.insert(f.first);
       extensions.insert(fs::path(f.first).extension().string());
     }
+    if (const std::string problem = foreign_entry_problem(target.string(), marker, names, extensions); !problem.empty())
+      throw Error(problem);
     bool common = false;
-    for (const auto& entry : fs::directory_iterator(target, ec)) {
-      const std::string name = entry.path().filename().string();
-      if (!entry.is_regular_file(ec) || !extensions.count(entry.path().extension().string()))
-        throw Error(path + ": the folder exists and holds \"" + name +
-                    "\", which this command does not write: it is not an earlier output of this command, so "
-                    "it is not replaced (remove it or choose another folder)");
-      common = common || names.count(name) > 0;
-    }
+    for (const auto& entry : fs::directory_iterator(target, ec))
+      common = common || names.count(entry.path().filename().string()) > 0;
     if (const std::string problem = folder_marker_problem(path, marker); !problem.empty()) throw Error(problem);
     const bool marked = !marker.file.empty() && fs::exists(target / marker.file, ec);
     if (!common && !marked)

@@ -5,7 +5,9 @@
 /// REQ-CORE-004).
 
 #include <cstdint>
+#include <functional>
 #include <optional>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -143,7 +145,23 @@ struct FolderMarker {
   bool by_name_fallback = false;
   /// Earlier formats of the same output (an older miner's folder), replaced like marker.format.
   std::vector<std::string> earlier_formats = {};
+  /// The names this kind of output writes in any run (a run folder's fixed names, a dataset's
+  /// shard pattern). When set, an existing folder is replaced only if every file in it is one
+  /// of these or one of the new files, whatever its extension (seventeenth campaign F31: a
+  /// user's notes.json kept in a run folder was deleted for having the outputs' extension).
+  std::function<bool(const std::string& name)> own_name = nullptr;
+  /// A field of marker.file listing the earlier output's own file names (figure folders'
+  /// "files"): those names count as its own too, with own_name's rule.
+  std::string listed = {};
 };
+
+/// Why the existing folder `path` holds something that is not part of an earlier output of the
+/// command `marker` describes (empty when all of it is), naming the first such entry: anything
+/// but a plain file; in a folder holding marker.file, with marker.own_name or marker.listed, a
+/// file that is none of the command's names (own_name, the marker's list, `new_names`); else a
+/// file whose extension is not in `extensions` (the names rule). The marker's own content is judged by folder_marker_problem.
+std::string foreign_entry_problem(const std::string& path, const FolderMarker& marker,
+                                  const std::set<std::string>& new_names, const std::set<std::string>& extensions);
 void write_folder_atomic(const std::string& path, const std::vector<std::pair<std::string, std::string>>& files,
                          const FolderMarker& marker = {});
 /// Why the existing non-empty folder `path` is not an earlier output marked by `marker` (empty

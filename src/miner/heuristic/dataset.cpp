@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <regex>
 #include <set>
 #include <sstream>
 
@@ -354,7 +355,15 @@ void check_sample_channels(const std::uint8_t* grids, const Eigen::Vector3i& dim
 }  // namespace
 
 FolderMarker dataset_folder_marker() {
-  return FolderMarker{"dataset.json", kDatasetFormat, false, {"miner-dataset-v1", "miner-dataset-v2"}};
+  FolderMarker marker{"dataset.json", kDatasetFormat, false, {"miner-dataset-v1", "miner-dataset-v2"}};
+  // Its own names: dataset.json, each split's index and its shards (shard_name); anything else
+  // in the folder is a user's, and the folder is refused rather than deleted with it
+  // (seventeenth campaign F31).
+  marker.own_name = [](const std::string& name) {
+    static const std::regex kOwn("(train|val|test)-(index\\.json|[0-9]{5,}\\.bin)");
+    return name == "dataset.json" || std::regex_match(name, kOwn);
+  };
+  return marker;
 }
 
 void validate(const DatasetOptions& o) {
@@ -560,6 +569,9 @@ Json merge_dataset_parts(const std::vector<std::string>& parts, const std::strin
   for (const auto& p : parts) {
     if (is_same_or_inside(dir, p))
       throw Error("dataset merge: --out " + dir + " is or holds the part " + p + ", which the merged folder would replace");
+    // ... nor lies in a part (seventeenth campaign F15: the merged dataset inside a part folder).
+    if (is_same_or_inside(p, dir))
+      throw Error("dataset merge: --out " + dir + " lies inside the part " + p + ": a part folder holds only what --shard wrote");
   }
   std::vector<Json> docs;
   std::vector<DatasetLayout> layouts;
@@ -730,11 +742,14 @@ namespace {
 /// A part of a sharded dataset holds only some of each split (issue 20, fifth campaign: `bench
 /// heuristic` measured a part's 2 of 4 samples as the split); every reader of a split refuses
 /// one the same way (sixth campaign U19: `bench paper` said "split 'test' has only 0 samples").
-void require_whole_split(const std::string& dir, const std::string& split, const SplitLayout& S) {
-  if (S.samples_here != S.count)
-    throw Error(dir + ": is a part of a sharded dataset (its " + split + " split holds " +
-                std::to_string(S.samples_here) + " of " + std::to_string(S.count) +
-                " samples): join the parts with `miner dataset --merge` first");
+/// Any part is refused, whether or not the asked split happens to lie whole in it (seventeenth
+/// campaign F14: a part holding all the test samples was read as the dataset).
+void require_whole_split(const std::string& dir, const std::string& split, const DatasetLayout& L) {
+  const SplitLayout& S = L.splits[split_index(split)];
+  if (L.is_part || S.samples_here != S.count)
+    throw Error(dir + ": is a part of a sharded dataset (part " + std::to_string(L.part_index) + "/" +
+                std::to_string(L.part_count) + "; its " + split + " split holds " + std::to_string(S.samples_here) +
+                " of " + std::to_string(S.count) + " samples): join the parts with `miner dataset --merge` first");
 }
 }  // namespace
 
@@ -775,9 +790,9 @@ void verify_samples(const std::string& dir, const std::vector<Sample>& samples) 
 
 std::size_t split_samples_held(const std::string& dir, const std::string& split) {
   const int sp = split_index(split);
-  const SplitLayout S = read_layout(read_json_file(dir + "/dataset.json"), dir + "/dataset.json").splits[sp];
-  require_whole_split(dir, split, S);
-  return S.samples_here;
+  const DatasetLayout L = read_layout(read_json_file(dir + "/dataset.json"), dir + "/dataset.json");
+  require_whole_split(dir, split, L);
+  return L.splits[sp].samples_here;
 }
 
 std::vector<Sample> read_split(const std::string& dir, const std::string& split) {
@@ -809,7 +824,7 @@ std::vector<Sample> read_split(const std::string& dir, const std::string& split)
     }
   }
   // Checked after its files, so a part that contradicts itself is named for that first.
-  require_whole_split(dir, split, S);
+  require_whole_split(dir, split, L);
   return out;
 }
 

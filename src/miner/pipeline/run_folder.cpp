@@ -1,8 +1,26 @@
 #include "miner/pipeline/run_folder.hpp"
 
+#include <filesystem>
+#include <set>
+
 #include "miner/traj/problem_io.hpp"
 
 namespace miner::pipeline {
+
+FolderMarker run_folder_marker() {
+  static const std::set<std::string> kNames = {"scenario.json", "map.json",       "region.json",    "tree.json", "path.json",
+                                               "trajectory.json", "flight_log.csv", "report.html", "summary.json"};
+  FolderMarker marker{"summary.json", flight::kSummaryFormat};
+  marker.own_name = [](const std::string& name) { return kNames.count(name) > 0; };
+  return marker;
+}
+
+std::string run_folder_name(const std::string& dir) {
+  std::filesystem::path p = std::filesystem::path(dir).lexically_normal();
+  if (p.has_relative_path() && p.filename().empty()) p = p.parent_path();
+  // "." normalises to itself, "./" to "."; an empty result is not a folder name, left to the writer.
+  return p.empty() ? dir : p.string();
+}
 
 std::string default_run_folder(const Scenario& s) { return "runs/" + s.name + "-seed" + std::to_string(s.seed); }
 
@@ -23,7 +41,7 @@ Json points(const Eigen::MatrixX3d& m) {
 
 RunFolder::RunFolder(std::string dir, const Json& scenario_as_flown, const Scenario& s, const ReferencePlan& reference, const flight::FlightResult& flight,
                      std::vector<std::pair<std::string, double>> stage_ms)
-    : dir_(std::move(dir)) {
+    : dir_(run_folder_name(dir)) {
   summary_ = flight.summary;
   summary_["run_folder"] = dir_;
   // Wall-clock times only when given (`fly --timing`): without them the folder's bytes are the
@@ -64,7 +82,7 @@ std::vector<std::string> RunFolder::names() const {
 void RunFolder::write() const {
   auto files = files_;
   files.emplace_back("summary.json", dump_json(summary_));
-  write_folder_atomic(dir_, files, FolderMarker{"summary.json", flight::kSummaryFormat});
+  write_folder_atomic(dir_, files, run_folder_marker());
 }
 
 }  // namespace miner::pipeline

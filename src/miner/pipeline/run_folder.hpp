@@ -25,6 +25,16 @@
 
 namespace miner::pipeline {
 
+/// What tells an earlier run folder (REQ-CORE-004): summary.json of flight::kSummaryFormat,
+/// and nothing in it but the names above (report.html the one page added). A user's notes.json
+/// kept in it makes `fly --out` refuse the folder rather than delete the file (seventeenth
+/// campaign F31).
+FolderMarker run_folder_marker();
+
+/// The folder `dir` names, as the run folder records it: "run/", "run/." and "run//" name run
+/// (seventeenth campaign F7: summary.json said "runA//report.html" for --out runA/).
+std::string run_folder_name(const std::string& dir);
+
 /// runs/<scenario name>-seed<seed>: where a run goes unless told otherwise.
 std::string default_run_folder(const Scenario& s);
 

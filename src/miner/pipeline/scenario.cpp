@@ -638,9 +638,24 @@ void check_envelope(const Scenario& s, const traj::PolynomialTrajectory& t) {
 
 }  // namespace
 
+Json reference_fields(const Scenario& s) {
+  const Json doc = scenario_document(s);
+  char fingerprint[17];
+  std::snprintf(fingerprint, sizeof fingerprint, "%016llx", static_cast<unsigned long long>(s.map->fingerprint()));
+  Json fields{{"map", fingerprint}, {"vehicle.radius", s.vehicle.radius}};
+  for (const char* key : {"start", "goal", "planning_margin_m", "waypoints", "trajectory", "planner"})
+    if (doc.contains(key)) fields[key] = doc[key];
+  // The seed draws the planner's samples; with waypoints or a file it only draws the flight's noise.
+  if (doc.contains("planner")) fields["seed"] = doc["seed"];
+  if (s.trajectory_file)
+    fields["trajectory"]["file_sha256"] = sha256_hex(dump_json(traj::answer_to_json(*s.trajectory_file)));
+  return fields;
+}
+
 ReferencePlan build_reference(const Scenario& s) {
   check_scenario(s);
   ReferencePlan r;
+  r.built_from = reference_fields(s);
   // Plan and repair with the tracking margin added: a reference that grazes the inflated
   // map would be left by any tracking error (the flight checks the vehicle radius alone).
   const double radius = s.vehicle.radius + s.planning_margin;
@@ -827,6 +842,23 @@ void check_reference(const Scenario& s, const ReferencePlan& reference) {
     if (s.wind.gusts[i].start_s >= end)
       throw Error(s.origin + ": wind.gusts[" + std::to_string(i) + "].start_s: " + short_number(s.wind.gusts[i].start_s) +
                   " s is after the flight ends at " + short_number(end) + " s: the gust would never blow");
+  // ... and built from this scenario's fields, not only ending where it does and keeping its
+  // limits (seventeenth campaign F18: a planned reference of seed 1 flew in the scenario of seed 2).
+  if (!reference.built_from.is_null()) {
+    const Json here = reference_fields(s);
+    for (const auto& [key, value] : here.items())
+      if (!reference.built_from.contains(key) || reference.built_from[key] != value)
+        throw Error(s.origin + ": " + key + ": the reference was built from a scenario whose " + key +
+                    " differs from this one's" +
+                    (reference.built_from.contains(key) && value.is_primitive()
+                         ? " (" + reference.built_from[key].dump() + " there, " + value.dump() + " here)"
+                         : std::string()) +
+                    ": build the reference from this scenario");
+    for (const auto& [key, value] : reference.built_from.items())
+      if (!here.contains(key))
+        throw Error(s.origin + ": " + key + ": the reference was built from a scenario that sets " + key +
+                    ", which this one does not: build the reference from this scenario");
+  }
 }
 
 flight::FlightResult fly(const Scenario& scenario, const ReferencePlan& reference, const flight::FlyOptions& options) {

@@ -135,7 +135,19 @@ struct ReferencePlan : flight::ReferenceTrajectory {
   Eigen::MatrixX3d planned_path;
   /// Wall-clock time of each stage (ms, not deterministic): "region", "plan", "trajectory".
   std::vector<std::pair<std::string, double>> stage_ms;
+  /// What it was built from (reference_fields of its scenario, set by build_reference): fly()
+  /// refuses it in a scenario whose fields differ. Empty in a reference assembled by hand.
+  Json built_from;
 };
+
+/// The fields of a scenario that build_reference reads, as a document: its map's fingerprint,
+/// vehicle radius, start, goal, planning margin, waypoints, trajectory (limits, order, allocation,
+/// or the file's SHA-256), and the planner and seed when it plans (without waypoints or a file;
+/// otherwise the seed draws only the flight's noise). Two scenarios with equal fields build the
+/// same reference
+/// (seventeenth campaign F18: from Python, a reference of another seed or region flew as this
+/// scenario's).
+Json reference_fields(const Scenario& s);
 
 /// Builds the reference: the file as is, or MINCO through start-waypoints-goal (or a
 /// MINER RRT* path when there are no waypoints) with collision repair, uniformly

@@ -68,7 +68,11 @@ double PolynomialTrajectory::total_duration() const {
     if (!(durations_[j] > 0.0 && std::isfinite(durations_[j])))
       throw Error("trajectory: durations[" + std::to_string(j) + "] must be a positive finite time in s, got " +
                   short_number(durations_[j]));
-  return std::accumulate(durations_.begin(), durations_.end(), 0.0);
+  // Seventeenth campaign F16: two durations of 1e308 summed to inf.
+  const double total = std::accumulate(durations_.begin(), durations_.end(), 0.0);
+  if (!std::isfinite(total))
+    throw Error("trajectory: the durations sum to " + exact_number(total) + " s, not a finite time");
+  return total;
 }
 
 Eigen::Vector3d PolynomialTrajectory::evaluate_segment(int i, double tau, int k) const {
@@ -97,6 +101,10 @@ Eigen::Vector3d PolynomialTrajectory::evaluate_segment(int i, double tau, int k)
     y = y * tau + f * c[a + rows];
     z = z * tau + f * c[a + 2 * rows];
   }
+  // Seventeenth campaign F16: finite coefficients at a huge local time gave inf.
+  if (!(std::isfinite(x) && std::isfinite(y) && std::isfinite(z)))
+    throw Error("trajectory: derivative " + std::to_string(k) + " of segment " + std::to_string(i) + " at local time " +
+                exact_number(tau) + " s is not finite (the coefficients overflow there)");
   return {x, y, z};
 }
 
@@ -141,6 +149,10 @@ double PolynomialTrajectory::cost() const {
     const auto c = segment_coefficients(i);
     j += (c.transpose() * monomial_cost_matrix(order_, durations_[i]) * c).trace();
   }
+  // Seventeenth campaign F16: a duration of 1e100 gave a NaN cost (inf x 0 in Q(T) c).
+  if (!std::isfinite(j))
+    throw Error("trajectory cost: is " + exact_number(j) + ", not finite (durations up to " +
+                exact_number(*std::max_element(durations_.begin(), durations_.end())) + " s overflow Q(T))");
   return j;
 }
 
@@ -151,6 +163,9 @@ Eigen::MatrixX3d PolynomialTrajectory::cost_gradient_coefficients() const {
     g.middleRows(2 * order_ * i, 2 * order_) =
         2.0 * monomial_cost_matrix(order_, durations_[i]) * segment_coefficients(i);
   }
+  if (!g.allFinite())
+    throw Error("trajectory cost gradient: not finite (durations up to " +
+                exact_number(*std::max_element(durations_.begin(), durations_.end())) + " s overflow Q(T))");
   return g;
 }
 

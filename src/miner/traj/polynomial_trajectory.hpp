@@ -31,7 +31,7 @@ class PolynomialTrajectory {
   int segments() const { return static_cast<int>(durations_.size()); }
   const std::vector<double>& durations() const { return durations_; }
   /// Sum of the durations; throws miner::Error naming one that is not positive and finite
-  /// (mutable_durations() may have changed it).
+  /// (mutable_durations() may have changed it), or when the sum is not finite.
   double total_duration() const;
   const Eigen::MatrixX3d& coefficients() const { return coefficients_; }
   /// c_i, 2s x 3 (segment index i from 0).
@@ -53,15 +53,17 @@ class PolynomialTrajectory {
 
   /// The k-th derivative (k = 0 position ... 4 snap, any k >= 0) of segment i at local
   /// time tau (Horner's rule on the differentiated coefficients). Throws miner::Error for a
-  /// segment index outside [0, segments()), k < 0 or a tau that is not finite.
+  /// segment index outside [0, segments()), k < 0, a tau that is not finite, or a value that
+  /// is not (finite coefficients overflow at a huge tau).
   Eigen::Vector3d evaluate_segment(int i, double tau, int k = 0) const;
   /// The k-th derivative at global time t, clamped to [0, total_duration()]; at a
   /// junction the later segment is used. Throws miner::Error for a t that is not finite.
   Eigen::Vector3d evaluate(double t, int k = 0) const;
 
   /// J = sum_i c_i^T Q(T_i) c_i (summed over axes), Q_ab = int_0^T (d^s t^a)(d^s t^b) dt.
+  /// Throws miner::Error when J is not finite (Q(T) overflows for huge durations), never NaN.
   double cost() const;
-  /// dJ/dc_i = 2 Q(T_i) c_i, stacked like coefficients().
+  /// dJ/dc_i = 2 Q(T_i) c_i, stacked like coefficients(); throws miner::Error when not finite.
   Eigen::MatrixX3d cost_gradient_coefficients() const;
 
  private:

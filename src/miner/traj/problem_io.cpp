@@ -105,8 +105,14 @@ TrajectoryRequest request_from_json(const Json& doc, const std::string& origin, 
     }
     return r;
   }
-  if (root.has("durations"))
+  if (root.has("durations")) {
+    // The same conflict as with trapezoid, the same class: an option against the file is a usage
+    // error (seventeenth campaign F29: exit 1 here, exit 2 there).
+    if (!allocation_override.empty())
+      throw Error("--allocate: " + origin + " gives durations, so there is nothing to allocate: drop --allocate or the durations",
+                  ExitCode::kUsage);
     root.at("durations").fail("durations are given, so there is nothing to optimise: drop them (or the optimise request)");
+  }
   AllocationOptions o;
   const JsonField l = root.at("limits");
   o.limits = Limits{l.at("v_max").number_in(kMinLimitValue, kMaxLimitValue, "m/s"),

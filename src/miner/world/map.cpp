@@ -37,10 +37,11 @@ void validate_box(const Box& b, const std::string& what) {
 
 /// Below this many boxes a ray tests them all: the bucket walk costs more than it saves.
 /// The comment line Map::save writes into the .bt beside a voxel map's JSON (after OctoMap's
-/// header line, which readers require first): the file is that save's own, and a later save to
-/// the same JSON may replace it. Looked for in the file's first kSideFileHeadBytes.
+/// header line, which readers require first): which program wrote the file.
 constexpr const char* kSideFileMark = "# MINER Map::save:";
-constexpr std::size_t kSideFileHeadBytes = 4096;
+/// The voxel file's name carries this many hex digits of its SHA-256 (64 bits: two different
+/// scans saved beside one JSON do not meet by chance).
+constexpr std::size_t kSideFileHashDigits = 16;
 
 constexpr std::size_t kRayWalkMinObstacles = 64;
 /// At most this many pieces per ray (a diagonal of the 32-bucket grid is ~56 buckets long).
@@ -321,7 +322,17 @@ std::string Map::voxel_file_path(const std::string& map_path, const std::string&
   // An empty name is no file: the map's folder itself came back (tenth campaign recheck).
   if (file.empty()) throw Error(map_path + ": voxels.file: is empty: name the voxel file (.bt or .ot)");
   fs::path p = file;
-  if (p.is_relative()) p = fs::path(map_path).parent_path() / p;
+  if (p.is_relative()) {
+    // Relative to where the map file is: a map file reached through a link names its voxels
+    // beside its target, where save() put them (seventeenth campaign F32).
+    fs::path map(map_path);
+    std::error_code ec;
+    if (fs::is_symlink(fs::symlink_status(map, ec))) {
+      const fs::path real = fs::weakly_canonical(map, ec);
+      if (!ec && !real.empty()) map = real;
+    }
+    p = map.parent_path() / p;
+  }
   return fs::absolute(p).lexically_normal().string();
 }
 
@@ -515,38 +526,18 @@ void Map::save_octomap(const std::string& path) const {
   write_octree_bt(to_voxel_layer(), path);
 }
 
-void Map::check_voxel_side_file(const std::string& path) {
+std::string Map::voxel_side_file(const std::string& path, const std::string& sha256) {
   namespace fs = std::filesystem;
-  const fs::path bt = fs::path(path).replace_extension(".bt");
+  // Beside the file the JSON really is: a JSON output that is a link is written into its target
+  // (REQ-CORE-004), and its voxels go beside that target, so the map loads by either name
+  // (seventeenth campaign F32: the .bt went beside the link and the target did not load).
+  fs::path json(path);
   std::error_code ec;
-  if (!fs::exists(bt, ec)) return;
-  // An earlier save to this path: the JSON there names this file as its voxels.
-  bool earlier_output = false;
-  try {
-    const Json doc = read_json_file(path);
-    earlier_output = doc.is_object() && doc.contains("voxels") && doc["voxels"].is_object() &&
-                     doc["voxels"].contains("file") && doc["voxels"]["file"].is_string() &&
-                     voxel_file_path(path, doc["voxels"]["file"].get<std::string>()) ==
-                         fs::absolute(bt).lexically_normal().string();
-  } catch (const Error&) {
-    earlier_output = false;  // no map there (or not one): the .bt is someone else's file
+  if (fs::is_symlink(fs::symlink_status(json, ec))) {
+    const fs::path real = fs::weakly_canonical(json, ec);
+    if (!ec && !real.empty()) json = real;
   }
-  // ... and the file is one a save wrote: a .bt that `map convert --in x.bt --out x.json`
-  // referenced is the user's input, which the JSON names just the same (sixteenth campaign F14:
-  // `map gen --preset scan --out x.json` then replaced the user's scan).
-  if (earlier_output) {
-    // The mark sits in the header: its first bytes are read, not the whole (maybe large) file.
-    // A file that cannot be read gives no bytes, so no mark: it is not replaced.
-    std::ifstream in(bt, std::ios::binary);
-    std::string head(kSideFileHeadBytes, '\0');
-    in.read(head.data(), static_cast<std::streamsize>(head.size()));
-    head.resize(static_cast<std::size_t>(in.gcount()));
-    earlier_output = head.find(kSideFileMark) != std::string::npos;
-  }
-  if (!earlier_output)
-    throw Error(bt.string() + ": exists and is not a voxel file that a save of a map at " + path +
-                " wrote: a voxel map's JSON is written with its voxels beside it as " + bt.filename().string() +
-                ", which would replace that file (remove it, or choose another output name)");
+  return (json.parent_path() / (json.stem().string() + "." + sha256.substr(0, kSideFileHashDigits) + ".bt")).string();
 }
 
 void Map::save(const std::string& path) const {
@@ -557,17 +548,34 @@ void Map::save(const std::string& path) const {
     save_octomap(path);
   } else if (source_ && source_->file.empty()) {
     // The voxels first, then the document that names them: a reader never sees a reference to a
-    // file that is not there yet.
-    check_voxel_side_file(path);
-    const std::filesystem::path bt = std::filesystem::path(path).replace_extension(".bt");
-    // Marked as this save's own (a comment line after OctoMap's first line), so a later save to
-    // `path` may replace it and nothing else.
+    // file that is not there yet. The voxel file is named by its content and never replaced:
+    // other map files and run folders reference it by SHA-256, and a later save with other
+    // voxels writes another file beside it (seventeenth campaign F9: re-generating a scan
+    // replaced s.bt and every map file that named it stopped loading). The mark line (after
+    // OctoMap's first line) says which save wrote it.
     std::string bytes = octree_bt_bytes(*source_->layer);
     bytes.insert(bytes.find('\n') + 1, std::string(kSideFileMark) + " the map JSON beside it\n");
-    write_file_atomic(bt.string(), bytes);
+    const std::string sha = sha256_hex(bytes);
+    const std::filesystem::path bt = voxel_side_file(path, sha);
+    std::error_code ec;
+    if (std::filesystem::exists(bt, ec)) {
+      // The same name is the same content unless a user put a file there: that one is kept.
+      std::string existing;
+      try {
+        existing = read_file_bytes(bt.string());
+      } catch (const Error&) {
+        existing.clear();
+      }
+      if (existing != bytes)
+        throw Error(bt.string() + ": exists with other content than the voxels of the map saved to " + path +
+                    " (the name is their SHA-256's first " + std::to_string(kSideFileHashDigits) +
+                    " digits): it is not replaced (remove it, or choose another output name)");
+    } else {
+      write_file_atomic(bt.string(), bytes);
+    }
     VoxelSource saved = *source_;
     saved.file = std::filesystem::absolute(bt).lexically_normal().string();
-    saved.sha256 = sha256_hex(bytes);
+    saved.sha256 = sha;
     Json doc = Map(bounds_, resolution_, obstacles_, query_, std::move(saved)).to_json();
     doc["voxels"]["file"] = bt.filename().string();  // relative: the pair moves together
     write_file_atomic(path, dump_json(doc, path));

@@ -110,14 +110,15 @@ class Map {
   /// The document; a voxel map references its file by absolute path and SHA-256. A voxel map
   /// made in memory (a generated scan) has no file yet: throws miner::Error (save() writes one).
   Json to_json() const;
-  /// The voxel file save() writes beside a JSON `path` (the path with .bt). Throws Error naming
-  /// it when it exists and is not the voxel file of the map now at `path` (an earlier output of
-  /// the same save): another file is never replaced (issue 20, sixth campaign: `map gen --preset
-  /// scan --out x.json` overwrote an unrelated x.bt).
-  static void check_voxel_side_file(const std::string& path);
+  /// The voxel file save() writes for a JSON `path` and voxel bytes of SHA-256 `sha256`:
+  /// "<stem>.<first 16 hex digits>.bt" beside the file the JSON is written to (a link's target).
+  /// Named by content, it is never replaced: a file there with other bytes (a user's) makes the
+  /// save refuse (issue 20, sixth campaign: an unrelated x.bt was overwritten; seventeenth
+  /// campaign F9: maps and run folders naming an earlier scan's voxels stopped loading).
+  static std::string voxel_side_file(const std::string& path, const std::string& sha256);
   /// Writes the map as JSON (atomic), or as an OctoMap `.bt` if `path` ends in .bt. A voxel
-  /// map made in memory saved as JSON writes its voxels first to the `.bt` of the same stem
-  /// beside it, referenced by file name and SHA-256 (REQ-WORLD-019).
+  /// map made in memory saved as JSON writes its voxels first to voxel_side_file() beside it,
+  /// referenced by file name and SHA-256 (REQ-WORLD-019).
   void save(const std::string& path) const;
   /// The map as voxels at its resolution on the lattice of its bounds: a voxel is occupied if
   /// the grid of VoxelGrid(map, 0) holds it, unknown if the voxel layer says so, else free.

@@ -560,6 +560,8 @@ PYBIND11_MODULE(_miner, m) {
         return miner::pipeline::fly(s, reference, o);
       }, py::arg("scenario"), py::arg("reference"), py::arg("log") = true,
       "Flies the reference with the scenario's vehicle, sensors, N3, EKF and controller (same seed, same bytes); "
-      "the reference must be this scenario's (miner.build_reference(scenario)). Ctrl-C raises KeyboardInterrupt "
+      "the reference must be this scenario's (miner.build_reference(scenario)): one built from a scenario with other "
+      "route fields (map, vehicle radius, start, goal, margin, waypoints, trajectory, and planner and seed when it "
+      "plans) is refused, naming the field. Ctrl-C raises KeyboardInterrupt "
       "within 4000 N3 ticks (10 s of flight).");
 }

@@ -218,8 +218,18 @@ def test_a_reference_flies_only_in_its_own_scenario(tmp_path):
     doc = json.loads((SOURCE / "fixtures" / "scenarios" / "default.json").read_text())
     doc["trajectory"]["v_max"], doc["trajectory"]["a_max"] = 0.1, 0.05
     slow = miner.Scenario.from_json(json.dumps(doc), base_dir=str(SOURCE / "fixtures" / "scenarios"))
+    ref = miner.build_reference(s)
     with pytest.raises(miner.Error, match="exceed the scenario's trajectory.v_max"):  # P8
-        miner.fly(slow, miner.build_reference(s))
+        miner.fly(slow, ref)
+    # Seventeenth campaign F18: the same ends and limits, another seed or region: another route.
+    base = str(SOURCE / "fixtures" / "scenarios")
+    other_seed = dict(json.loads((SOURCE / "fixtures" / "scenarios" / "default.json").read_text()), seed=2)
+    with pytest.raises(miner.Error, match="seed: the reference was built from a scenario whose seed differs"):
+        miner.fly(miner.Scenario.from_json(json.dumps(other_seed), base_dir=base), ref)
+    other_region = json.loads((SOURCE / "fixtures" / "scenarios" / "default.json").read_text())
+    other_region["planner"] = dict(other_region.get("planner", {}), region="astar")
+    with pytest.raises(miner.Error, match="planner: the reference was built from a scenario whose planner differs"):
+        miner.fly(miner.Scenario.from_json(json.dumps(other_region), base_dir=base), ref)
     with pytest.raises(miner.Error, match="reference"):
         miner.fly(s, "not a reference")
     for base_dir in (str(tmp_path / "nodir"), str(SOURCE / "README.md")):  # P16

@@ -311,6 +311,42 @@ TEST_CASE("A folder write replaces only an earlier output of the same kind", "[R
   CHECK(fs::exists(other / "notes.json"));
 }
 
+TEST_CASE("A folder whose kind names its files keeps a user's file of the same extension: the write is refused",
+          "[REQ-CORE-004]") {
+  namespace fs = std::filesystem;
+  const auto dir = temp_dir("folder_own_names");
+  const std::string run = (dir / "run").string();
+  miner::FolderMarker marker{"summary.json", "fmt-v1"};
+  marker.own_name = [](const std::string& name) { return name == "summary.json" || name == "log.csv" || name == "page.html"; };
+  const std::vector<std::pair<std::string, std::string>> first{{"summary.json", "{\"format\": \"fmt-v1\"}\n"}, {"log.csv", "t\n"}};
+  miner::write_folder_atomic(run, first, marker);
+  // An own name the new output does not write (an earlier run's page) is replaced with the rest.
+  std::ofstream(dir / "run" / "page.html") << "old page";
+  miner::write_folder_atomic(run, first, marker);
+  CHECK_FALSE(fs::exists(dir / "run" / "page.html"));
+  // Seventeenth campaign F31: a user's notes.json in the folder was deleted, its extension being
+  // one the outputs use. Now the folder is refused, naming the file, and nothing changes.
+  std::ofstream(dir / "run" / "notes.json") << "precious";
+  CHECK_THROWS_WITH(miner::write_folder_atomic(run, {{"summary.json", "{\"format\": \"fmt-v1\", \"x\": 2}\n"}}, marker),
+                    Contains("holds \"notes.json\", a file this command never writes") && Contains("not replaced"));
+  CHECK(read_all(run + "/notes.json") == "precious");
+  CHECK(read_all(run + "/log.csv") == "t\n");
+  CHECK(miner::foreign_entry_problem(run, marker, {}, {".json"}) != "");
+  fs::remove(dir / "run" / "notes.json");
+  CHECK(miner::foreign_entry_problem(run, marker, {}, {".json"}) == "");
+  // A marker listing its files (figure folders' manifest "files"): those names are its own.
+  miner::FolderMarker listed{"figures.json", "fig-v1", true, {}, nullptr, "files"};
+  const std::string figs = (dir / "figs").string();
+  miner::write_folder_atomic(figs, {{"a.svg", "<svg/>"}, {"figures.json", "{\"format\": \"fig-v1\", \"files\": [\"a.svg\"]}"}}, listed);
+  std::ofstream(dir / "figs" / "mine.svg") << "user's drawing";
+  CHECK_THROWS_WITH(miner::write_folder_atomic(figs, {{"b.svg", "<svg/>"}, {"figures.json", "{\"format\": \"fig-v1\"}"}}, listed),
+                    Contains("\"mine.svg\""));
+  fs::remove(dir / "figs" / "mine.svg");
+  miner::write_folder_atomic(figs, {{"b.svg", "<svg/>"}, {"figures.json", "{\"format\": \"fig-v1\", \"files\": [\"b.svg\"]}"}}, listed);
+  CHECK_FALSE(fs::exists(dir / "figs" / "a.svg"));
+  CHECK(fs::exists(dir / "figs" / "b.svg"));
+}
+
 TEST_CASE("only_keys refuses an unknown key, naming it and the known ones", "[REQ-CORE-003]") {
   const Json doc = miner::parse_json(R"({"a": 1, "b": {"c": 2, "controler": 3}})", "k.json");
   const JsonField root(doc, "", "k.json");

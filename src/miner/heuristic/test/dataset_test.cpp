@@ -316,6 +316,19 @@ TEST_CASE("The dataset has its splits, unseen test seeds and the same bytes for 
   CHECK(val[0].target == again.target);
   CHECK(val[0].environment == again.environment);
   CHECK(val[0].start == again.start);
+  // Written again over itself it is replaced; a user's file of the dataset's extensions kept in
+  // it makes the write refuse, naming it, and stays (seventeenth campaign F31: notes.json and
+  // readme.bin were deleted with the folder).
+  heuristic::write_dataset(o, a, nullptr);
+  std::ofstream(a + "/notes.json") << "{\"x\": 1}";
+  CHECK_THROWS_WITH(heuristic::write_dataset(o, a, nullptr), Contains("\"notes.json\", a file this command never writes"));
+  CHECK(read_bytes(a + "/notes.json") == "{\"x\": 1}");
+  std::filesystem::remove(a + "/notes.json");
+  const auto own = heuristic::dataset_folder_marker().own_name;
+  for (const char* name : {"dataset.json", "train-00000.bin", "val-12345.bin", "test-index.json", "train-123456.bin"})
+    CHECK(own(name));
+  for (const char* name : {"notes.json", "readme.bin", "train-1.bin", "train-00000.bin.bak", "extra-index.json"})
+    CHECK_FALSE(own(name));
   // A truncated shard is refused naming the file and the sizes.
   std::filesystem::resize_file(a + "/test-00000.bin", 100);
   CHECK_THROWS_WITH(heuristic::read_split(a, "test"), Contains("test-00000.bin") && Contains("expected"));
@@ -365,6 +378,12 @@ TEST_CASE("A dataset folder that contradicts itself is refused naming the file a
   heuristic::write_dataset(o, p1, nullptr);  // train-00001 (1 sample)
   heuristic::merge_dataset_parts({p0, p1}, root + "/honest");
   CHECK(heuristic::read_split(root + "/honest", "train").size() == 3);
+  // A part is never read as the dataset, even where a split lies whole in it (p0 holds all of
+  // val and test: seventeenth campaign F14 read them as the dataset's).
+  for (const char* split : {"val", "test"}) {
+    CHECK_THROWS_WITH(heuristic::read_split(p0, split), Contains("is a part of a sharded dataset (part 0/2"));
+    CHECK_THROWS_WITH(heuristic::split_samples_held(p0, split), Contains("join the parts with `miner dataset --merge`"));
+  }
   // Edits a JSON file of a part; an index edited this way gets its hash in dataset.json
   // recomputed, as a deliberate editor would, so the checks behind the hash are reached.
   const auto edit_json = [](const std::string& path, const auto& change) {
@@ -517,6 +536,8 @@ TEST_CASE("A dataset folder that contradicts itself is refused naming the file a
   // An output folder that is or holds a part: refused, the parts kept.
   CHECK_THROWS_WITH(heuristic::merge_dataset_parts({p0, p1}, root), Contains("is or holds the part"));
   CHECK_THROWS_WITH(heuristic::merge_dataset_parts({p0, p1}, p0), Contains("is or holds the part"));
+  CHECK_THROWS_WITH(heuristic::merge_dataset_parts({p0, p1}, p1 + "/sub"), Contains("lies inside the part"));
+  CHECK_FALSE(std::filesystem::exists(p1 + "/sub"));
   CHECK(fs::exists(p0 + "/dataset.json"));
   CHECK(fs::exists(p1 + "/dataset.json"));
   // A negative map seed (nlohmann would wrap it on reading).

@@ -258,6 +258,18 @@ TEST_CASE("Allocation requests in problem files are checked", "[REQ-TRAJ-011]") 
     CHECK_NOTHROW(request_from_json(timed, "p.json"));
     CHECK_THROWS_WITH(request_from_json(timed, "p.json", "trapezoid", std::nullopt),
                       Contains("--allocate: p.json gives durations, so there is nothing to allocate"));
+    // Seventeenth campaign F29: --allocate optimise against the durations is the same usage
+    // error (exit 2), not the file's (exit 1).
+    for (const char* method : {"trapezoid", "optimise"}) {
+      INFO(method);
+      try {
+        request_from_json(timed, "p.json", method, std::nullopt);
+        FAIL("accepted");
+      } catch (const miner::Error& e) {
+        CHECK(e.code() == miner::ExitCode::kUsage);
+        CHECK_THAT(e.what(), Contains("--allocate: p.json gives durations, so there is nothing to allocate"));
+      }
+    }
     timed["allocation"] = "trapezoid";
     CHECK_THROWS_WITH(request_from_json(timed, "p.json"),
                       Contains("p.json: allocation: durations are given, so there is nothing to allocate"));

@@ -55,6 +55,20 @@ TEST_CASE("Tenth campaign: the trajectory API refuses what would give NaN, garba
   far(1, 0) = nan;
   CHECK_THROWS_WITH(trapezoidal_allocation(far, Limits{2, 1}), Contains("points[1]"));
 
+  // Seventeenth campaign F16: finite coefficients and durations the constructor accepts gave a
+  // NaN cost, a NaN gradient, an infinite total time and an infinite value. Each is named now.
+  {
+    Eigen::MatrixX3d c = Eigen::MatrixX3d::Zero(6, 3);
+    c(1, 0) = 1.0;
+    c(3, 0) = 1e-30;
+    CHECK(std::isfinite(PolynomialTrajectory(3, {10.0}, c).cost()));
+    CHECK_THROWS_WITH(PolynomialTrajectory(3, {1e100}, c).cost(), Contains("trajectory cost") && Contains("not finite"));
+    CHECK_THROWS_WITH(PolynomialTrajectory(3, {1e200}, c).cost_gradient_coefficients(), Contains("not finite"));
+    CHECK_THROWS_WITH(PolynomialTrajectory(3, {1e200}, c).evaluate(1e200), Contains("not finite"));
+    CHECK_THROWS_WITH(PolynomialTrajectory(3, {1e308, 1e308}, Eigen::MatrixX3d::Zero(12, 3)).total_duration(),
+                      Contains("sum to inf"));
+  }
+
   Eigen::MatrixX3d pts(3, 3);
   pts << 0, 0, 0, 2, 0, 0, 2, 2, 0;
   const PolynomialTrajectory t = solve_minco(rest_to_rest(4, pts, {2.0, 2.0}));

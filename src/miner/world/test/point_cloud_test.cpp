@@ -334,7 +334,13 @@ TEST_CASE("Malformed point clouds are refused naming the fault, never crash", "[
   one.points = {V(1, 0, 0)};
   CHECK_THROWS_WITH(integrate_clouds({{one, V(1e308, 0, 0), ""}}, 0.05, 0.0), Contains("cloud 0: the sensor origin"));
   PointCloud far;
-  far.points = {V(1e9, 0, 0)};
+  // A point past the key range is named with its file before the work is bounded (seventeenth
+  // campaign F13: "rays would walk inf voxels" for a point at 1e300).
+  far.points = {V(1, 0, 0), V(1e300, 0, 0)};
+  CHECK_THROWS_WITH(integrate_clouds({{far, V(0, 0, 0), "dbl_big.ply"}}, 0.1, 0.0),
+                    Contains("dbl_big.ply: point 1") && Contains("beyond OctoMap's key range"));
+  // Within it, too many voxels along the rays is the work bound's.
+  far.points.assign(70000, V(1500, 0, 0));
   CHECK_THROWS_WITH(integrate_clouds({{far, V(0, 0, 0), ""}}, 0.05, 0.0), Contains("would walk"));
   far.points = {V(2000, 0, 0)};
   CHECK_THROWS_WITH(integrate_clouds({{far, V(0, 0, 0), ""}}, 0.05, 0.0), Contains("beyond OctoMap's key range"));

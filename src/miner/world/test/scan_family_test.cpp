@@ -2,6 +2,7 @@
 #include <catch2/catch.hpp>
 
 #include <filesystem>
+#include <fstream>
 #include <set>
 
 #include "miner/core/error.hpp"
@@ -89,12 +90,13 @@ TEST_CASE("A scan map saved as JSON writes its voxels beside it and loads back t
   fs::create_directories(dir);
   const std::string json = (dir / "scan.json").string();
   map.save(json);
-  REQUIRE(fs::exists(dir / "scan.bt"));
   const nlohmann::json doc = miner::read_json_file(json);
-  CHECK(doc["voxels"]["file"] == "scan.bt");
-  // The file beside it: the layer's OctoMap bytes with the save's mark after the header line
-  // (sixteenth campaign F14: only a file the save itself wrote is replaced later).
-  const std::string side = miner::read_file_bytes((dir / "scan.bt").string());
+  // Named by content: scan.<first 16 hex digits of its SHA-256>.bt (seventeenth campaign F9).
+  const std::string name = doc["voxels"]["file"].get<std::string>();
+  CHECK(name == "scan." + doc["voxels"]["sha256"].get<std::string>().substr(0, 16) + ".bt");
+  REQUIRE(fs::exists(dir / name));
+  // The file beside it: the layer's OctoMap bytes with the save's mark after the header line.
+  const std::string side = miner::read_file_bytes((dir / name).string());
   CHECK(doc["voxels"]["sha256"] == miner::sha256_hex(side));
   std::string unmarked = side;
   const std::size_t mark = unmarked.find('\n') + 1;
@@ -109,6 +111,54 @@ TEST_CASE("A scan map saved as JSON writes its voxels beside it and loads back t
   CHECK(back.bounds().max == map.bounds().max);
   // An unsaved voxel map has no file to reference: to_json refuses rather than write "".
   CHECK_THROWS_WITH(map.to_json(), Catch::Contains("save"));
+  fs::remove_all(dir);
+}
+
+TEST_CASE("A scan saved again never replaces voxels that other map files name, and a linked JSON keeps its pair together",
+          "[REQ-WORLD-019][REQ-CORE-004]") {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / "miner-scan-family-resave";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "other");
+  const std::string json = (dir / "s.json").string();
+  const Map first = generate_map(generator_preset("scan"), 1, small("rooms"));
+  first.save(json);
+  // Another map file naming the first scan's voxels (as `map convert` or a run folder's map.json
+  // does): absolute path and SHA-256.
+  const std::string keep = (dir / "keep.json").string();
+  Map::load(json).save(keep);
+  const std::string first_voxels = miner::read_json_file(json)["voxels"]["file"].get<std::string>();
+  // Seventeenth campaign F9: a scan of another seed saved to the same JSON replaced s.bt, and
+  // keep.json stopped loading. Now the second scan's voxels go to their own file.
+  const Map second = generate_map(generator_preset("scan"), 3, small("rooms"));
+  REQUIRE(bt_bytes(second) != bt_bytes(first));
+  second.save(json);
+  const std::string second_voxels = miner::read_json_file(json)["voxels"]["file"].get<std::string>();
+  CHECK(second_voxels != first_voxels);
+  CHECK(fs::exists(dir / first_voxels));
+  CHECK(bt_bytes(Map::load(keep)) == bt_bytes(first));
+  CHECK(bt_bytes(Map::load(json)) == bt_bytes(second));
+  // The same save again: the same file, left as it is.
+  second.save(json);
+  CHECK(miner::read_json_file(json)["voxels"]["file"] == second_voxels);
+  // A file a user put under the name a save would take, with other bytes, is refused, not replaced.
+  const std::string third = (dir / "t.json").string();
+  const fs::path taken = dir / ("t" + second_voxels.substr(1));
+  std::ofstream(taken) << "someone else's OctoMap";
+  CHECK_THROWS_WITH(second.save(third), Catch::Contains(taken.string()) && Catch::Contains("not replaced"));
+  CHECK(miner::read_file_bytes(taken.string()) == "someone else's OctoMap");
+  CHECK_FALSE(fs::exists(third));
+  // Seventeenth campaign F32: a JSON output that is a link is written into its target, and the
+  // voxels now go beside the target, so the map loads by either name.
+  std::ofstream(dir / "other" / "Y.json") << "{}";
+  fs::create_symlink(dir / "other" / "Y.json", dir / "X.json");
+  first.save((dir / "X.json").string());
+  CHECK(fs::is_symlink(dir / "X.json"));
+  const std::string linked = miner::read_json_file((dir / "other" / "Y.json").string())["voxels"]["file"].get<std::string>();
+  CHECK(fs::exists(dir / "other" / linked));
+  CHECK(linked.rfind("Y.", 0) == 0);
+  CHECK(bt_bytes(Map::load((dir / "other" / "Y.json").string())) == bt_bytes(first));
+  CHECK(bt_bytes(Map::load((dir / "X.json").string())) == bt_bytes(first));
   fs::remove_all(dir);
 }
 

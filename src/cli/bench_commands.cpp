@@ -103,7 +103,7 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   auto o = std::make_shared<BackendOptions>();
   CLI::App* b = bench_cmd->add_subcommand("backend", "MINCO vs dense LU, closed form and KKT QP (paper Table II)");
   b->add_option("--segments", o->bench.segments, "segment counts M")->capture_default_str()->delimiter(',')
-      ->check(CLI::Range(1, 1000000));
+      ->check(integer_in(1, 1000000));
   b->add_option("--orders", o->bench.orders, "orders s (3 jerk, 4 snap)")->capture_default_str()->delimiter(',')
       ->check(integer_in(3, 4));
   b->add_option("--methods", o->bench.methods, "minco, dense-lu, closed-form, kkt-qp")->capture_default_str()->delimiter(',')
@@ -381,12 +381,12 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
   // Bounds on the work a benchmark is asked for: 10^6 queries of each kind and 100 repeats take
   // a few seconds on a small scan (issue 20, seventh campaign U2: 1000 repeats took 27 s).
   vc->add_option("--queries", vo->bench.queries, "random queries of each kind (at most 10^6)")->capture_default_str()
-      ->check(CLI::Range(1, 1000000));
+      ->check(integer_in(1, 1000000));
   vc->add_option("--segment-length", vo->bench.segment_length, "segment query length in m")->capture_default_str()
       ->check(finite_in(1e-3, 1e4));
   vc->add_option("--repeats", vo->bench.repeats, "timed loads, grid builds and encodings (median; at most 100)")
       ->capture_default_str()
-      ->check(CLI::Range(1, 100));
+      ->check(integer_in(1, 100));
   vc->add_option("--seed", vo->bench.seed, "seed of the random queries")->capture_default_str()->check(kUnsigned64);
   add_output_options(vc, vo->output);
   vc->callback([vo, &out] {

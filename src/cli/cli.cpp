@@ -52,8 +52,8 @@ const CLI::Validator kUnsigned64(
     },
     "UINT64");
 
-const CLI::Validator kIterationsRange = CLI::Range(1, kMaxIterations);
-const CLI::Validator kRunsRange = CLI::Range(1, kMaxRuns);
+const CLI::Validator kIterationsRange = integer_in(1, static_cast<long long>(kMaxIterations));
+const CLI::Validator kRunsRange = integer_in(1, static_cast<long long>(kMaxRuns));
 
 const CLI::Validator kDecimalInteger(
     [](std::string& text) -> std::string {

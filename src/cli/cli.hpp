@@ -112,7 +112,8 @@ extern const CLI::Validator kMapPreset;
 inline constexpr int kMaxIterations = static_cast<int>(plan::kMaxIterations);
 inline constexpr int kMaxRuns = 100000;
 inline constexpr int kMaxObstacles = 10000;
-/// CLI::Range(1, kMaxIterations) and CLI::Range(1, kMaxRuns).
+/// integer_in(1, kMaxIterations) and integer_in(1, kMaxRuns): "must be an integer in [1, N], got X",
+/// the wording of every integer option (seventeenth campaign F26: CLI11's "Value X not in range").
 extern const CLI::Validator kIterationsRange;
 extern const CLI::Validator kRunsRange;
 /// Output paths checked when the command line is parsed, before any work (issue 20: a bad

@@ -211,9 +211,18 @@ void run_convert(const ConvertOptions& o, std::ostream& out) {
   std::ostringstream human;
   human << "wrote " << o.out << " (" << map.obstacles().size() << " obstacles";
   if (map.voxels()) human << ", " << map.voxels()->layer().count(world::VoxelState::kOccupied) << " occupied voxels";
-  human << " from " << o.in << (dropped || (to_octomap && map.query()) ? "; its query was dropped, as asked" : "") << ")\n";
+  // A .bt keeps no unknown-space policy: its unknown voxels read as occupied. A map that read
+  // them as free changes meaning, said here (seventeenth campaign F22: dropped without a word).
+  const bool policy_dropped =
+      to_octomap && map.voxel_source() && map.voxel_source()->unknown == world::UnknownPolicy::kFree;
+  human << " from " << o.in << (dropped || (to_octomap && map.query()) ? "; its query was dropped, as asked" : "")
+        << (policy_dropped ? "; its \"unknown\": \"free\" policy is not kept: a .bt's unknown voxels read as occupied "
+                             "(load it with --unknown free, or write .json, to keep it)"
+                           : "")
+        << ")\n";
   Json doc{{"in", o.in}, {"out", o.out}, {"obstacles", map.obstacles().size()},
-           {"query_dropped", dropped || (to_octomap && map.query().has_value())}};
+           {"query_dropped", dropped || (to_octomap && map.query().has_value())},
+           {"unknown_free_dropped", policy_dropped}};
   if (map.voxels()) doc["occupied_voxels"] = map.voxels()->layer().count(world::VoxelState::kOccupied);
   report(o.json, doc, human.str(), out);
 }
@@ -370,7 +379,7 @@ void add_map_commands(CLI::App& app, std::ostream& out) {
       ->check(one_of("scan base", world::scan_base_names()));
   g->add_option("--seed", gen->seed, "random seed")->capture_default_str()->check(kUnsigned64);
   g->add_option("--obstacles", gen->obstacles, "number of the family's obstacles (pillars, trees, cuboids; each may be several boxes; default: the preset's range)")
-      ->check(CLI::Range(0, kMaxObstacles));
+      ->check(integer_in(0, static_cast<long long>(kMaxObstacles)));
   g->add_option("--size", gen->size, "families: extents X Y Z in m instead of drawn ones")->expected(3)
       ->check(finite_in(3.0, 1000.0));  // the families' sizes (REQ-WORLD-011)
   g->add_option("--resolution", gen->resolution, "families: grid resolution in m instead of the drawn one")

@@ -266,6 +266,21 @@ TEST_CASE("map convert to .bt neither loses a query silently nor blames its outp
   const miner::Json none = miner::read_json_file(dir() + "/conv-query-none.json");
   CHECK_FALSE(none.contains("query"));
   CHECK(none["obstacles"] == miner::read_json_file(with_query)["obstacles"]);
+  CHECK(miner::parse_json(dropped.out, "stdout")["unknown_free_dropped"] == false);
+  // A voxel map read with unknown space free becomes one read as occupied: said, in words and
+  // in --json (seventeenth campaign F22: dropped without a word).
+  const std::string voxel_json = dir() + "/conv-scan.json";
+  REQUIRE(miner_cli({"map", "convert", "--in", std::string(MINER_SOURCE_DIR) + "/fixtures/scans/indoor-1-lidar.bt", "--out",
+                     voxel_json}).code == 0);
+  miner::Json free_doc = miner::read_json_file(voxel_json);
+  free_doc["voxels"]["unknown"] = "free";
+  std::ofstream(voxel_json) << free_doc.dump();
+  const Run policy = miner_cli({"map", "convert", "--in", voxel_json, "--out", dir() + "/conv-scan.bt"});
+  REQUIRE(policy.code == 0);
+  CHECK_THAT(policy.out, Contains("its \"unknown\": \"free\" policy is not kept"));
+  const Run policy_json = miner_cli({"map", "convert", "--in", voxel_json, "--out", dir() + "/conv-scan.bt", "--json"});
+  REQUIRE(policy_json.code == 0);
+  CHECK(miner::parse_json(policy_json.out, "stdout")["unknown_free_dropped"] == true);
   // A generated map written as .bt says that its query is not in it.
   const Run gen = miner_cli({"map", "gen", "--preset", "indoor", "--out", dir() + "/gen-q.bt", "--quiet"});
   REQUIRE(gen.code == 0);
@@ -569,7 +584,7 @@ TEST_CASE("A failing command leaves an existing output file untouched", "[REQ-CL
 TEST_CASE("Range errors are short: no 309-digit bound", "[REQ-CLI-002]") {
   const Run r = miner_cli({"bench", "frontend", "--map", "x.json", "--runs", "-3"});
   CHECK(r.code == 2);
-  CHECK_THAT(r.err, Contains("--runs: Value -3 not in range 1 to 100000"));
+  CHECK_THAT(r.err, Contains("--runs: must be an integer in [1, 100000], got -3"));
   CHECK(r.err.size() < 200);
 }
 
@@ -747,7 +762,12 @@ TEST_CASE("Every numeric option of every command declares its range", "[REQ-CLI-
     INFO(r.err);
     CHECK(r.code == 2);
     CHECK_THAT(r.err, Contains(message));
+    // One wording for every integer range (seventeenth campaign F26: CLI11's "Value X not in range").
+    CHECK_THAT(r.err, !Contains("not in range"));
   }
+  CHECK_THAT(miner_cli({"plan", "--map", map, "--iterations", "1000001"}).err,
+             Contains("--iterations: must be an integer in [1, 1000000], got 1000001"));
+  CHECK_THAT(miner_cli({"bench", "backend", "--segments", "0"}).err, Contains("--segments: must be an integer in [1, 1000000], got 0"));
 }
 
 TEST_CASE("cli reference is current: docs/cli-reference.md is what the commands define", "[REQ-CLI-001]") {

@@ -353,6 +353,11 @@ Eigen::Vector3d HeuristicRegion::sample(Rng& rng) const {
 }
 
 void HeuristicRegion::require_matches(const world::Map& map, const std::string& what) const {
+  // A moved-from map (fingerprint 0) is no map at all, not another one (seventeenth campaign
+  // F23: "built for another map ... other obstacles").
+  if (map.fingerprint() == 0)
+    throw Error(what + ": the map was moved from (its obstacles and voxels went with the move): check the region "
+                "against the map it was moved into");
   const world::Box& mb = map.bounds();
   const double tol = kBoundsRelativeTolerance * (mb.max - mb.min).maxCoeff();
   if (((bounds_.min - mb.min).cwiseAbs().array() > tol).any() ||

@@ -239,6 +239,13 @@ TEST_CASE("A region must match the map's bounds and hold at least one cell", "[R
   const HeuristicRegion back = HeuristicRegion::from_json(own.to_json(), "r.json");
   CHECK(back.map_fingerprint() == map.fingerprint());
   CHECK_THROWS_WITH(back.require_matches(closed, "r.json"), Contains("built for another map"));
+  // A moved-from map is named as such, not as another map (seventeenth campaign F23).
+  {
+    auto source = miner::testing::wall_with_door_map();
+    const auto moved_into = std::move(source);
+    CHECK_NOTHROW(own.require_matches(moved_into, "r.json"));
+    CHECK_THROWS_WITH(own.require_matches(source, "r.json"), Contains("r.json: the map was moved from") && !Contains("another map"));
+  }
   // Without one (a region made from numbers, or an older file) the bounds are all it is checked by.
   miner::Json older = own.to_json();
   older.erase("map_fingerprint");

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "miner/core/error.hpp"
+#include "miner/core/text.hpp"
 
 namespace miner::traj {
 
@@ -160,6 +161,37 @@ Json answer_to_json(const PolynomialTrajectory& t) {
           {"coefficients", coefficients}};
 }
 
+namespace {
+/// The "allocation" record of an answer (answer_to_json's) is what `traj solve --allocate
+/// optimise` said of this curve: its method, rho and limits in their ranges, and its figures
+/// those of the coefficients (seventeenth campaign F17: "magic", rho -1 and a total time of 1 s
+/// for a 25 s curve were read without a word). `tolerance` is relative, floor 1.
+void check_allocation_record(const JsonField& a, const PolynomialTrajectory& t, double tolerance) {
+  if (a.has("method") && a.at("method").string() != "optimise")
+    a.at("method").fail("expected \"optimise\" (the only allocation that writes this record), got \"" +
+                        a.at("method").string() + "\"");
+  if (a.has("rho")) (void)a.at("rho").number_in(1e-9, 1e9);
+  if (a.has("v_max")) (void)a.at("v_max").number_in(kMinLimitValue, kMaxLimitValue, "m/s");
+  if (a.has("a_max")) (void)a.at("a_max").number_in(kMinLimitValue, kMaxLimitValue, "m/s^2");
+  const auto agrees = [&](const char* key, double actual, const std::string& what) {
+    if (!a.has(key)) return;
+    const double recorded = a.at(key).number();
+    if (!(std::fabs(recorded - actual) <= tolerance * std::max(1.0, std::fabs(actual))))
+      a.at(key).fail("is " + exact_number(recorded) + " but " + what + " is " + exact_number(actual) +
+                     ": the record was edited or is stale");
+  };
+  agrees("cost", t.cost(), "the coefficients' cost");
+  agrees("total_time", t.total_duration(), "the durations' sum");
+  if (a.has("max_speed") || a.has("max_acceleration")) {
+    const auto [v, acc] = exact_extremes(t);
+    agrees("max_speed", v, "the curve's peak speed");
+    agrees("max_acceleration", acc, "the curve's peak acceleration");
+  }
+  if (a.has("objective") && a.has("rho"))
+    agrees("objective", t.cost() + a.at("rho").number() * t.total_duration(), "J + rho T of the curve");
+}
+}  // namespace
+
 PolynomialTrajectory trajectory_from_answer_json(const Json& doc, const std::string& origin) {
   const JsonField root(doc, "", origin);
   // Strict like every file (issue 20, fifth campaign: unknown keys and a junk "allocation"
@@ -216,6 +248,7 @@ PolynomialTrajectory trajectory_from_answer_json(const Json& doc, const std::str
       root.at("cost").fail("is " + root.at("cost").value().dump() + " but the coefficients' cost is " +
                            std::to_string(actual) + ": the file was edited or is stale");
   }
+  if (root.has("allocation")) check_allocation_record(root.at("allocation"), t, kJunctionTolerance);
   return t;
 }
 

@@ -215,6 +215,29 @@ TEST_CASE("rho 1e9 with limits of 1e6 is answered at its optimal time scale, not
   CHECK(r.objective < 1e-6 * r.start_objective);
 }
 
+TEST_CASE("An answer's allocation record is read back only when it is this curve's", "[REQ-TRAJ-011][REQ-TRAJ-010]") {
+  // Seventeenth campaign F17: method "magic", rho -1, a total time of 1 s for a 25 s curve and
+  // wrong peaks were read from a trajectory file without a word.
+  AllocationOptions o;
+  o.limits = Limits{2, 1};
+  const AllocationResult r = optimise_allocation(rest_to_rest(4, zigzag(), {}), o);
+  const miner::Json good = answer_to_json(r, o);
+  CHECK_NOTHROW(trajectory_from_answer_json(good, "a.json"));
+  const auto refused = [&](const char* key, const miner::Json& value, const std::string& why) {
+    miner::Json bad = good;
+    bad["allocation"][key] = value;
+    CHECK_THROWS_WITH(trajectory_from_answer_json(bad, "a.json"), Contains(std::string("a.json: allocation.") + key) && Contains(why));
+  };
+  refused("method", "magic", "expected \"optimise\"");
+  refused("rho", -1.0, "must be in");
+  refused("v_max", 0.0, "must be in");
+  refused("total_time", 1.0, "the durations' sum");
+  refused("cost", 2.0 * r.cost, "the coefficients' cost");
+  refused("max_speed", 0.1, "the curve's peak speed");
+  refused("max_acceleration", 10.0, "the curve's peak acceleration");
+  refused("objective", -5.0, "J + rho T of the curve");
+}
+
 TEST_CASE("Optimised allocation bounds its work: more segments than it optimises are refused up front", "[REQ-TRAJ-011]") {
   // issue 20: 400 segments ran for more than 5 minutes. The refusal comes before any solve.
   Eigen::MatrixX3d points(miner::traj::kMaxOptimisedSegments + 2, 3);

@@ -113,8 +113,9 @@ PoseParams pose_params_from_json(const JsonField& f) {
     if (!(p.rate_hz > 0.0)) f.at("rate_hz").fail("must be positive");
   }
   p.delay_s = f.number_in_or("delay_s", p.delay_s, 0.0, 1.0, "s");
-  p.position_sigma = f.number_in_or("position_sigma", p.position_sigma, 0.0, 10.0, "m");
-  p.attitude_sigma = f.number_in_or("attitude_sigma", p.attitude_sigma, 0.0, 1.0, "rad");
+  // (0, hi]: the EKF divides by them, so the range itself refuses 0 (seventeenth campaign F21).
+  if (f.has("position_sigma")) p.position_sigma = f.at("position_sigma").number_above(0.0, 10.0, "m");
+  if (f.has("attitude_sigma")) p.attitude_sigma = f.at("attitude_sigma").number_above(0.0, 1.0, "rad");
   // Outliers are a minority, or no gate can tell them from the truth: at 1.0 every fix was an
   // outlier and the flight left the map, blamed on the flight (issue 20, seventh campaign C4).
   p.outlier_probability = f.number_in_or("outlier_probability", p.outlier_probability, 0.0, kMaxOutlierProbability, "");

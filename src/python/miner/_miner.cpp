@@ -121,7 +121,18 @@ long long integer_in(py::handle o, const std::string& field, long long lo, long 
 }
 
 std::uint64_t seed_of(py::handle o, const std::string& field = "seed") {
-  if (!is_integer(o)) throw miner::Error(field + ": expected an integer in [0, 2^64 - 1], got " + type_name(o));
+  // The integer rule of every argument: a whole float that holds its integer exactly (below
+  // 2^53) is that integer (seventeenth campaign F19: iterations=300.0 passed, seed=1.0 did not).
+  if (is_whole_float(o)) {
+    const double v = PyFloat_AsDouble(o.ptr());
+    if (v < 0.0) throw miner::Error(field + ": must be an integer in [0, 2^64 - 1], got " + miner::short_number(v));
+    return static_cast<std::uint64_t>(v);
+  }
+  if (!is_integer(o))
+    throw miner::Error(field + ": expected an integer in [0, 2^64 - 1], got " + type_name(o) +
+                       (PyFloat_Check(o.ptr()) ? " " + std::string(py::str(o)) +
+                                                     " (a float is taken as an integer only when whole and below 2^53)"
+                                               : std::string()));
   const py::int_ v = py::reinterpret_steal<py::int_>(PyNumber_Index(o.ptr()));
   if (v < py::int_(0) || v > py::int_(py::reinterpret_steal<py::object>(PyLong_FromUnsignedLongLong(~0ULL))))
     throw miner::Error(field + ": must be an integer in [0, 2^64 - 1], got " + std::string(py::str(py::handle(v))));

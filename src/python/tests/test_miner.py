@@ -256,6 +256,13 @@ def test_none_for_an_object_and_whole_floats_for_integers():
     for bad in (5, [8, 8], "884"):
         with pytest.raises(miner.Error, match="dims"):
             miner.astar_region(m, dims=bad)
+    # Seeds follow the same rule (seventeenth campaign F19: seed=1.0 was refused, iterations=300.0
+    # accepted): the same path for 7 and 7.0; a fraction, or a float past 2^53, is refused.
+    assert np.array_equal(miner.plan(m, planner="rrtstar", seed=7.0, iterations=300).path,
+                          miner.plan(m, planner="rrtstar", seed=7, iterations=300).path)
+    for bad in (7.5, 2.0 ** 60, -1.0):
+        with pytest.raises(miner.Error, match="seed"):
+            miner.plan(m, planner="rrtstar", seed=bad, iterations=300)
 
 
 # ---- issue 20, eleventh campaign: Python refuses what the CLI refuses; Ctrl-C stops a long plan ----

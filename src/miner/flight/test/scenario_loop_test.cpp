@@ -296,6 +296,21 @@ TEST_CASE("Bad scenarios are refused before flight with the fault named", "[REQ-
   doc.erase("planner");
   expect_scenario_error(doc, "s.json: waypoints[0]: waypoints[0] (");
   expect_scenario_error(doc, "coincides with start");
+  // A waypoint on the goal the file leaves to the map's query is the waypoint's fault, not the
+  // top level's (seventeenth campaign F21).
+  {
+    miner::Json on_goal = default_doc();
+    on_goal.erase("planner");
+    on_goal["waypoints"] = {miner::read_json_file(kScenarios + "/../maps/indoor-1.json")["query"]["goal"]};
+    expect_scenario_error(on_goal, "s.json: waypoints[0]: goal (");
+    // Ranges that refuse their lower end say so: (0, 10] s, (0, 1] rad.
+    miner::Json zero = default_doc();
+    zero["n3"]["timeout_s"] = 0.0;
+    expect_scenario_error(zero, "n3.timeout_s: must be in (0, 10] s");
+    zero = default_doc();
+    zero["pose"]["attitude_sigma"] = 0.0;
+    expect_scenario_error(zero, "pose.attitude_sigma: must be in (0, 1] rad");
+  }
   // An empty list is not "no waypoints": it flew a straight line through the map (issue 20).
   doc["waypoints"] = miner::Json::array();
   expect_scenario_error(doc, "s.json: waypoints: empty: give at least one interior point");

@@ -754,6 +754,14 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
   const auto settings = [](nlohmann::json j) {
     for (const char* k : {"planners", "run_records", "shard", "total_s"}) j.erase(k);
     j["region"].erase("build_ms");
+    // A region or weights file is known by its SHA-256: the same file spelled another way
+    // (./reg.json, an absolute path, a copy) is the same campaign (seventeenth campaign F12); the
+    // merged file records shard 0's spelling.
+    if (j["region"].is_object() && j["region"].contains("sha256") && j["region"]["sha256"].is_string())
+      j["region"].erase("source");
+    if (j.contains("weights") && j["weights"].is_object() && j["weights"].contains("sha256") &&
+        j["weights"]["sha256"].is_string() && j["weights"].contains("source") && j["weights"]["source"] != "builtin")
+      j["weights"].erase("source");
     if (j.contains("throughput") && j["throughput"].is_object()) {
       j["throughput"].erase("rrtstar_iterations_per_s");
       j["throughput"].erase("ompl_rrtstar_iterations_per_s");
@@ -793,6 +801,7 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
     if (part.at("shard").at("index").get<int>() == 0) {
       merged["throughput"] = part.at("throughput");
       merged["region"] = part.at("region");
+      if (part.contains("weights")) merged["weights"] = part.at("weights");
     }
   }
   // A record twice (the same planner and run in two parts, or twice in one) would count

@@ -1585,6 +1585,19 @@ TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[RE
       CHECK(r.code == 1);
       CHECK_THAT(r.err, Contains(why));
     };
+    // The region is known by its SHA-256: the same region under another spelling of its path is
+    // the same campaign (seventeenth campaign F12); other contents are not.
+    {
+      miner::Json d = miner::parse_json(s1.str(), parts[2]);
+      REQUIRE(d["region"]["sha256"].is_string());
+      d["region"]["source"] = "./elsewhere/" + d["region"]["source"].get<std::string>();
+      const std::string path = dir() + "/respelled.json";
+      std::ofstream(path) << d.dump();
+      const Run respelled = miner_cli({"bench", "merge", parts[0], parts[1], path, "--json"});
+      INFO(respelled.err);
+      CHECK(respelled.code == 0);
+    }
+    doctor([](miner::Json& d) { d["region"]["sha256"] = std::string(64, 'a'); }, "are different campaigns");
     doctor([](miner::Json& d) { d["run_records"].erase(0); }, "has no record in any part");
     doctor([](miner::Json& d) { d["run_records"][0]["planner"] = "bogus"; }, "\"bogus\" is not a planner of this campaign");
     doctor([](miner::Json& d) { d["run_records"][0]["run"] = 7; }, "is not a run of part 1/3");

@@ -376,8 +376,9 @@ std::string suite_markdown(const SuiteBenchResult& r, const std::string& figure_
      << " times per map and eta (n = " << o.runs << " in every row and plot), interleaved run by run; ours stop at "
      << o.max_iterations << " iterations, OMPL's RRTstar and InformedRRTstar at the same count or " << f(o.time_limit_s, 1)
      << " s, OMPL's other planners at " << f(o.time_limit_s, 1)
-     << " s. Iterations, nodes and costs are deterministic for the seed (OMPL's included, REQ-PLAN-017); times are wall "
-        "clock on this machine and vary. One goal rule for all planners (REQ-PLAN-018): a path ends exactly at x_goal "
+     << " s. Iterations, nodes and costs are deterministic for the seed for our planners and for OMPL's RRTstar and "
+        "InformedRRTstar when the count stops them (REQ-PLAN-017); OMPL's planners stopped by the clock vary from run to "
+        "run (`miner bench frontend --ompl-checks N` repeats them). Times are wall clock on this machine and vary. One goal rule for all planners (REQ-PLAN-018): a path ends exactly at x_goal "
         "and costs its whole length. Target = the A* path's length on the map's grid. `miner-sgan` includes its "
         "region query (encode, inference, filter) in every time; `miner` samples the A*-dilated region built from the "
         "path that defines the target and is an upper bound, never a result. A missed stage counts as +inf in medians "

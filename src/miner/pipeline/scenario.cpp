@@ -653,6 +653,14 @@ Json reference_fields(const Scenario& s) {
   if (doc.contains("planner")) fields["seed"] = doc["seed"];
   if (s.trajectory_file)
     fields["trajectory"]["file_sha256"] = sha256_hex(dump_json(traj::answer_to_json(*s.trajectory_file)));
+  // The network is its bytes, not its path (eighteenth campaign F18: a copy of the weights at
+  // another path was refused, weights overwritten after the build were flown): the shipped
+  // network's hash when none is named.
+  if (fields.contains("planner") && s.region == "sgan") {
+    static const std::string builtin = heuristic::Sgan::builtin().sha256();
+    fields["planner"].erase("weights");
+    fields["planner"]["weights_sha256"] = s.weights.empty() ? builtin : sha256_hex(read_file_bytes(s.weights));
+  }
   return fields;
 }
 
@@ -850,14 +858,25 @@ void check_reference(const Scenario& s, const ReferencePlan& reference) {
   // limits (seventeenth campaign F18: a planned reference of seed 1 flew in the scenario of seed 2).
   if (!reference.built_from.is_null()) {
     const Json here = reference_fields(s);
-    for (const auto& [key, value] : here.items())
-      if (!reference.built_from.contains(key) || reference.built_from[key] != value)
-        throw Error(s.origin + ": " + key + ": the reference was built from a scenario whose " + key +
-                    " differs from this one's" +
-                    (reference.built_from.contains(key) && value.is_primitive()
-                         ? " (" + reference.built_from[key].dump() + " there, " + value.dump() + " here)"
-                         : std::string()) +
-                    ": build the reference from this scenario");
+    for (const auto& [key, value] : here.items()) {
+      if (reference.built_from.contains(key) && reference.built_from[key] == value) continue;
+      // Within a block (planner, trajectory) the member that differs is named.
+      std::string field = key;
+      Json there = reference.built_from.contains(key) ? reference.built_from[key] : Json(), mine = value;
+      if (there.is_object() && mine.is_object())
+        for (const auto& [sub, v] : mine.items())
+          if (!there.contains(sub) || there[sub] != v) {
+            field = key + "." + sub;
+            there = there.contains(sub) ? there[sub] : Json();
+            mine = v;
+            break;
+          }
+      throw Error(s.origin + ": " + field + ": the reference was built from a scenario whose " + field +
+                  " differs from this one's" +
+                  (!there.is_null() && mine.is_primitive() ? " (" + there.dump() + " there, " + mine.dump() + " here)"
+                                                           : std::string()) +
+                  ": build the reference from this scenario");
+    }
     for (const auto& [key, value] : reference.built_from.items())
       if (!here.contains(key))
         throw Error(s.origin + ": " + key + ": the reference was built from a scenario that sets " + key +

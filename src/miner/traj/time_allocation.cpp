@@ -231,8 +231,23 @@ struct Evaluation {
 
 /// Solves at T, stretches until the exact peaks (exact_extremes) are within the limits, and
 /// evaluates F.
+bool evaluate_or_throw(const MincoProblem& base, const std::vector<double>& T, const AllocationOptions& o,
+                       MincoSolver& solver, Evaluation& e);
+
+/// evaluate_or_throw, false where the curve overflows: the trajectory's values and cost throw
+/// rather than return inf (seventeenth campaign F16), and no exception may cross Ceres, which
+/// calls this for every trial point.
 bool evaluate(const MincoProblem& base, const std::vector<double>& T, const AllocationOptions& o, MincoSolver& solver,
               Evaluation& e) {
+  try {
+    return evaluate_or_throw(base, T, o, solver, e);
+  } catch (const Error&) {
+    return false;
+  }
+}
+
+bool evaluate_or_throw(const MincoProblem& base, const std::vector<double>& T, const AllocationOptions& o,
+                       MincoSolver& solver, Evaluation& e) {
   e.problem = base;
   e.problem.durations = T;
   e.k = 1.0;
@@ -380,6 +395,28 @@ AllocationResult optimise_allocation(const MincoProblem& problem, const Allocati
                 short_number(o.limits.v_max) + " m/s, a_max " + short_number(o.limits.a_max) +
                 " m/s^2): the trajectory is beyond double precision at these limits");
 
+  // A second start, the trapezoid stretched in time to F's minimum along that ray: J(k T) =
+  // J(T) / k^(2s-1) for a rest-to-rest curve, so F(k) = J / k^(2s-1) + rho k sum T is least at
+  // k^(2s) = (2s-1) J / (rho sum T). Only a stretch (k > 1: peaks fall, limits hold). Where the
+  // limits are loose and the legs short the trapezoid is orders of magnitude too fast, its J
+  // beyond what Ceres can start from (seventeenth campaign F23: waypoints 1 mm apart at v_max =
+  // a_max = 1e6 returned F = 1.8e6 where uniform 0.5 s durations give 7.5). The search then
+  // runs around whichever start has the lower F.
+  Evaluation origin = start;
+  {
+    const int s = problem.order;
+    const double k = std::pow((2.0 * s - 1.0) * start.J / (o.rho * start.total), 1.0 / (2.0 * s));
+    if (std::isfinite(k) && k > 1.0) {
+      std::vector<double> stretched = start.problem.durations;
+      for (double& d : stretched) d *= k;
+      Evaluation e;
+      if (evaluate(base, stretched, o, solver, e) && e.F < start.F) {
+        origin = std::move(e);
+        base.durations = origin.problem.durations;  // the search's box is centred there
+      }
+    }
+  }
+
   const std::size_t M = base.durations.size();
   std::vector<double> tau(M);
   for (std::size_t i = 0; i < M; ++i) tau[i] = std::log(base.durations[i]);
@@ -405,10 +442,10 @@ AllocationResult optimise_allocation(const MincoProblem& problem, const Allocati
   // Two passes from the trapezoid, the better answer kept: F as it is, and F / F(start)
   // (session 32: where J is large the raw F's first L-BFGS step leapt ~1e5 in tau and the search
   // settled at 100x the optimum's F; the normalised F can stop short of a limit-active optimum).
-  Evaluation overall = start;
-  for (const double scale : {1.0, 1.0 / start.F}) {
+  Evaluation overall = origin;
+  for (const double scale : {1.0, 1.0 / origin.F}) {
   ceres::GradientProblem gp(new AllocationObjective(base, o, base.durations, scale));
-  Evaluation best = start;
+  Evaluation best = origin;
   for (int round = 0; round < kRounds; ++round) {
     const double before = best.F;
     log_of(best);

@@ -307,7 +307,9 @@ PYBIND11_MODULE(_miner, m) {
             if (drop_query && !octomap) throw miner::Error("drop_query: only for a .bt path (a .json map keeps its query)");
             map.save(path);
           }, py::arg("path"), py::arg("drop_query") = false,
-          "Writes the map as miner-map-v1 JSON (.json) or an OctoMap (.bt, which holds no query: drop_query=True).")
+          "Writes the map as miner-map-v1 JSON (.json) or an OctoMap (.bt, which holds no query: drop_query=True, and no "
+          "unknown-space policy: its unknown voxels read as occupied). A generated scan saved as .json writes its voxels "
+          "beside it as <stem>.<16 hex digits of their SHA-256>.bt, never replacing a voxel file.")
       .def("to_json", [](const Map& map) { return map.to_json().dump(2); })
       .def_property_readonly("bounds", [](const Map& map) {
             return py::make_tuple(V3(map.bounds().min), V3(map.bounds().max));

@@ -228,8 +228,19 @@ def test_a_reference_flies_only_in_its_own_scenario(tmp_path):
         miner.fly(miner.Scenario.from_json(json.dumps(other_seed), base_dir=base), ref)
     other_region = json.loads((SOURCE / "fixtures" / "scenarios" / "default.json").read_text())
     other_region["planner"] = dict(other_region.get("planner", {}), region="astar")
-    with pytest.raises(miner.Error, match="planner: the reference was built from a scenario whose planner differs"):
+    with pytest.raises(miner.Error, match=r"planner.region: the reference was built from a scenario whose planner.region "
+                                          r"differs from this one's \(\"sgan\" there, \"astar\" here\)"):
         miner.fly(miner.Scenario.from_json(json.dumps(other_region), base_dir=base), ref)
+    # The network is compared by its bytes (eighteenth campaign F18): a copy of the shipped weights
+    # at another path flies the reference; the same path holding other weights does not.
+    weights = tmp_path / "w.bin"
+    weights.write_bytes((SOURCE / "fixtures" / "sgan" / "sgan.bin").read_bytes())
+    copied = json.loads((SOURCE / "fixtures" / "scenarios" / "default.json").read_text())
+    copied["planner"] = dict(copied.get("planner", {}), weights=str(weights))
+    assert miner.fly(miner.Scenario.from_json(json.dumps(copied), base_dir=base), ref, log=False).goal_reached
+    weights.write_bytes((SOURCE / "fixtures" / "sgan" / "passability" / "lofo" / "without-forest.bin").read_bytes())
+    with pytest.raises(miner.Error, match="planner.weights_sha256: the reference was built from a scenario whose"):
+        miner.fly(miner.Scenario.from_json(json.dumps(copied), base_dir=base), ref)
     with pytest.raises(miner.Error, match="reference"):
         miner.fly(s, "not a reference")
     for base_dir in (str(tmp_path / "nodir"), str(SOURCE / "README.md")):  # P16

@@ -215,6 +215,30 @@ TEST_CASE("rho 1e9 with limits of 1e6 is answered at its optimal time scale, not
   CHECK(r.objective < 1e-6 * r.start_objective);
 }
 
+TEST_CASE("Loose limits on short legs: the optimised F is below that of plain uniform durations", "[REQ-TRAJ-011]") {
+  // Seventeenth campaign F23: waypoints ~1 mm apart at v_max = a_max = 1e6 (the top of their
+  // range) made the trapezoid ~1e4 times too fast, its J ~1e27; Ceres could not start there and
+  // the answer was F = 1.8e6 where uniform 0.5 s durations give F = 7.5. The trapezoid stretched
+  // to F's minimum along the time scale is the second start.
+  Eigen::MatrixX3d points(11, 3);
+  points << 0, 0, 0, 0.000312, -0.000794, -0.000208, 0.000552, -0.000867, -0.000197, 0.001478, 0.000601, 0.00053,
+      0.001778, 7.3e-05, -0.000447, 0.002033, -0.000788, -0.000571, 0.002968, 0.000658, 0.000613, 0.003788, -0.000613,
+      -0.00038, 0.004453, 0.000464, 0.000709, 0.005345, -0.000827, 0.000212, 0.006049, 1.2e-05, -0.000644;
+  for (const double rho : {1e-3, 1.0, 1e3}) {
+    INFO("rho " << rho);
+    AllocationOptions o;
+    o.limits = Limits{1e6, 1e6};
+    o.rho = rho;
+    const AllocationResult r = optimise_allocation(rest_to_rest(4, points, {}), o);
+    // The best uniform duration: F(T) = J(1) / T^7 + rho 10 T is least at T^8 = 7 J(1) / (10 rho).
+    const double j1 = solve_minco(rest_to_rest(4, points, std::vector<double>(10, 1.0))).cost();
+    const double t = std::pow(7.0 * j1 / (10.0 * rho), 1.0 / 8.0);
+    const double uniform = solve_minco(rest_to_rest(4, points, std::vector<double>(10, t))).cost() + rho * 10.0 * t;
+    CHECK(r.objective <= uniform * (1.0 + 1e-9));
+    CHECK(r.objective < 1e-6 * r.start_objective);
+  }
+}
+
 TEST_CASE("An answer's allocation record is read back only when it is this curve's", "[REQ-TRAJ-011][REQ-TRAJ-010]") {
   // Seventeenth campaign F17: method "magic", rho -1, a total time of 1 s for a 25 s curve and
   // wrong peaks were read from a trajectory file without a word.

@@ -522,6 +522,7 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
                     "safeguard", "region", "weights", "throughput", "total_s", "shard", "planners", "run_records"});
     for (const char* k : {"runs", "seed"}) (void)root.at(k);
     const JsonField shard = root.at("shard");
+    shard.only_keys({"index", "count"});  // eighteenth campaign F7: an unknown key in it was ignored
     (void)shard.at("index").integer();
     (void)shard.at("count").integer();
     // A part's wall clock: no campaign part runs a year (seventeenth campaign F27: two parts of
@@ -549,6 +550,13 @@ nlohmann::json merge_frontend_shards(const std::vector<nlohmann::json>& parts, c
     if (const double f = root.at("target_factor").number(); !(f >= kMinTargetFactor && f <= kMaxTargetFactor))
       root.at("target_factor").fail("must be in [0.01, 100] (as --target-factor), got " + root.at("target_factor").value().dump());
     root.at("region").only_keys({"source", "cells", "sha256", "build_ms"});
+    // The region's build time is copied into the merge from shard 0: a time like every other
+    // (eighteenth campaign F6: -5, 1e300, a string or no value merged).
+    {
+      constexpr double kMaxBuildMs = 1e9;  // as a record's stage time: 11 days
+      const JsonField build = root.at("region").at("build_ms");
+      if (!(build.number() >= 0.0 && build.number() <= kMaxBuildMs)) build.fail("a time must be in [0, 1e9] ms");
+    }
     (void)sha256_field(root.at("region").at("sha256"));
     // The weights miner-sgan ran with, by content: given exactly when miner-sgan ran, and the
     // shipped ones' own hash for "builtin" (seventeenth campaign F3, F20: null beside miner-sgan

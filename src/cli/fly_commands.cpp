@@ -57,6 +57,9 @@ pipeline::Scenario resolve_scenario(const ScenarioDocument& d) {
   return pipeline::scenario_from_json(d.doc, d.origin, d.base_dir);
 }
 
+/// The extensions of a run folder's files (the names rule's part for folders without a marker).
+const std::vector<std::string> kRunFolderExtensions = {".json", ".csv", ".html"};
+
 struct FlyCliOptions {
   ScenarioOptions scenario;
   std::string out;
@@ -72,6 +75,14 @@ void run_fly(const FlyCliOptions& o, std::ostream& out) {
   // The run folder replaces its contents whole: it must hold none of the scenario's inputs,
   // checked before any work (REQ-CLI-003).
   const std::string run_dir = o.out.empty() ? pipeline::default_run_folder(s) : o.out;
+  // The default folder gets --out's own check, before the flight (eighteenth campaign F16: it
+  // was refused only after the whole flight, exit 1).
+  if (o.out.empty()) {
+    std::string folder = run_dir;
+    if (const std::string problem = output_folder_for(pipeline::run_folder_marker(), kRunFolderExtensions)(folder);
+        !problem.empty())
+      throw CLI::ValidationError("--out", "the default run folder " + problem);
+  }
   if (!o.scenario.scenario.empty())
     if (const auto input = pipeline::run_folder_conflict(run_dir, document.doc, document.base_dir))
       throw CLI::ValidationError("--out", run_dir + " holds " + *input + ", which the scenario reads: the run folder would replace it");
@@ -142,7 +153,7 @@ void add_fly_commands(CLI::App& app, std::ostream& out) {
   auto o = std::make_shared<FlyCliOptions>();
   CLI::App* fly = app.add_subcommand("fly", "fly a scenario in closed loop: reference -> SE(3) PID -> N3 -> CVODE -> EKF");
   add_scenario_options(fly, o->scenario);
-  fly->add_option("--out", o->out, "run folder (default runs/<scenario>-seed<seed>)")->check(output_folder_for(pipeline::run_folder_marker(), {".json", ".csv", ".html"}));
+  fly->add_option("--out", o->out, "run folder (default runs/<scenario>-seed<seed>)")->check(output_folder_for(pipeline::run_folder_marker(), kRunFolderExtensions));
   fly->add_flag("--ground-truth", o->ground_truth, "diagnostic: the controller reads the true state, not the EKF");
   fly->add_flag("--json", o->json, "print the summary as JSON");
   fly->add_flag("--timing", o->timing,

@@ -73,8 +73,11 @@ void run_gen(const GenOptions& o, std::ostream& out) {
     const world::VoxelLayer& layer = scan.map.voxels()->layer();
     const Eigen::Vector3d e = scan.map.bounds().extent();
     const world::ScanOptions& s = scan.sensor;
+    // As for every preset: a .bt holds no query (eighteenth campaign F17: the scan's was dropped
+    // without a word).
+    const bool scan_query_kept = !ends_with(o.out, ".bt");
     if (o.json) {
-      out << dump_json({{"out", o.out}, {"preset", "scan"}, {"seed", o.seed}, {"base", scan.base},
+      out << dump_json({{"out", o.out}, {"preset", "scan"}, {"seed", o.seed}, {"base", scan.base}, {"query_kept", scan_query_kept},
                         {"extent_m", vec3_json(e)}, {"resolution_m", scan.map.resolution()},
                         {"sensor", {{"h_fov_deg", s.h_fov_deg}, {"v_fov_deg", s.v_fov_deg}, {"range_m", s.range},
                                     {"noise_m", s.noise}, {"dropout", s.dropout}}},
@@ -88,7 +91,8 @@ void run_gen(const GenOptions& o, std::ostream& out) {
         << " deg, range " << s.range << " m, noise " << s.noise << " m, dropout " << s.dropout << "): " << e.x()
         << " x " << e.y() << " x " << e.z() << " m at " << scan.map.resolution() << " m, "
         << layer.count(world::VoxelState::kFree) << " free, " << layer.count(world::VoxelState::kOccupied)
-        << " occupied, " << layer.count(world::VoxelState::kUnknown) << " unknown voxels\n";
+        << " occupied, " << layer.count(world::VoxelState::kUnknown) << " unknown voxels"
+        << (scan_query_kept ? "" : "; no query (an OctoMap holds voxels only: write .json to keep it)") << "\n";
     return;
   }
   const Map map = world::generate_map(preset, o.seed, overrides);

@@ -285,6 +285,11 @@ TEST_CASE("map convert to .bt neither loses a query silently nor blames its outp
   const Run gen = miner_cli({"map", "gen", "--preset", "indoor", "--out", dir() + "/gen-q.bt", "--quiet"});
   REQUIRE(gen.code == 0);
   CHECK_THAT(gen.out, Contains("no query (an OctoMap holds voxels only"));
+  // ... a scan too (eighteenth campaign F17).
+  const Run scan_bt = miner_cli({"map", "gen", "--preset", "scan", "--base", "rooms", "--size", "20", "16", "4", "--resolution",
+                                 "0.25", "--out", dir() + "/gen-scan.bt", "--quiet"});
+  REQUIRE(scan_bt.code == 0);
+  CHECK_THAT(scan_bt.out, Contains("no query (an OctoMap holds voxels only"));
   // Bounds off the resolution's lattice are the input map's fault.
   const std::string offgrid = write("conv-offgrid.json", R"({"format": "miner-map-v1",
     "bounds": {"min": [0,0,0], "max": [4,4,3]}, "resolution": 0.3, "obstacles": []})");
@@ -1311,6 +1316,21 @@ TEST_CASE("plan --region astar beside a file named astar is refused as ambiguous
   CHECK(elsewhere.code == 0);  // no file named sgan here: the keyword
 }
 
+TEST_CASE("fly without --out checks its default run folder before the flight", "[REQ-CLI-003][REQ-FLIGHT-009]") {
+  // Eighteenth campaign F16: runs/<name>-seed<seed> holding a user's file was refused only after
+  // the whole flight, exit 1.
+  const std::filesystem::path here = std::filesystem::current_path();
+  const std::string folder = dir() + "/default-out";
+  std::filesystem::create_directories(folder + "/runs/indoor-1-seed1");
+  std::filesystem::current_path(folder);
+  std::ofstream("runs/indoor-1-seed1/u.txt") << "mine";
+  const Run r = miner_cli({"fly"});
+  std::filesystem::current_path(here);
+  CHECK(r.code == 2);
+  CHECK_THAT(r.err, Contains("--out: the default run folder runs/indoor-1-seed1") && Contains("\"u.txt\""));
+  CHECK_FALSE(std::filesystem::exists(folder + "/runs/indoor-1-seed1/summary.json"));
+}
+
 TEST_CASE("miner fly with no argument flies the default scenario and writes the run folder", "[REQ-FLIGHT-009]") {
   const std::string run = dir() + "/fly-run";
   const Run r = miner_cli({"fly", "--out", run, "--json"});
@@ -1598,6 +1618,12 @@ TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[RE
       CHECK(respelled.code == 0);
     }
     doctor([](miner::Json& d) { d["region"]["sha256"] = std::string(64, 'a'); }, "are different campaigns");
+    // Eighteenth campaign F6, F7: the region's build time is checked like every time, and the
+    // shard object is strict.
+    doctor([](miner::Json& d) { d["region"]["build_ms"] = -5.0; }, "region.build_ms: a time must be in [0, 1e9] ms");
+    doctor([](miner::Json& d) { d["region"]["build_ms"] = "x"; }, "region.build_ms: expected a number");
+    doctor([](miner::Json& d) { d["region"].erase("build_ms"); }, "region.build_ms");
+    doctor([](miner::Json& d) { d["shard"]["extra"] = 1; }, "shard.extra: unknown key");
     doctor([](miner::Json& d) { d["run_records"].erase(0); }, "has no record in any part");
     doctor([](miner::Json& d) { d["run_records"][0]["planner"] = "bogus"; }, "\"bogus\" is not a planner of this campaign");
     doctor([](miner::Json& d) { d["run_records"][0]["run"] = 7; }, "is not a run of part 1/3");

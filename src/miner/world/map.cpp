@@ -580,6 +580,23 @@ void Map::save(const std::string& path) const {
     doc["voxels"]["file"] = bt.filename().string();  // relative: the pair moves together
     write_file_atomic(path, dump_json(doc, path));
   } else {
+    // A voxel map read from a file is written as a reference to it: the file must still hold the
+    // voxels, or the JSON would name what is gone (eighteenth campaign F21: the .bt was deleted
+    // after loading, and the saved JSON could not be loaded).
+    if (source_ && !source_->file.empty()) {
+      std::string bytes;
+      try {
+        bytes = read_file_bytes(source_->file);
+      } catch (const Error&) {
+        throw Error(path + ": voxels.file: " + source_->file +
+                    " cannot be read any more, and the map's JSON would reference it: save as .bt to write the "
+                    "voxels themselves");
+      }
+      if (sha256_hex(bytes) != source_->sha256)
+        throw Error(path + ": voxels.file: " + source_->file + " changed since the map was read (SHA-256 " +
+                    sha256_hex(bytes) + ", not " + source_->sha256 +
+                    "), and the map's JSON would reference it: save as .bt to write the voxels themselves");
+    }
     write_file_atomic(path, dump_json(to_json(), path));
   }
 }

@@ -159,6 +159,14 @@ TEST_CASE("A scan saved again never replaces voxels that other map files name, a
   CHECK(linked.rfind("Y.", 0) == 0);
   CHECK(bt_bytes(Map::load((dir / "other" / "Y.json").string())) == bt_bytes(first));
   CHECK(bt_bytes(Map::load((dir / "X.json").string())) == bt_bytes(first));
+  // Eighteenth campaign F21: a map read from a JSON whose voxel file was then deleted (or
+  // changed) saved a JSON naming the missing file. Refused, naming voxels.file.
+  const Map loaded = Map::load(keep);
+  const std::string named = miner::read_json_file(keep)["voxels"]["file"].get<std::string>();
+  fs::remove(named);
+  CHECK_THROWS_WITH(loaded.save((dir / "again.json").string()), Catch::Contains("voxels.file: " + named));
+  CHECK_FALSE(fs::exists(dir / "again.json"));
+  CHECK_NOTHROW(loaded.save((dir / "again.bt").string()));  // the voxels themselves: still in memory
   fs::remove_all(dir);
 }
 

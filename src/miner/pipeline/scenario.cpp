@@ -863,14 +863,20 @@ void check_reference(const Scenario& s, const ReferencePlan& reference) {
       // Within a block (planner, trajectory) the member that differs is named.
       std::string field = key;
       Json there = reference.built_from.contains(key) ? reference.built_from[key] : Json(), mine = value;
-      if (there.is_object() && mine.is_object())
-        for (const auto& [sub, v] : mine.items())
-          if (!there.contains(sub) || there[sub] != v) {
-            field = key + "." + sub;
-            there = there.contains(sub) ? there[sub] : Json();
-            mine = v;
+      if (there.is_object() && mine.is_object()) {
+        std::string differing;
+        for (const auto& [sub, member] : mine.items())
+          if (!there.contains(sub) || there[sub] != member) {
+            differing = sub;
             break;
           }
+        if (!differing.empty()) {
+          field = key + "." + differing;
+          const Json member = mine[differing];
+          there = there.contains(differing) ? Json(there[differing]) : Json();
+          mine = member;
+        }
+      }
       throw Error(s.origin + ": " + field + ": the reference was built from a scenario whose " + field +
                   " differs from this one's" +
                   (!there.is_null() && mine.is_primitive() ? " (" + there.dump() + " there, " + mine.dump() + " here)"

@@ -458,6 +458,21 @@ void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& 
 
 void write_file_atomic(const std::string& path, const std::string& content) { write_files_atomic({{path, content}}); }
 
+namespace {
+/// A folder marker's document: a small JSON file; anything large, unreadable or malformed is no
+/// marker of ours (null).
+Json marker_document(const std::filesystem::path& file) {
+  constexpr std::uintmax_t kMaxMarkerBytes = 64u << 20;
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec) || std::filesystem::file_size(file, ec) > kMaxMarkerBytes) return {};
+  try {
+    return parse_json(read_file_bytes(file.string()), file.string());
+  } catch (const Error&) {
+    return {};
+  }
+}
+}  // namespace
+
 std::string folder_marker_problem(const std::string& path, const FolderMarker& marker) {
   namespace fs = std::filesystem;
   if (marker.file.empty()) return {};
@@ -467,17 +482,9 @@ std::string folder_marker_problem(const std::string& path, const FolderMarker& m
                                "choose another folder)";
   if (!fs::exists(file, ec))
     return marker.by_name_fallback ? std::string() : path + ": the folder exists and holds no " + marker.file + not_ours;
-  // A marker is a small JSON file: anything large or unreadable is not one of ours.
-  constexpr std::uintmax_t kMaxMarkerBytes = 64u << 20;
   std::string format;
-  if (fs::is_regular_file(file, ec) && fs::file_size(file, ec) <= kMaxMarkerBytes) {
-    try {
-      const Json doc = parse_json(read_file_bytes(file.string()), file.string());
-      if (doc.is_object() && doc.contains("format") && doc["format"].is_string()) format = doc["format"].get<std::string>();
-    } catch (const Error&) {
-      format.clear();
-    }
-  }
+  const Json doc = marker_document(file);
+  if (doc.is_object() && doc.contains("format") && doc["format"].is_string()) format = doc["format"].get<std::string>();
   if (format == marker.format ||
       std::find(marker.earlier_formats.begin(), marker.earlier_formats.end(), format) != marker.earlier_formats.end())
     return {};
@@ -492,18 +499,10 @@ std::set<std::string> listed_names(const std::filesystem::path& folder, const Fo
   namespace fs = std::filesystem;
   std::set<std::string> listed;
   if (marker.listed.empty() || marker.file.empty()) return listed;
-  constexpr std::uintmax_t kMaxMarkerBytes = 64u << 20;
-  const fs::path file = folder / marker.file;
-  std::error_code ec;
-  if (!fs::is_regular_file(file, ec) || fs::file_size(file, ec) > kMaxMarkerBytes) return listed;
-  try {
-    const Json doc = parse_json(read_file_bytes(file.string()), file.string());
-    if (doc.is_object() && doc.contains(marker.listed) && doc[marker.listed].is_array())
-      for (const Json& name : doc[marker.listed])
-        if (name.is_string()) listed.insert(name.get<std::string>());
-  } catch (const Error&) {
-    listed.clear();
-  }
+  const Json doc = marker_document(folder / marker.file);
+  if (doc.is_object() && doc.contains(marker.listed) && doc[marker.listed].is_array())
+    for (const Json& name : doc[marker.listed])
+      if (name.is_string()) listed.insert(name.get<std::string>());
   return listed;
 }
 }  // namespace

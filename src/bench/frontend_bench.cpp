@@ -187,7 +187,12 @@ FrontendBenchResult run_frontend_bench(const world::Map& map, const std::string&
           : plan::HeuristicRegion::load(options.region_file);
   out.region_ms = elapsed_ms(region_start);
   region.require_matches(map, options.region_file.empty() ? std::string("bench frontend") : options.region_file);
-  out.region_source = options.region_file.empty() ? region.source() : options.region_file;
+  // A file is labelled as one, with the source it records, so a file named like a source is
+  // not read as that source (eighteenth campaign F11).
+  out.region_source = options.region_file.empty()
+                          ? region.source()
+                          : "file " + options.region_file + " (" +
+                                (region.source().empty() ? std::string("no source recorded") : region.source()) + ")";
   out.region_cells = region.cells().size();
   out.region_sha256 = sha256_hex(region.to_json().dump());
 

@@ -64,10 +64,12 @@ void run_frontend(const FrontendOptions& o, std::ostream& out) {
 /// A figure folder (bench paper, bench suite) is replaced only when it is an earlier one, told
 /// by its manifest (kFiguresMarker): the --figures option's own check, applied before the work
 /// to the folder used, the default one too.
-void require_figures_folder(const std::filesystem::path& folder) {
+/// A refusal is a usage error naming --figures, the default folder's too (eighteenth campaign
+/// F12: that one was exit 1 without naming the option).
+void require_figures_folder(const std::filesystem::path& folder, bool given) {
   std::string path = folder.string();
   if (const std::string problem = output_folder_for(kFiguresMarker, {".svg", ".json"})(path); !problem.empty())
-    throw Error(problem);
+    throw CLI::ValidationError("--figures", (given ? "" : "the default figures folder (beside the report) ") + problem);
 }
 
 /// The figures folder of a report, checked before the work (require_figures_folder): --figures
@@ -80,7 +82,7 @@ std::filesystem::path figures_folder(const std::filesystem::path& results, const
   const std::filesystem::path folder =
       !given.empty() ? std::filesystem::path(given)
                      : results.parent_path() / (stem == results.filename() ? stem.string() + "-figures" : stem.string());
-  require_figures_folder(folder);
+  require_figures_folder(folder, !given.empty());
   return folder;
 }
 
@@ -158,7 +160,21 @@ void add_bench_commands(CLI::App& app, std::ostream& out) {
       ->check(finite_in(bench::kMinGoalRadius, bench::kMaxGoalRadius));
   fc->add_flag("!--no-safeguard", f->bench.planner_options.safeguard,
                "miner, miner-sgan: the paper's fixed mu, without the safeguard (REQ-PLAN-020)");
-  fc->add_option("--region", f->bench.region_file, "miner's region file (default: the A*-dilated region)");
+  fc->add_option("--region", f->bench.region_file, "miner's region file (default: the A*-dilated region)")
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {
+            // plan's source names are no files here (eighteenth campaign F11: a file named sgan
+            // was read and the campaign labelled "sgan"): miner runs on the A*-dilated region
+            // without --region, miner-sgan on the network's.
+            std::string lower = text;
+            for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+            if (lower == "astar" || lower == "sgan")
+              return text + " names a region source of `miner plan`; bench frontend's --region takes a region file "
+                            "(without it miner runs on the A*-dilated region, and the miner-sgan planner on the "
+                            "network's): write ./" + text + " for a file of that name";
+            return "";
+          },
+          "FILE"));
   fc->add_option("--weights", f->bench.weights_file, "miner-sgan's weights (default: the shipped fixtures/sgan/sgan.bin)");
   fc->add_option("--dims,--region-dims", f->region_dims, "A*-dilated region grid nx ny nz (as plan --dims)")->expected(3)->check(integer_in(1, 4096));
   fc->add_option("--throughput-iterations", f->bench.throughput_iterations,

@@ -89,9 +89,6 @@ std::filesystem::path nearest_existing(std::filesystem::path p) {
   return p;
 }
 
-/// Links followed when an output's target is named: the kernel's own limit (MAXSYMLINKS).
-constexpr int kMaxLinkHops = 40;
-
 /// What makes an output file path unusable whatever its folder: a name over the file-system
 /// limit (checked before the work, not when the write fails after it), or an existing thing
 /// that is not a regular file (a device, FIFO or socket would be replaced by the write's
@@ -110,11 +107,11 @@ std::string output_file_problem(const std::string& text) {
   // An output is written through a symbolic link into its target (REQ-CORE-004), and the name's
   // suffix chooses what is written (.json, .bt, .md ...): a link whose target has another suffix
   // would put one kind of file under another's name (issue 20: `--out x.json` linking to y.png).
-  fs::path target = p;
-  for (int hop = 0; hop < kMaxLinkHops && fs::is_symlink(fs::symlink_status(target, ec)); ++hop) {
-    const fs::path next = fs::read_symlink(target, ec);
-    if (ec) break;
-    target = next.is_absolute() ? next : target.parent_path() / next;
+  fs::path target;
+  try {
+    target = link_target(text);
+  } catch (const Error& e) {
+    return e.what();
   }
   if (target != p && target.extension() != p.extension())
     return text + " is a symbolic link to " + target.string() + ": the file written there would hold what the name " +
@@ -135,8 +132,12 @@ const CLI::Validator kOutputFile(
       std::error_code ec;
       if (fs::is_directory(p, ec)) return text + " is a folder, not a file";
       if (std::string problem = output_file_problem(text); !problem.empty()) return problem;
-      const fs::path parent = p.parent_path().empty() ? fs::path(".") : p.parent_path();
-      if (!fs::is_directory(parent, ec)) return "the folder " + parent.string() + " does not exist";
+      // Written through a link into its target, dangling or not (REQ-CORE-004): the target's folder.
+      const fs::path real(link_target(text));
+      const fs::path parent = real.parent_path().empty() ? fs::path(".") : real.parent_path();
+      if (!fs::is_directory(parent, ec))
+        return "the folder " + parent.string() + " does not exist" +
+               (real != p ? " (" + text + " is a symbolic link to " + real.string() + ")" : std::string());
       return probe_writable(parent);
     },
     "OUTPUT FILE");
@@ -478,6 +479,22 @@ void check_no_option_as_value(CLI::App* app) {
       }
 }
 
+/// The hint for a word led by a dash look-alike (an autocorrected en dash, em dash or minus
+/// sign): "W starts with a dash look-alike, not "-": did you mean --name?" (-1 for a number);
+/// empty for any other word.
+std::string dash_lookalike_hint(const std::string& word) {
+  for (const char* dash : {"\xE2\x80\x93", "\xE2\x80\x94", "\xE2\x88\x92"}) {
+    if (word.rfind(dash, 0) != 0) continue;
+    std::string meant = word;
+    while (!meant.empty() && (meant[0] == '-' || meant.rfind(dash, 0) == 0))
+      meant.erase(0, meant[0] == '-' ? 1 : std::strlen(dash));
+    // A number's minus sign autocorrected is meant as -1, not as an option.
+    const bool number = !meant.empty() && (std::isdigit(static_cast<unsigned char>(meant[0])) || meant[0] == '.');
+    return word + " starts with a dash look-alike, not \"-\": did you mean " + (number ? "-" : "--") + meant + "?";
+  }
+  return {};
+}
+
 /// CLI11's count messages in plain words (issue 20, third campaign: "--radius: At Most 1
 /// required but received 2", "--planners: 1 required TEXT:PLANNER missing").
 std::string plain_usage_text(const std::string& text, bool separator) {
@@ -505,13 +522,7 @@ std::string plain_usage_text(const std::string& text, bool separator) {
     std::string line, hint;
     for (auto it = list.rbegin(); it != list.rend(); ++it) {
       line += (line.empty() ? "\"" : ", \"") + *it + "\"";
-      for (const char* dash : {"\xE2\x80\x93", "\xE2\x80\x94", "\xE2\x88\x92"})
-        if (hint.empty() && it->rfind(dash, 0) == 0) {
-          std::string meant = *it;
-          while (!meant.empty() && (meant[0] == '-' || meant.rfind(dash, 0) == 0))
-            meant.erase(0, meant[0] == '-' ? 1 : std::strlen(dash));
-          hint = "; " + *it + " starts with a dash look-alike, not \"-\": did you mean --" + meant + "?";
-        }
+      if (hint.empty() && !dash_lookalike_hint(*it).empty()) hint = "; " + dash_lookalike_hint(*it);
     }
     return std::string("unexpected argument") + (list.size() > 1 ? "s " : " ") + line + ": the command takes none" +
            (separator ? " (after \"--\" every word is an argument, not an option)" : "") + hint;
@@ -617,6 +628,34 @@ std::string unknown_option(CLI::App* cmd, const std::string& path, const std::ve
     return "unknown option " + name + " for `" + path + "`" +
            (nearest.empty() ? "" : ", did you mean " + nearest + "?");
   }
+  return {};
+}
+
+/// A word meant as an option but not read as one: led by a dash look-alike (an autocorrected en
+/// dash, em dash or minus sign) before "--", or any word after "--" where the command takes no
+/// arguments. Named first, before CLI11's complaint about what it then missed ("--map is
+/// required"; eighteenth campaign F9). Empty when none.
+std::string stray_option_word(CLI::App* cmd, const std::vector<std::string>& args) {
+  const bool positional = !cmd->get_options([](const CLI::Option* o) { return o->get_positional(); }).empty();
+  const auto separator = std::find(args.begin(), args.end(), "--");
+  if (separator != args.end() && separator + 1 != args.end() && !positional) {
+    std::string line;
+    for (auto it = separator + 1; it != args.end(); ++it) line += (line.empty() ? "\"" : ", \"") + *it + "\"";
+    return std::string("unexpected argument") + (args.end() - separator > 2 ? "s " : " ") + line +
+           ": the command takes none (after \"--\" every word is an argument, not an option)";
+  }
+  for (auto a = args.begin(); a != separator; ++a) {
+    // "--out=" is an option given an empty value, not one waiting for the next word (eighteenth
+    // campaign F24: "--out: needs a value, got the option --json").
+    if (a->size() > 3 && a->rfind("--", 0) == 0 && a->back() == '=' && a->find('=') == a->size() - 1)
+      return a->substr(0, a->size() - 1) + ": needs a value, got an empty one (nothing after \"=\")";
+    // --version prints the version and nothing else: a word beside it is a mistake (F24).
+    if (*a == "--version" && args.size() > 1)
+      return "--version prints the version and takes no other argument, got " +
+             std::to_string(args.size() - 1) + " more (\"" + (a == args.begin() ? args[1] : args[0]) + "\")";
+  }
+  for (auto a = args.begin(); a != separator; ++a)
+    if (const std::string hint = dash_lookalike_hint(*a); !hint.empty()) return "unexpected argument \"" + *a + "\"; " + hint;
   return {};
 }
 
@@ -801,6 +840,16 @@ int parse_line(CLI::App& app, const std::vector<std::string>& args, std::ostream
         return 0;
       }
     }
+    // A group without its command (`miner map`) is named with the commands it has (eighteenth
+    // campaign F24: CLI11's "A subcommand is required").
+    if (cmd != &app && !cmd->get_subcommands([](CLI::App*) { return true; }).empty()) {
+      std::string list;
+      for (CLI::App* sub : cmd->get_subcommands([](CLI::App*) { return true; }))
+        list += (list.empty() ? "" : ", ") + sub->get_name();
+      err << "miner: usage error: `" << path << "` needs a command (commands: " << list << ")\n"
+          << "run '" << path << " --help' for usage\n";
+      return static_cast<int>(ExitCode::kUsage);
+    }
     const std::string unknown = unknown_option(cmd, path, args);
     if (!unknown.empty()) {
       err << "miner: usage error: " << unknown << "\nrun '" << path << " --help' for usage\n";
@@ -808,6 +857,10 @@ int parse_line(CLI::App& app, const std::vector<std::string>& args, std::ostream
     }
     if (const std::string empty = empty_list_piece(cmd, args); !empty.empty()) {
       err << "miner: usage error: " << empty << "\nrun '" << path << " --help' for usage\n";
+      return static_cast<int>(ExitCode::kUsage);
+    }
+    if (const std::string stray = stray_option_word(cmd, args); !stray.empty()) {
+      err << "miner: usage error: " << stray << "\nrun '" << path << " --help' for usage\n";
       return static_cast<int>(ExitCode::kUsage);
     }
   }

@@ -287,6 +287,16 @@ void run_scan(const ScanCliOptions& o, std::ostream& out) {
   options.h_rays = o.rays[0];
   options.v_rays = o.rays[1];
   if (options.body_radius < 0.0) options.body_radius = q.radius;
+  // A voxel size too fine for the map's bounds is the option's fault, named as a usage error
+  // before the flight (eighteenth campaign F26: exit 1, "resolution: ..." without the option).
+  if (options.resolution > 0.0) {
+    try {
+      (void)world::grid_dims(q.map.bounds(), options.resolution);
+    } catch (const Error& e) {
+      const std::string why = e.what();
+      throw CLI::ValidationError("--resolution", why.rfind("resolution: ", 0) == 0 ? why.substr(12) : why);
+    }
+  }
   // The sensor flies the A* path of the query (the route a mapping flight would take).
   const world::VoxelGrid grid(q.map, q.radius);
   const world::GridPath route = world::astar(q.map, grid, q.start, q.goal, q.start_name, q.goal_name);

@@ -89,6 +89,9 @@ TEST_CASE("A suite file is read strictly", "[REQ-REPORT-008]") {
   CHECK_THROWS_WITH(load_suite(bad("preset.json", "\"cluttered\"", "\"clutered\"")),
                     Contains("maps[0].preset: unknown preset \"clutered\""));
   CHECK_THROWS_WITH(load_suite(bad("band.json", "[1, 1000000]", "[10, 1]")), Contains("band: hi is below lo"));
+  // Eighteenth campaign F27: a fractional band was rounded without a word.
+  CHECK_THROWS_WITH(load_suite(bad("band-frac.json", "[1, 1000000]", "[700.7, 2000]")), Contains("band[0]"));
+  CHECK_THROWS_WITH(load_suite(bad("band-zero.json", "[1, 1000000]", "[0, 2000]")), Contains("band[0]: iterations are at least 1"));
   CHECK_THROWS_WITH(load_suite(bad("name.json", "\"tiny\"", "\"a/b\"")), Contains("maps[0].name: a name is"));
   CHECK_THROWS_WITH(load_suite("/nonexistent/suite.json"), Contains("/nonexistent/suite.json"));
   // Bounded work: each step is a campaign per map (issue 20: 10^5 steps ran for ever), and a

@@ -435,6 +435,18 @@ TEST_CASE("Options a run would not read, clamped values and mismatched suffixes 
       {{"astar", "--map", map, "x"}, 2, "unexpected argument \"x\": the command takes none\nrun"},
       {{"astar", "--map", map, "\xE2\x80\x93-radius", "5"}, 2,
        "\xE2\x80\x93-radius starts with a dash look-alike, not \"-\": did you mean --radius?"},
+      // Eighteenth campaign F9: a required option so written, or after "--", was reported only
+      // as "--map is required"; F24: the same for `map gen \xE2\x80\x93-help`.
+      {{"astar", "\xE2\x80\x93\xE2\x80\x93map", map}, 2,
+       "unexpected argument \"\xE2\x80\x93\xE2\x80\x93map\"; \xE2\x80\x93\xE2\x80\x93map starts with a dash look-alike"},
+      {{"astar", "--", "--map", map}, 2, "unexpected arguments \"--map\", \"" + map + "\": the command takes none (after \"--\""},
+      {{"map", "gen", "\xE2\x80\x93-help"}, 2, "did you mean --help?"},
+      {{"astar", "--map", map, "--start", "\xE2\x88\x92" "1", "5", "5"}, 2, "did you mean -1?"},
+      // F24: a group without its command names its commands.
+      {{"map"}, 2, "`miner map` needs a command (commands: "},
+      {{"astar", "--map", map, "--out=", "--json"}, 2, "--out: needs a value, got an empty one (nothing after \"=\")"},
+      {{"--version", "extra"}, 2, "--version prints the version and takes no other argument, got 1 more (\"extra\")"},
+      {{"bench", "--json"}, 2, "`miner bench` needs a command (commands: "},
       // A stored query's fault names the file and the field.
       {{"astar", "--map", write("query-in-4th.json", R"({"format": "miner-map-v1", "bounds": {"min": [0,0,0], "max": [10,10,10]},
          "resolution": 1, "obstacles": [{"type": "box", "min": [4,4,0], "max": [6,6,10]}],
@@ -480,6 +492,10 @@ TEST_CASE("Fifth campaign: empty shards, coinciding ends, far clouds and shard p
       {{"map", "scan", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5", "--rays", "6000", "6000",
         "--fov", "180", "30", "--no-spin", "--out", dir() + "/s6.bt"},
        1, "a scan may cast; use fewer rays or a larger spacing"},
+      // Eighteenth campaign F26: a voxel size too fine for the map was exit 1 without the option.
+      {{"map", "scan", "--map", map, "--start", "1", "5", "5", "--goal", "9", "5", "5", "--resolution", "0.002",
+        "--out", dir() + "/s7.bt"},
+       2, "--resolution: 0.002 m gives a grid of"},
       {{"map", "gen", "--preset", "rooms", "--size", "1000", "1000", "1000", "--resolution", "0.01", "--out",
         dir() + "/g5.json"},
        2, "grid cells (at most 5e+07)"},
@@ -1052,8 +1068,18 @@ TEST_CASE("A figure folder carries a manifest and a later run with other steps r
   std::ofstream(user + "/suite/figures.json") << R"({"format": "mine"})";
   const Run refused = miner_cli({"bench", "suite", "--suite", suite_a, "--planners", "rrtstar", "--runs", "1", "--out",
                                  user + "/suite.md", "--quiet"});
-  CHECK(refused.code == 1);
-  CHECK_THAT(refused.err, Contains("holds figures.json, which is not a \"miner-figures-v1\" file"));
+  CHECK(refused.code == 2);  // a usage error naming the option (eighteenth campaign F12: exit 1, no option named)
+  CHECK_THAT(refused.err, Contains("--figures: the default figures folder") &&
+                              Contains("holds figures.json, which is not a \"miner-figures-v1\" file"));
+  // Eighteenth campaign F1 (and F11's figure part): a user's file under a figure's name was
+  // overwritten. The folder's SHA256SUMS says what the earlier run wrote; other bytes are kept.
+  CHECK(std::filesystem::exists(dir() + "/c6/suite/SHA256SUMS"));
+  std::ofstream(dir() + "/c6/suite/m-0.2-target.svg") << "mine";
+  const Run user_figure = miner_cli({"bench", "suite", "--suite", suite_a, "--planners", "rrtstar", "--runs", "1",
+                                     "--iterations", "300", "--out", out, "--quiet"});
+  CHECK(user_figure.code == 2);
+  CHECK_THAT(user_figure.err, Contains("\"m-0.2-target.svg\", which the earlier output did not write"));
+  CHECK(read(dir() + "/c6/suite/m-0.2-target.svg") == "mine");
 }
 
 TEST_CASE("A list option's value with an empty piece is refused, not shortened", "[REQ-CLI-002]") {
@@ -1366,8 +1392,22 @@ TEST_CASE("miner fly with no argument flies the default scenario and writes the 
   write("fly-run/notes.json", "{\"my\": \"precious notes\"}");
   const Run kept = miner_cli({"fly", "--out", run, "--seed", "2"});
   CHECK(kept.code == 2);
-  CHECK_THAT(kept.err, Contains("notes.json") && Contains("never writes"));
+  CHECK_THAT(kept.err, Contains("notes.json") && Contains("did not write"));
   CHECK(read(run + "/notes.json") == "{\"my\": \"precious notes\"}");
+  CHECK(read(run + "/summary.json") == first_summary);
+  std::filesystem::remove(run + "/notes.json");
+  // Eighteenth campaign F1: a file under one of a run's own names that the earlier run did not
+  // write, or wrote other bytes into (a user's region.json), was deleted. SHA256SUMS lists
+  // what the run wrote; anything else is kept and the run refused before the work.
+  CHECK_THAT(read(run + "/SHA256SUMS"), Contains("  summary.json\n") && Contains("  flight_log.csv\n"));
+  const std::string own_region = read(run + "/region.json");
+  write("fly-run/region.json", "{\"my\": \"region\"}");
+  const Run changed = miner_cli({"fly", "--out", run, "--seed", "2"});
+  CHECK(changed.code == 2);
+  CHECK_THAT(changed.err, Contains("\"region.json\" changed since the earlier output wrote it"));
+  CHECK(read(run + "/region.json") == "{\"my\": \"region\"}");
+  write("fly-run/region.json", own_region);
+  CHECK(miner_cli({"fly", "--out", run, "--seed", "1"}).code == 0);
   CHECK(read(run + "/summary.json") == first_summary);
 }
 
@@ -1845,6 +1885,16 @@ TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[RE
     use_weights("without-sim.bin");
     const std::string p0 = part("0/2"), p1 = part("1/2");
     REQUIRE(miner_cli({"bench", "merge", p0, p1}).code == 0);
+    // A file region is labelled as a file with the source it records (eighteenth campaign
+    // F11: a file named sgan labelled the campaign "sgan"), and plan's source names are refused.
+    CHECK(miner::read_json_file(p0)["region"]["source"] == "file " + region + " (astar-dilated)");
+    for (const char* name : {"sgan", "astar", "SGAN"}) {
+      const Run bare = miner_cli({"bench", "frontend", "--map", src + "/fixtures/maps/sim-2.json", "--planners", "miner",
+                                  "--region", name, "--runs", "1"});
+      CHECK(bare.code == 2);
+      CHECK_THAT(bare.err, Contains("--region: " + std::string(name) + " names a region source of `miner plan`") &&
+                               Contains("write ./" + std::string(name)));
+    }
     use_weights("without-indoor.bin");
     const std::string p1_weights = part("1/2");
     const Run w = miner_cli({"bench", "merge", p0, p1_weights});
@@ -1914,6 +1964,15 @@ TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[RE
     args.insert(args.end(), extra.begin(), extra.end());
     return miner_cli(args);
   };
+  REQUIRE(dataset({"--out", dir() + "/ds-full"}).code == 0);
+  // Eighteenth campaign F1: a file under a shard name the dataset never wrote was deleted by
+  // the next --out; its SHA256SUMS lists the shards it wrote.
+  std::ofstream(dir() + "/ds-full/train-00009.bin") << "userdata";
+  const Run user_shard = dataset({"--out", dir() + "/ds-full"});
+  CHECK(user_shard.code == 2);
+  CHECK_THAT(user_shard.err, Contains("\"train-00009.bin\", which the earlier output did not write"));
+  CHECK(read(dir() + "/ds-full/train-00009.bin") == "userdata");
+  std::filesystem::remove(dir() + "/ds-full/train-00009.bin");
   REQUIRE(dataset({"--out", dir() + "/ds-full"}).code == 0);
   REQUIRE(dataset({"--shard", "1/2", "--out", dir() + "/ds-1"}).code == 0);
   REQUIRE(dataset({"--shard", "0/2", "--out", dir() + "/ds-0"}).code == 0);

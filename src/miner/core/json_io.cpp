@@ -9,11 +9,13 @@
 #include <set>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <sstream>
 
 #include <unistd.h>
 
 #include "miner/core/error.hpp"
+#include "miner/core/sha256.hpp"
 #include "miner/core/text.hpp"
 
 namespace miner {
@@ -426,13 +428,29 @@ void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& 
     // (issue 20: `--out /dev/null` as root replaced the device with a plain file), and a
     // symbolic link is written through (its target is replaced, the link kept).
     fs::path final_target = target;
-    if (fs::is_symlink(fs::symlink_status(target, ec))) final_target = fs::weakly_canonical(target, ec);
+    if (fs::is_symlink(fs::symlink_status(target, ec))) {
+      try {
+        final_target = fs::path(link_target(path)).lexically_normal();
+      } catch (const Error&) {
+        discard();
+        throw;
+      }
+      // A dangling link is written through too, into its target (eighteenth campaign F2: it was
+      // replaced by a file), when the target's folder exists.
+      const fs::path target_dir = final_target.has_parent_path() ? final_target.parent_path() : fs::path(".");
+      if (!fs::is_directory(target_dir, ec)) {
+        discard();
+        throw Error(path + ": a symbolic link to " + final_target.string() + ", whose folder " + target_dir.string() +
+                    " does not exist (outputs are written through links into their targets)");
+      }
+    }
     if (const auto st = fs::status(final_target, ec); fs::exists(st) && !fs::is_regular_file(st)) {
       discard();
       throw Error(path + ": exists and is not a regular file (a device, FIFO or socket); outputs are written as "
                          "regular files, which would replace it");
     }
-    const fs::path tmp = final_target.parent_path() / temporary_name(final_target, "tmp");
+    const fs::path target_dir = final_target.has_parent_path() ? final_target.parent_path() : fs::path(".");
+    const fs::path tmp = target_dir / temporary_name(final_target, "tmp");
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     if (!out) {
       discard();
@@ -446,6 +464,9 @@ void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& 
       discard();
       throw Error(path + ": write failed");
     }
+    out.close();
+    // A replaced file keeps its mode (eighteenth campaign F22: a private 0600 file came back 0644).
+    if (const auto st = fs::status(final_target, ec); fs::is_regular_file(st)) fs::permissions(tmp, st.permissions(), ec);
   }
   for (const auto& [tmp, target] : moves) {
     fs::rename(tmp, target, ec);
@@ -507,19 +528,91 @@ std::set<std::string> listed_names(const std::filesystem::path& folder, const Fo
 }
 }  // namespace
 
+std::string folder_manifest(const std::vector<std::pair<std::string, std::string>>& files) {
+  std::map<std::string, std::string> sorted;
+  for (const auto& [name, content] : files) {
+    // sha256sum escapes such names; ours are plain, and one that is not is a program error.
+    if (name.find_first_of("\n\\") != std::string::npos)
+      throw Error(name + ": a file name with a newline or backslash cannot be listed in " + kFolderManifest);
+    sorted[name] = sha256_hex(content);
+  }
+  std::string text;
+  for (const auto& [name, hash] : sorted) text += hash + "  " + name + "\n";
+  return text;
+}
+
+std::string link_target(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::path target(path);
+  for (int hop = 0; fs::is_symlink(fs::symlink_status(target, ec)); ++hop) {
+    if (hop == kMaxLinkHops)
+      throw Error(path + ": a chain of more than " + std::to_string(kMaxLinkHops) + " symbolic links (a loop?)");
+    const fs::path next = fs::read_symlink(target, ec);
+    if (ec) throw Error(path + ": the symbolic link " + target.string() + " cannot be read: " + ec.message());
+    target = next.is_absolute() ? next : target.parent_path() / next;
+  }
+  return target.string();
+}
+
+namespace {
+/// The manifest rule of foreign_entry_problem for a folder carrying kFolderManifest: empty when
+/// every entry is the manifest or a plain file it lists with the same SHA-256.
+std::string manifest_problem(const std::filesystem::path& folder, const std::string& not_ours) {
+  namespace fs = std::filesystem;
+  const fs::path file = folder / kFolderManifest;
+  const std::string where = file.string();
+  constexpr std::uintmax_t kMaxManifestBytes = 64u << 20;  // ~800,000 files, far past any output
+  std::error_code ec;
+  if (!fs::is_regular_file(file, ec) || fs::file_size(file, ec) > kMaxManifestBytes)
+    return where + ": not a manifest this command wrote (not a plain file, or larger than 64 MiB): " + not_ours;
+  std::map<std::string, std::string> listed;
+  std::istringstream in(read_file_bytes(where));
+  std::string line;
+  for (std::size_t number = 1; std::getline(in, line); ++number) {
+    const bool hex = line.size() > 66 && std::all_of(line.begin(), line.begin() + 64, [](char c) {
+                       return std::isdigit(static_cast<unsigned char>(c)) || (c >= 'a' && c <= 'f');
+                     });
+    const std::string name = hex ? line.substr(66) : std::string();
+    if (!hex || line.compare(64, 2, "  ") != 0 || name.find('/') != std::string::npos || name == "." || name == ".." ||
+        !listed.emplace(name, line.substr(0, 64)).second)
+      return where + ": line " + std::to_string(number) +
+             " is not \"<64 hex digits>  <file name>\" naming a file once: not a manifest this command wrote: " +
+             not_ours;
+  }
+  for (const auto& entry : fs::directory_iterator(folder, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name == kFolderManifest) continue;
+    const auto it = listed.find(name);
+    if (!entry.is_regular_file(ec) || it == listed.end())
+      return folder.string() + ": the folder holds \"" + name + "\", which the earlier output did not write (" +
+             kFolderManifest + " does not list it; replacing the folder would delete it): " + not_ours;
+    if (sha256_hex(read_file_bytes(entry.path().string())) != it->second)
+      return folder.string() + ": \"" + name + "\" changed since the earlier output wrote it (its SHA-256 is not the one " +
+             kFolderManifest + " lists; replacing the folder would lose the change): " + not_ours;
+  }
+  return {};
+}
+}  // namespace
+
 std::string foreign_entry_problem(const std::string& path, const FolderMarker& marker,
                                   const std::set<std::string>& new_names, const std::set<std::string>& extensions) {
   namespace fs = std::filesystem;
   std::error_code ec;
   const fs::path folder(path);
+  const std::string not_ours =
+      "it is not an earlier output of this command, so it is not replaced (remove it or choose another folder)";
+  // A marked folder with a manifest lists every byte it may lose; one without is an older
+  // miner's output, judged by names below.
+  if (!marker.file.empty() && fs::is_regular_file(folder / marker.file, ec) &&
+      fs::symlink_status(folder / kFolderManifest, ec).type() != fs::file_type::not_found)
+    return manifest_problem(folder, not_ours);
   const std::set<std::string> listed = listed_names(folder, marker);
   // The kind's names judge a folder that carries its marker; the names rule stays for one
   // without (refused by folder_marker_problem unless by_name_fallback, which then judges by
   // extensions: a figure folder written before its manifest listed its files).
   const bool marked = !marker.file.empty() && fs::is_regular_file(folder / marker.file, ec);
   const bool by_names = marked && (marker.own_name || !listed.empty());
-  const std::string not_ours =
-      "it is not an earlier output of this command, so it is not replaced (remove it or choose another folder)";
   for (const auto& entry : fs::directory_iterator(folder, ec)) {
     const std::string name = entry.path().filename().string();
     const bool plain = entry.is_regular_file(ec);
@@ -535,9 +628,15 @@ std::string foreign_entry_problem(const std::string& path, const FolderMarker& m
   return {};
 }
 
-void write_folder_atomic(const std::string& path, const std::vector<std::pair<std::string, std::string>>& files,
+void write_folder_atomic(const std::string& path, const std::vector<std::pair<std::string, std::string>>& given,
                          const FolderMarker& marker) {
   namespace fs = std::filesystem;
+  std::vector<std::pair<std::string, std::string>> files = given;
+  if (!marker.file.empty()) {
+    for (const auto& f : given)
+      if (f.first == kFolderManifest) throw Error(path + ": " + kFolderManifest + " is the folder's manifest, not a file to write");
+    files.emplace_back(kFolderManifest, folder_manifest(given));
+  }
   require_path_without_nul(path, "output folder");
   fs::path target = fs::path(path).lexically_normal();
   // "run/" names the folder run, as the shell's completion writes it (sixteenth campaign F20:
@@ -549,8 +648,10 @@ void write_folder_atomic(const std::string& path, const std::vector<std::pair<st
   // replaced the user's link with a new folder and left the folder it named as it was).
   std::error_code link_ec;
   if (fs::is_symlink(fs::symlink_status(target, link_ec))) {
-    target = fs::weakly_canonical(target, link_ec);
-    if (link_ec || target.empty() || target.filename().empty()) throw Error(path + ": a link that cannot be followed");
+    target = fs::path(link_target(target.string())).lexically_normal();
+    if (!target.empty() && target.filename().empty() && target.has_relative_path()) target = target.parent_path();
+    if (target.empty() || target.filename().empty() || target.filename() == "." || target.filename() == "..")
+      throw Error(path + ": a link that cannot be followed to a folder name");
   }
   const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");
   std::error_code ec;
@@ -602,6 +703,14 @@ void write_folder_atomic(const std::string& path, const std::vector<std::pair<st
   }
   // Swap: the old folder stays whole until the new one is complete and in place.
   const bool had_old = fs::exists(target, ec);
+  // The replaced folder's modes are kept, its own and each rewritten file's (eighteenth campaign
+  // F22: a private 0700 run folder came back 0755).
+  if (had_old) {
+    for (const auto& [name, content] : files)
+      if (const auto st = fs::symlink_status(target / name, ec); fs::is_regular_file(st))
+        fs::permissions(partial / name, st.permissions(), ec);
+    fs::permissions(partial, fs::status(target, ec).permissions(), ec);
+  }
   if (had_old) {
     fs::rename(target, old, ec);
     if (ec) {

@@ -138,7 +138,9 @@ void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& 
 /// by_name_fallback is set (figure folders written before they carried a manifest), a folder
 /// without marker.file is judged by the names rule above. A marker of one of
 /// marker.earlier_formats counts as the command's output too (a dataset of the previous format
-/// is regenerated in place).
+/// is regenerated in place). With a marker the folder also gets kFolderManifest, and a folder
+/// carrying one is replaced only when its files are the ones listed there, unchanged. The
+/// replaced folder's and files' permission bits are kept.
 struct FolderMarker {
   std::string file;
   std::string format;
@@ -155,11 +157,33 @@ struct FolderMarker {
   std::string listed = {};
 };
 
+/// The manifest a marked output folder carries (write_folder_atomic writes it whenever a marker
+/// is given): one line `<64 hex digits of SHA-256>  <name>` per file written, the folder's own
+/// files sorted by name, the format `sha256sum` prints and `sha256sum -c SHA256SUMS` checks.
+/// Replacing the folder later deletes only these bytes: a file it does not list, or one whose
+/// bytes changed since, is a user's and the folder is refused (eighteenth campaign F1: a user's
+/// region.json in a waypoint-run folder, a shard name the earlier dataset never wrote, a user's
+/// file under a figure's name were deleted or overwritten with exit 0).
+inline constexpr const char* kFolderManifest = "SHA256SUMS";
+/// The manifest text for `files` (name, content).
+std::string folder_manifest(const std::vector<std::pair<std::string, std::string>>& files);
+
+/// The path `path` names once symbolic links are followed (each link's target read relative to
+/// the link's folder), up to kMaxLinkHops links; `path` itself when it is no link. The result
+/// may not exist (a dangling link's target). Throws naming the path on a longer chain (a loop).
+/// Outputs are written through links into their targets, whether the target exists or not
+/// (REQ-CORE-004; eighteenth campaign F2: a dangling link was replaced by a file).
+inline constexpr int kMaxLinkHops = 40;
+std::string link_target(const std::string& path);
+
 /// Why the existing folder `path` holds something that is not part of an earlier output of the
 /// command `marker` describes (empty when all of it is), naming the first such entry: anything
 /// but a plain file; in a folder holding marker.file, with marker.own_name or marker.listed, a
 /// file that is none of the command's names (own_name, the marker's list, `new_names`); else a
-/// file whose extension is not in `extensions` (the names rule). The marker's own content is judged by folder_marker_problem.
+/// file whose extension is not in `extensions` (the names rule). Where the folder carries
+/// kFolderManifest too, the manifest rules instead of names: each file must be listed there
+/// with the same SHA-256 (a malformed manifest is refused). The marker's own content is judged
+/// by folder_marker_problem.
 std::string foreign_entry_problem(const std::string& path, const FolderMarker& marker,
                                   const std::set<std::string>& new_names, const std::set<std::string>& extensions);
 void write_folder_atomic(const std::string& path, const std::vector<std::pair<std::string, std::string>>& files,

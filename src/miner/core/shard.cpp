@@ -1,5 +1,7 @@
 #include "miner/core/shard.hpp"
 
+#include <map>
+
 #include <exception>
 
 #include "miner/core/error.hpp"
@@ -41,6 +43,16 @@ void require_complete_parts(const std::vector<Json>& tags, const std::vector<std
       if (!tags[p].is_object() || !tags[p].contains(key) || !tags[p].at(key).is_number_integer())
         throw Error(names[p] + ": its part tag needs an integer \"" + key + "\"");
   const int n = tags.front().at("count").get<int>();
+  // A part given twice is named before the count is judged (eighteenth campaign F26: a copied
+  // part folder was reported only as "has 2 parts, got 3").
+  std::map<int, std::size_t> first_at;  // a part's index -> where it was first given (n may be any count)
+  for (std::size_t p = 0; p < tags.size(); ++p) {
+    const int index = tags[p].at("index").get<int>();
+    if (tags[p].at("count").get<int>() != n || index < 0 || index >= n) continue;  // judged below
+    if (const auto [it, fresh] = first_at.emplace(index, p); !fresh)
+      throw Error(names[p] + ": part " + std::to_string(index) + "/" + std::to_string(n) + " appears twice (also " +
+                  names[it->second] + ")");
+  }
   if (static_cast<int>(tags.size()) != n)
     throw Error(job + " has " + std::to_string(n) + " parts, got " + std::to_string(tags.size()));
   std::vector<bool> seen(static_cast<std::size_t>(n), false);

@@ -10,8 +10,13 @@
 namespace miner::traj {
 
 double falling_factorial(int a, int k) {
+  // Eighteenth campaign F8: k = -1 returned 1 and (200, 200) inf.
+  if (k < 0) throw Error("falling_factorial: k must be >= 0, got " + std::to_string(k));
   double f = 1.0;
   for (int i = 0; i < k; ++i) f *= a - i;
+  if (!std::isfinite(f))
+    throw Error("falling_factorial: " + std::to_string(a) + "!/(" + std::to_string(a) + " - " + std::to_string(k) +
+                ")! overflows a double");
   return f;
 }
 
@@ -24,8 +29,12 @@ Eigen::RowVectorXd monomial_derivative_row(int n, int k, double t) {
   // Tenth campaign L4: k = -1 wrote before the row (heap corruption), n = -1 asked for 2^64 bytes.
   if (n < 0 || n > kMaxCoefficientRows) throw Error("monomial_derivative_row: n must be in [0, " + std::to_string(kMaxCoefficientRows) + "], got " + std::to_string(n));
   if (k < 0) throw Error("monomial_derivative_row: the derivative order k must be >= 0, got " + std::to_string(k));
+  // Eighteenth campaign F8: a NaN or huge t gave a row of NaN or inf, returned.
+  if (!std::isfinite(t)) throw Error("monomial_derivative_row: t must be finite, got " + exact_number(t));
   Eigen::RowVectorXd r = Eigen::RowVectorXd::Zero(n);
   for (int a = k; a < n; ++a) r(a) = falling_factorial(a, k) * std::pow(t, a - k);
+  if (!r.allFinite())
+    throw Error("monomial_derivative_row: t = " + exact_number(t) + " overflows t^" + std::to_string(n - 1 - k));
   return r;
 }
 
@@ -139,15 +148,30 @@ Eigen::MatrixXd monomial_cost_matrix(int order, double duration) {
       const int e = a + b - 2 * order + 1;
       q(a, b) = falling_factorial(a, order) * falling_factorial(b, order) * std::pow(duration, e) / e;
     }
+  // Eighteenth campaign F8: 1e300 s gave inf entries, returned.
+  if (!q.allFinite())
+    throw Error("monomial_cost_matrix: Q(T) is not finite (the duration " + exact_number(duration) +
+                " s overflows T^" + std::to_string(2 * order - 1) + ")");
   return q;
 }
+
+namespace {
+/// monomial_cost_matrix, its overflow named for `who` (cost, gradient).
+Eigen::MatrixXd cost_matrix(int order, double duration, const char* who) {
+  try {
+    return monomial_cost_matrix(order, duration);
+  } catch (const Error& e) {
+    throw Error(std::string(who) + ": not finite: " + e.what());
+  }
+}
+}  // namespace
 
 double PolynomialTrajectory::cost() const {
   check_consistent("trajectory cost");
   double j = 0.0;
   for (int i = 0; i < segments(); ++i) {
     const auto c = segment_coefficients(i);
-    j += (c.transpose() * monomial_cost_matrix(order_, durations_[i]) * c).trace();
+    j += (c.transpose() * cost_matrix(order_, durations_[i], "trajectory cost") * c).trace();
   }
   // Seventeenth campaign F16: a duration of 1e100 gave a NaN cost (inf x 0 in Q(T) c).
   if (!std::isfinite(j))
@@ -161,7 +185,7 @@ Eigen::MatrixX3d PolynomialTrajectory::cost_gradient_coefficients() const {
   Eigen::MatrixX3d g(coefficients_.rows(), 3);
   for (int i = 0; i < segments(); ++i) {
     g.middleRows(2 * order_ * i, 2 * order_) =
-        2.0 * monomial_cost_matrix(order_, durations_[i]) * segment_coefficients(i);
+        2.0 * cost_matrix(order_, durations_[i], "trajectory cost gradient") * segment_coefficients(i);
   }
   if (!g.allFinite())
     throw Error("trajectory cost gradient: not finite (durations up to " +

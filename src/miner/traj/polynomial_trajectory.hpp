@@ -72,14 +72,17 @@ class PolynomialTrajectory {
   Eigen::MatrixX3d coefficients_;
 };
 
-/// a! / (a - k)!: the factor of t^{a-k} in the k-th derivative of t^a.
+/// a! / (a - k)!: the factor of t^{a-k} in the k-th derivative of t^a. Throws miner::Error
+/// for k < 0 or a result past a double's range.
 double falling_factorial(int a, int k);
 
-/// The row d^k/dt^k (1, t, ..., t^{n-1}) = (a!/(a-k)! t^{a-k})_a, zero for a < k.
+/// The row d^k/dt^k (1, t, ..., t^{n-1}) = (a!/(a-k)! t^{a-k})_a, zero for a < k. Throws
+/// miner::Error for a non-finite t or an entry that overflows.
 Eigen::RowVectorXd monomial_derivative_row(int n, int k, double t);
 
 /// Q(T) of the control effort in the monomial basis of degree 2s - 1:
-/// Q_ab = a!/(a-s)! b!/(b-s)! T^{a+b-2s+1} / (a+b-2s+1) for a, b >= s, else 0.
+/// Q_ab = a!/(a-s)! b!/(b-s)! T^{a+b-2s+1} / (a+b-2s+1) for a, b >= s, else 0. Throws
+/// miner::Error for a duration that is negative, not finite, or overflows an entry.
 Eigen::MatrixXd monomial_cost_matrix(int order, double duration);
 
 }  // namespace miner::traj

@@ -40,6 +40,9 @@ MincoProblem problem_from_json(const Json& doc, const std::string& origin) {
   MincoProblem p;
   p.order = root.at("order").integer();
   p.points = rows_of(root.at("points"));
+  // Named with the file here, before any allocation reads them (eighteenth campaign F14).
+  if (p.points.rows() < 2)
+    root.at("points").fail("a trajectory needs at least 2 points, got " + std::to_string(p.points.rows()));
   p.head = rows_of(root.at("head"));
   p.tail = rows_of(root.at("tail"));
   if (root.has("durations")) {

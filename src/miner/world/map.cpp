@@ -10,6 +10,7 @@
 #include <fstream>
 
 #include "miner/core/error.hpp"
+#include "miner/core/json_io.hpp"
 #include "miner/core/text.hpp"
 #include "miner/core/sha256.hpp"
 #include "miner/world/octree_io.hpp"
@@ -325,13 +326,7 @@ std::string Map::voxel_file_path(const std::string& map_path, const std::string&
   if (p.is_relative()) {
     // Relative to where the map file is: a map file reached through a link names its voxels
     // beside its target, where save() put them (seventeenth campaign F32).
-    fs::path map(map_path);
-    std::error_code ec;
-    if (fs::is_symlink(fs::symlink_status(map, ec))) {
-      const fs::path real = fs::weakly_canonical(map, ec);
-      if (!ec && !real.empty()) map = real;
-    }
-    p = map.parent_path() / p;
+    p = fs::path(link_target(map_path)).parent_path() / p;
   }
   return fs::absolute(p).lexically_normal().string();
 }
@@ -403,7 +398,9 @@ Map Map::from_json(const Json& doc, const std::string& origin) {
     q.only_keys({"start", "goal", "robot_radius"});
     // The radius is required: a forgotten one planned for a point robot, touching obstacles
     // (issue 20); 0 must be said.
-    query = Query{q.at("start").vec3(), q.at("goal").vec3(), q.at("robot_radius").number()};
+    // -0 reads as 0, as on the command line (eighteenth campaign F20: "robot radius -0 m").
+    const auto plus_zero = [](Eigen::Vector3d v) { return Eigen::Vector3d(v.array() + 0.0); };
+    query = Query{plus_zero(q.at("start").vec3()), plus_zero(q.at("goal").vec3()), q.at("robot_radius").number() + 0.0};
   }
   // Bounds reaching beyond the voxels under the occupied policy are refused by the constructor.
   try {
@@ -531,12 +528,7 @@ std::string Map::voxel_side_file(const std::string& path, const std::string& sha
   // Beside the file the JSON really is: a JSON output that is a link is written into its target
   // (REQ-CORE-004), and its voxels go beside that target, so the map loads by either name
   // (seventeenth campaign F32: the .bt went beside the link and the target did not load).
-  fs::path json(path);
-  std::error_code ec;
-  if (fs::is_symlink(fs::symlink_status(json, ec))) {
-    const fs::path real = fs::weakly_canonical(json, ec);
-    if (!ec && !real.empty()) json = real;
-  }
+  const fs::path json(link_target(path));
   return (json.parent_path() / (json.stem().string() + "." + sha256.substr(0, kSideFileHashDigits) + ".bt")).string();
 }
 

@@ -6,6 +6,7 @@
 #include <cctype>
 #include <cstring>
 #include <limits>
+#include <map>
 #include <sstream>
 #include <tuple>
 
@@ -14,6 +15,7 @@
 #include "miner/core/error.hpp"
 #include "miner/core/text.hpp"
 #include "miner/core/json_io.hpp"
+#include "miner/core/sha256.hpp"
 #include "miner/world/map.hpp"
 #include "miner/world/octree_leaves.hpp"
 
@@ -50,10 +52,14 @@ std::vector<std::string> words(const std::string& line) {
 }
 
 std::size_t count_of(const std::string& text, const std::string& what, const std::string& origin) {
-  if (text.empty() || text.size() > 12 || text.find_first_not_of("0123456789") != std::string::npos)
+  if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos)
     fail(origin, what + " \"" + text + "\" is not a count");
-  const std::size_t n = std::stoull(text);
+  // A count of many digits is too large, not malformed (eighteenth campaign F15).
+  const std::size_t n = text.size() > 12 ? kMaxCloudPoints + 1 : std::stoull(text);
   if (n > kMaxCloudPoints) {
+    if (text.size() > 12)
+      fail(origin, what + " " + (text.size() > 24 ? text.substr(0, 24) + "..." : text) + " exceeds the " +
+                       std::to_string(kMaxCloudPoints) + " points a cloud may hold");
     std::ostringstream os;
     os << what << " " << n << " exceeds the " << kMaxCloudPoints << " points a cloud may hold";
     fail(origin, os.str());
@@ -110,6 +116,30 @@ bool decimal_or_special(const std::string& token) {
   const std::string bare = !lower.empty() && (lower[0] == '-' || lower[0] == '+') ? lower.substr(1) : lower;
   if (bare == "nan" || bare == "inf" || bare == "infinity") return true;
   return token.find_first_not_of("0123456789+-.eE") == std::string::npos;
+}
+
+/// Why the ASCII value `token` is no value of field `f`'s type, or "" when it is one: a float
+/// field takes a decimal (or nan/inf) within its range, an integer field a whole number within
+/// its size (eighteenth campaign F15: a uchar "abc" or 300 was never read).
+std::string ascii_value_problem(const std::string& token, const Field& f) {
+  if (f.kind == 'f') {
+    char* end = nullptr;
+    const double v = std::strtod(token.c_str(), &end);
+    if (end == token.c_str() || *end != '\0' || !decimal_or_special(token)) return "is not a number";
+    if (std::isinf(v) && token.find_first_of("0123456789") != std::string::npos) return "is beyond the largest double";
+    if (f.size == 4 && std::isfinite(v) && std::abs(v) > static_cast<double>(std::numeric_limits<float>::max()))
+      return "is beyond the range of a 4-byte float";
+    return "";
+  }
+  const bool negative = !token.empty() && token[0] == '-';
+  const std::string digits = !token.empty() && (token[0] == '-' || token[0] == '+') ? token.substr(1) : token;
+  if (digits.empty() || digits.size() > 20 || digits.find_first_not_of("0123456789") != std::string::npos)
+    return "is not a whole number";
+  const long double v = std::strtold(digits.c_str(), nullptr) * (negative ? -1.0L : 1.0L);
+  const long double bits = 8.0L * static_cast<long double>(f.size);
+  const long double lo = f.kind == 'u' ? 0.0L : -std::pow(2.0L, bits - 1), hi = std::pow(2.0L, f.kind == 'u' ? bits : bits - 1) - 1;
+  if (v < lo || v > hi) return "is outside the field's range";
+  return "";
 }
 
 double parse_number(const std::string& token, const std::string& origin, std::size_t point) {
@@ -173,6 +203,17 @@ std::size_t read_records(PointCloud& cloud, const std::string& bytes, std::size_
           std::ostringstream os;
           os << "point " << i << ": " << w[static_cast<std::size_t>(xyz[static_cast<std::size_t>(a)])] << " is beyond the range of its "
              << "4-byte float field \"" << f.name << "\"";
+          fail(origin, os.str());
+        }
+      }
+      // Every other property is read by its type too.
+      for (std::size_t j = 0; j < fields.size(); ++j) {
+        if (static_cast<int>(j) == xyz[0] || static_cast<int>(j) == xyz[1] || static_cast<int>(j) == xyz[2]) continue;
+        if (const std::string why = ascii_value_problem(w[j], fields[j]); !why.empty()) {
+          std::ostringstream os;
+          os << "point " << i << ": the value \"" << w[j] << "\" of \"" << fields[j].name << "\" ("
+             << (fields[j].kind == 'f' ? "float" : fields[j].kind == 'u' ? "unsigned" : "signed") << ", "
+             << fields[j].size << " bytes) " << why;
           fail(origin, os.str());
         }
       }
@@ -518,6 +559,21 @@ std::shared_ptr<const VoxelLayer> integrate_clouds(const std::vector<CloudScan>&
   const auto label = [&](std::size_t s) {
     return scans[s].name.empty() ? "cloud " + std::to_string(s) : scans[s].name;
   };
+  // One scan given twice (a copy under another name) would push every voxel's log-odds twice
+  // as far (eighteenth campaign F28): the same origin and the same points are refused, naming
+  // both. Compared by a checksum first, then point by point.
+  {
+    std::map<std::uint64_t, std::size_t> first_with;
+    for (std::size_t s = 0; s < scans.size(); ++s) {
+      const auto& pts = scans[s].cloud.points;
+      std::uint64_t h = fnv1a64(scans[s].origin.data(), sizeof(double) * 3);
+      for (const Eigen::Vector3d& p : pts) h = fnv1a64(p.data(), sizeof(double) * 3, h);
+      const auto [it, fresh] = first_with.emplace(h, s);
+      if (!fresh && scans[it->second].origin == scans[s].origin && scans[it->second].cloud.points == pts)
+        throw Error(label(s) + ": the same scan as " + label(it->second) +
+                    " (the same sensor origin and points): integrating it twice would count every ray twice");
+    }
+  }
   // Each point's ray walks |point - origin| / res voxels (at most max_range / res): the total is
   // bounded before OctoMap starts (it integrates ~1e7 voxels per second).
   constexpr double kMaxRaySteps = 2e9;

@@ -14,6 +14,7 @@
 
 #include "miner/core/error.hpp"
 #include "miner/core/json_io.hpp"
+#include "miner/core/sha256.hpp"
 
 using miner::Error;
 using miner::Json;
@@ -320,10 +321,14 @@ TEST_CASE("A folder whose kind names its files keeps a user's file of the same e
   marker.own_name = [](const std::string& name) { return name == "summary.json" || name == "log.csv" || name == "page.html"; };
   const std::vector<std::pair<std::string, std::string>> first{{"summary.json", "{\"format\": \"fmt-v1\"}\n"}, {"log.csv", "t\n"}};
   miner::write_folder_atomic(run, first, marker);
+  // Here the folders an older miner wrote, without a manifest: judged by the kind's names.
+  const auto older = [&] { REQUIRE(fs::remove(dir / "run" / miner::kFolderManifest)); };
+  older();
   // An own name the new output does not write (an earlier run's page) is replaced with the rest.
   std::ofstream(dir / "run" / "page.html") << "old page";
   miner::write_folder_atomic(run, first, marker);
   CHECK_FALSE(fs::exists(dir / "run" / "page.html"));
+  older();
   // Seventeenth campaign F31: a user's notes.json in the folder was deleted, its extension being
   // one the outputs use. Now the folder is refused, naming the file, and nothing changes.
   std::ofstream(dir / "run" / "notes.json") << "precious";
@@ -345,6 +350,93 @@ TEST_CASE("A folder whose kind names its files keeps a user's file of the same e
   miner::write_folder_atomic(figs, {{"b.svg", "<svg/>"}, {"figures.json", "{\"format\": \"fig-v1\", \"files\": [\"b.svg\"]}"}}, listed);
   CHECK_FALSE(fs::exists(dir / "figs" / "a.svg"));
   CHECK(fs::exists(dir / "figs" / "b.svg"));
+}
+
+TEST_CASE("A marked folder lists what it wrote in SHA256SUMS, and only those bytes are replaced", "[REQ-CORE-004]") {
+  namespace fs = std::filesystem;
+  const auto dir = temp_dir("folder_manifest");
+  const std::string run = (dir / "run").string();
+  miner::FolderMarker marker{"summary.json", "fmt-v1"};
+  marker.own_name = [](const std::string& name) { return name == "summary.json" || name == "region.json" || name == "log.csv"; };
+  const std::vector<std::pair<std::string, std::string>> first{{"summary.json", "{\"format\": \"fmt-v1\"}\n"}, {"log.csv", "t\n"}};
+  miner::write_folder_atomic(run, first, marker);
+  // The manifest is sha256sum's format, sorted by name, and lists every file but itself.
+  CHECK(read_all(run + "/SHA256SUMS") == miner::sha256_hex("t\n") + "  log.csv\n" +
+                                            miner::sha256_hex("{\"format\": \"fmt-v1\"}\n") + "  summary.json\n");
+  CHECK(miner::folder_manifest({{"b", "x"}, {"a", ""}}) ==
+        "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855  a\n" + miner::sha256_hex("x") + "  b\n");
+  // Rewriting the same output replaces it (same bytes, same manifest).
+  miner::write_folder_atomic(run, first, marker);
+  CHECK(read_all(run + "/log.csv") == "t\n");
+  // Eighteenth campaign F1: a user's file under one of the kind's own names that this output
+  // never wrote (region.json in a waypoint run's folder) was deleted with exit 0.
+  std::ofstream(dir / "run" / "region.json") << "{\"mine\": 1}";
+  CHECK_THROWS_WITH(miner::write_folder_atomic(run, first, marker),
+                    Contains("\"region.json\", which the earlier output did not write") && Contains("not replaced"));
+  CHECK(miner::foreign_entry_problem(run, marker, {}, {".json"}) != "");
+  CHECK(read_all(run + "/region.json") == "{\"mine\": 1}");
+  fs::remove(dir / "run" / "region.json");
+  // ... and a file the output wrote but the user changed since (its figure redrawn) is kept too.
+  std::ofstream(dir / "run" / "log.csv") << "edited\n";
+  CHECK_THROWS_WITH(miner::write_folder_atomic(run, first, marker),
+                    Contains("\"log.csv\" changed since the earlier output wrote it"));
+  CHECK(read_all(run + "/log.csv") == "edited\n");
+  // A listed file that is gone is no loss.
+  fs::remove(dir / "run" / "log.csv");
+  miner::write_folder_atomic(run, first, marker);
+  CHECK(read_all(run + "/log.csv") == "t\n");
+  // A manifest that is not one (a user's own SHA256SUMS) is refused, naming its line.
+  std::ofstream(dir / "run" / "SHA256SUMS") << "my checksums\n";
+  CHECK_THROWS_WITH(miner::write_folder_atomic(run, first, marker), Contains("SHA256SUMS: line 1 is not"));
+  CHECK(read_all(run + "/SHA256SUMS") == "my checksums\n");
+  // The file name is the folder's own: a writer may not give it.
+  CHECK_THROWS_WITH(miner::write_folder_atomic((dir / "x").string(), {{"SHA256SUMS", ""}}, marker),
+                    Contains("is the folder's manifest"));
+  // Unmarked folders get no manifest.
+  miner::write_folder_atomic((dir / "plain").string(), first);
+  CHECK_FALSE(fs::exists(dir / "plain" / "SHA256SUMS"));
+}
+
+TEST_CASE("A replaced output keeps its permission bits", "[REQ-CORE-004]") {
+  namespace fs = std::filesystem;
+  const auto dir = temp_dir("keep_mode");
+  // Eighteenth campaign F22: a private 0600 file and a 0700 run folder came back world-readable.
+  const std::string file = (dir / "priv.json").string();
+  miner::write_file_atomic(file, "{}\n");
+  fs::permissions(file, fs::perms::owner_read | fs::perms::owner_write);
+  miner::write_file_atomic(file, "{\"new\": 1}\n");
+  CHECK(read_all(file) == "{\"new\": 1}\n");
+  CHECK(fs::status(file).permissions() == (fs::perms::owner_read | fs::perms::owner_write));
+  const std::string run = (dir / "run").string();
+  miner::write_folder_atomic(run, {{"a.txt", "1"}});
+  fs::permissions(run, fs::perms::owner_all);
+  fs::permissions(run + "/a.txt", fs::perms::owner_read);
+  miner::write_folder_atomic(run, {{"a.txt", "2"}, {"b.txt", "3"}});
+  CHECK(read_all(run + "/a.txt") == "2");
+  CHECK(fs::status(run).permissions() == fs::perms::owner_all);
+  CHECK(fs::status(run + "/a.txt").permissions() == fs::perms::owner_read);
+}
+
+TEST_CASE("An output that is a dangling link is written into the link's target", "[REQ-CORE-004]") {
+  namespace fs = std::filesystem;
+  const auto dir = temp_dir("dangling_link");
+  fs::create_directories(dir / "sub");
+  // Eighteenth campaign F2: a live link was written through, a dangling one replaced by a file.
+  fs::create_symlink("sub/none.json", dir / "dang.json");
+  miner::write_file_atomic((dir / "dang.json").string(), "{}\n");
+  CHECK(fs::is_symlink(fs::symlink_status(dir / "dang.json")));
+  CHECK(read_all((dir / "sub" / "none.json").string()) == "{}\n");
+  CHECK(miner::link_target((dir / "dang.json").string()) == (dir / "sub/none.json").string());
+  // A link whose target's folder is missing is refused, naming both; the link stays.
+  fs::create_symlink("gone/x.json", dir / "nowhere.json");
+  CHECK_THROWS_WITH(miner::write_file_atomic((dir / "nowhere.json").string(), "{}"),
+                    Contains("nowhere.json: a symbolic link to") && Contains("does not exist"));
+  CHECK(fs::is_symlink(fs::symlink_status(dir / "nowhere.json")));
+  // A loop is named as one, not followed for ever.
+  fs::create_symlink("loop-b.json", dir / "loop-a.json");
+  fs::create_symlink("loop-a.json", dir / "loop-b.json");
+  CHECK_THROWS_WITH(miner::write_file_atomic((dir / "loop-a.json").string(), "{}"), Contains("more than 40 symbolic links"));
+  CHECK(miner::link_target((dir / "sub").string()) == (dir / "sub").string());
 }
 
 TEST_CASE("only_keys refuses an unknown key, naming it and the known ones", "[REQ-CORE-003]") {

@@ -12,7 +12,10 @@ TEST_CASE("Parts of one split join: others are refused naming the part in plain 
   CHECK_THROWS_WITH(miner::require_complete_parts({tag(0, 3), tag(1, 3)}, {"a", "b"}, "merge: the campaign"),
                     Contains("merge: the campaign has 3 parts, got 2"));
   CHECK_THROWS_WITH(miner::require_complete_parts({tag(0, 2), tag(0, 2)}, {"a", "b"}, "merge: the campaign"),
-                    Contains("b: part 0/2 appears twice"));
+                    Contains("b: part 0/2 appears twice (also a)"));
+  // Eighteenth campaign F26: a copied part beside the whole split was only "has 2 parts, got 3".
+  CHECK_THROWS_WITH(miner::require_complete_parts({tag(0, 2), tag(1, 2), tag(1, 2)}, {"a0", "a1", "a1copy"}, "dataset merge"),
+                    Contains("a1copy: part 1/2 appears twice (also a1)"));
   // Fifth campaign: "splits dataset merge: the dataset differently".
   CHECK_THROWS_WITH(miner::require_complete_parts({tag(0, 2), tag(1, 3)}, {"a", "b"}, "dataset merge: the dataset"),
                     Contains("b: is part 1 of 3, but a is a part of 2: the parts come from different splits"));

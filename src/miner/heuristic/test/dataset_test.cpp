@@ -321,7 +321,7 @@ TEST_CASE("The dataset has its splits, unseen test seeds and the same bytes for 
   // readme.bin were deleted with the folder).
   heuristic::write_dataset(o, a, nullptr);
   std::ofstream(a + "/notes.json") << "{\"x\": 1}";
-  CHECK_THROWS_WITH(heuristic::write_dataset(o, a, nullptr), Contains("\"notes.json\", a file this command never writes"));
+  CHECK_THROWS_WITH(heuristic::write_dataset(o, a, nullptr), Contains("\"notes.json\", which the earlier output did not write"));
   CHECK(read_bytes(a + "/notes.json") == "{\"x\": 1}");
   std::filesystem::remove(a + "/notes.json");
   const auto own = heuristic::dataset_folder_marker().own_name;
@@ -629,6 +629,8 @@ TEST_CASE("A dataset folder of an earlier format is regenerated in place, a user
   miner::Json doc = miner::read_json_file(dir + "/dataset.json");
   doc["format"] = "miner-dataset-v2";
   miner::write_file_atomic(dir + "/dataset.json", miner::dump_json(doc));
+  // A v2 folder was written before folders carried SHA256SUMS.
+  REQUIRE(std::filesystem::remove(dir + "/" + miner::kFolderManifest));
   CHECK_THROWS_WITH(heuristic::read_split(dir, "train"), Contains("written by an earlier miner"));
   CHECK_NOTHROW(heuristic::write_dataset(o, dir, nullptr));
   CHECK(miner::read_json_file(dir + "/dataset.json")["format"] == heuristic::kDatasetFormat);
@@ -636,6 +638,8 @@ TEST_CASE("A dataset folder of an earlier format is regenerated in place, a user
   doc["format"] = "my-own-notes";
   miner::write_file_atomic(dir + "/dataset.json", miner::dump_json(doc));
   CHECK_THROWS_WITH(heuristic::write_dataset(o, dir, nullptr), Contains("is not an earlier output of this command"));
+  REQUIRE(std::filesystem::remove(dir + "/" + miner::kFolderManifest));
+  CHECK_THROWS_WITH(heuristic::write_dataset(o, dir, nullptr), Contains("is not a \"miner-dataset-v3\" file"));
 }
 
 TEST_CASE("A whole dataset (--shard 0/1) merges on its own into the same bytes", "[REQ-REPORT-006]") {

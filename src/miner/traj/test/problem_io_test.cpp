@@ -63,6 +63,13 @@ TEST_CASE("Problem file errors name the file and the field", "[REQ-TRAJ-007]") {
   doc.erase("limits");
   doc["durations"] = {1.0, 0.0};
   CHECK_THROWS_WITH(problem_from_json(doc, "p.json"), Contains("p.json: durations[1]: must be positive and finite"));
+  // Eighteenth campaign F14: "points: a trajectory needs at least 2 points" named no file.
+  for (const miner::Json& points : {miner::Json::array(), miner::Json::array({miner::Json::array({0.0, 0.0, 0.0})})}) {
+    doc = problem();
+    doc["points"] = points;
+    CHECK_THROWS_WITH(problem_from_json(doc, "p.json"),
+                      Contains("p.json: points: a trajectory needs at least 2 points, got " + std::to_string(points.size())));
+  }
   // Issue 20: a waypoint at 1e155 m overflowed the cost to "null" with exit 0; values beyond
   // 1e6 (m, m/s, ...) are refused, naming the row.
   for (const char* key : {"points", "head", "tail"}) {

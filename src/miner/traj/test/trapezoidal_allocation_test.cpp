@@ -82,6 +82,15 @@ TEST_CASE("Tenth campaign: the trajectory API refuses what would give NaN, garba
   // L17: the cost matrix of a negative or NaN duration, a trajectory of order 0 or NaN parts.
   CHECK_THROWS_WITH(monomial_cost_matrix(3, -1.0), Contains("duration"));
   CHECK_THROWS_WITH(monomial_cost_matrix(3, nan), Contains("duration"));
+  // Eighteenth campaign F8: the free functions returned NaN, inf or a wrong value.
+  CHECK_THROWS_WITH(monomial_derivative_row(8, 0, nan), Contains("t must be finite"));
+  CHECK_THROWS_WITH(monomial_derivative_row(8, 0, 1e300), Contains("overflows t^7"));
+  CHECK(monomial_derivative_row(8, 0, 1e40).allFinite());
+  CHECK_THROWS_WITH(monomial_cost_matrix(4, 1e300), Contains("Q(T) is not finite"));
+  CHECK_THROWS_WITH(falling_factorial(200, 200), Contains("overflows a double"));
+  CHECK_THROWS_WITH(falling_factorial(5, -1), Contains("k must be >= 0"));
+  CHECK(falling_factorial(5, 2) == 20.0);
+  CHECK(falling_factorial(5, 0) == 1.0);
   CHECK_THROWS_WITH(PolynomialTrajectory(0, {1.0}, Eigen::MatrixX3d::Zero(0, 3)), Contains("order"));
   CHECK_THROWS_WITH(PolynomialTrajectory(3, {-1.0}, Eigen::MatrixX3d::Zero(6, 3)), Contains("durations[0]"));
   CHECK_THROWS_WITH(PolynomialTrajectory(3, {nan}, Eigen::MatrixX3d::Zero(6, 3)), Contains("durations[0]"));

@@ -41,6 +41,19 @@ TEST_CASE("A miner-map-v1 document loads as written in the design contract", "[R
   CHECK_FALSE(map.query());
 }
 
+TEST_CASE("A map's query written with negative zeros reads as zeros", "[REQ-WORLD-001]") {
+  // Eighteenth campaign F20: "robot radius -0 m" and "start": [1.0, 1.0, -0.0] were echoed.
+  Json doc = valid_doc();
+  doc["obstacles"] = Json::array();
+  doc["query"] = {{"start", {1.0, 1.0, -0.0}}, {"goal", {-0.0, 9.0, 1.0}}, {"robot_radius", -0.0}};
+  const Map map = Map::from_json(doc, "doc");
+  REQUIRE(map.query());
+  CHECK_FALSE(std::signbit(map.query()->start.z()));
+  CHECK_FALSE(std::signbit(map.query()->goal.x()));
+  CHECK_FALSE(std::signbit(map.query()->robot_radius));
+  CHECK(miner::dump_json(map.to_json()).find("-0") == std::string::npos);
+}
+
 TEST_CASE("Saving and loading a map gives back the same map and the same bytes", "[REQ-WORLD-001]") {
   const Map map(Box{{0, 0, 0}, {10, 10, 5}}, 0.1, {Box{{1, 2, 0}, {1.6, 3.2, 4.5}}},
                 miner::world::Query{{0.5, 0.5, 1}, {9, 9, 1}, 0.2});

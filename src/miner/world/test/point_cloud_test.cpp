@@ -196,6 +196,20 @@ TEST_CASE("A cloud becomes free space along its rays, occupied at its points, un
   CHECK(short_range->count(VoxelState::kFree) > 0);
 }
 
+TEST_CASE("One scan given twice is refused naming both, not integrated twice", "[REQ-WORLD-018]") {
+  // Eighteenth campaign F28: a byte-identical copy under another name pushed every voxel's
+  // log-odds twice as far.
+  PointCloud cloud;
+  cloud.points = wall_points();
+  CHECK_THROWS_WITH(integrate_clouds({{cloud, V(0, 0, 0.5), "c1.ply"}, {cloud, V(0, 0, 0.5), "c2.ply"}}, 0.1, 0.0),
+                    Contains("c2.ply: the same scan as c1.ply"));
+  // The same points seen from another pose, or one point moved, are other scans.
+  CHECK_NOTHROW(integrate_clouds({{cloud, V(0, 0, 0.5), "c1.ply"}, {cloud, V(0, 0.1, 0.5), "c2.ply"}}, 0.1, 0.0));
+  PointCloud moved = cloud;
+  moved.points.back().x() += 0.01;
+  CHECK_NOTHROW(integrate_clouds({{cloud, V(0, 0, 0.5), "c1.ply"}, {moved, V(0, 0, 0.5), "c2.ply"}}, 0.1, 0.0));
+}
+
 TEST_CASE("Non-finite points are skipped and counted", "[REQ-WORLD-018]") {
   const std::string text = "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 3\nHEIGHT 1\nPOINTS 3\nDATA ascii\n"
                            "1 2 3\nnan nan nan\n4 5 6\n";
@@ -223,6 +237,24 @@ TEST_CASE("Malformed point clouds are refused naming the fault, never crash", "[
           true, "data ends after 1 of 2 points");
   refuses("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n1 2 x\n",
           true, "\"x\" is not a number");
+  // Eighteenth campaign F15: the other properties' values were not read at all; a huge count
+  // was "not a count".
+  const std::string with_r = "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+                             "property uchar r\nend_header\n0 0 1 ";
+  refuses(with_r + "abc\n", true, "point 0: the value \"abc\" of \"r\" (unsigned, 1 bytes) is not a whole number");
+  refuses(with_r + "300\n", true, "the value \"300\" of \"r\" (unsigned, 1 bytes) is outside the field's range");
+  refuses(with_r + "-5\n", true, "is outside the field's range");
+  refuses(with_r + "1.5\n", true, "is not a whole number");
+  CHECK(parse_point_cloud(with_r + "255\n", true, "ok").points.size() == 1);
+  const std::string with_i = "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+                             "property short s\nproperty float q\nend_header\n0 0 1 ";
+  CHECK(parse_point_cloud(with_i + "-32768 nan\n", true, "ok").points.size() == 1);
+  refuses(with_i + "32768 0\n", true, "is outside the field's range");
+  refuses(with_i + "1 1e39\n", true, "is beyond the range of a 4-byte float");
+  refuses(with_i + "1 0x10\n", true, "is not a number");
+  refuses("ply\nformat ascii 1.0\nelement vertex 1000000000000\nproperty float x\nproperty float y\nproperty float z\n"
+          "end_header\n",
+          true, "element vertex 1000000000000 exceeds the 134217728 points a cloud may hold");
   refuses("ply\nformat binary_little_endian 1.0\nelement vertex 99999999\nproperty float x\nproperty float y\n"
           "property float z\nend_header\nabc",
           true, "only 3 data bytes follow");

@@ -311,7 +311,10 @@ void run_scan(const ScanCliOptions& o, std::ostream& out) {
     Json doc = scanned.to_json();
     doc["query"] = {{"start", vec3_json(q.start)}, {"goal", vec3_json(q.goal)}, {"robot_radius", q.radius}};
     // Relative to the JSON's folder when they share one, so the pair can be moved together.
-    const auto bt = std::filesystem::absolute(o.out), json = std::filesystem::absolute(o.map_out);
+    // Where the files really land: a link is written through into its target (nineteenth
+    // campaign F10: a name relative to the link's folder did not resolve beside the target).
+    const auto bt = std::filesystem::absolute(link_target(o.out)).lexically_normal(),
+               json = std::filesystem::absolute(link_target(o.map_out)).lexically_normal();
     if (bt.parent_path() == json.parent_path()) doc["voxels"]["file"] = bt.filename().string();
     files.emplace_back(o.map_out, dump_json(doc));
   }

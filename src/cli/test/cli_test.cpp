@@ -446,6 +446,11 @@ TEST_CASE("Options a run would not read, clamped values and mismatched suffixes 
       {{"map"}, 2, "`miner map` needs a command (commands: "},
       {{"astar", "--map", map, "--out=", "--json"}, 2, "--out: needs a value, got an empty one (nothing after \"=\")"},
       {{"--version", "extra"}, 2, "--version prints the version and takes no other argument, got 1 more (\"extra\")"},
+      // Nineteenth campaign F6: "--" as a value wrote a file named "--"; F19: `--out .` was
+      // refused after the work, exit 1.
+      {{"astar", "--map", map, "--out=--"}, 2, "--out: needs a value, got \"--\""},
+      {{"fly", "--out", "."}, 2, "--out: . is not a folder name"},
+      {{"fly", "--out", "x/.."}, 2, "--out: x/.. is not a folder name"},
       {{"bench", "--json"}, 2, "`miner bench` needs a command (commands: "},
       // A stored query's fault names the file and the field.
       {{"astar", "--map", write("query-in-4th.json", R"({"format": "miner-map-v1", "bounds": {"min": [0,0,0], "max": [10,10,10]},
@@ -1853,6 +1858,21 @@ TEST_CASE("sharded campaigns and datasets merge into the unsharded result", "[RE
   const Run twice = miner_cli({"bench", "merge", parts[0], parts[0], parts[1]});
   CHECK(twice.code == 2);  // one file named twice: a usage error (REQ-CLI-002)
   CHECK_THAT(twice.err, Contains("parts: lists " + parts[0] + " twice"));
+  // Eighteenth campaign F19: after "--" every word is a part, one named like an option too
+  // ("the command takes none" before).
+  {
+    const std::string dashed = dir() + "/-dashed-part.json";
+    std::filesystem::copy_file(parts[2], dashed, std::filesystem::copy_options::overwrite_existing);
+    const std::string here = std::filesystem::current_path().string();
+    std::filesystem::current_path(dir());
+    const Run plain = miner_cli({"bench", "merge", parts[0], parts[1], parts[2], "--json"});
+    const Run separated = miner_cli({"bench", "merge", parts[0], "--json", parts[1], "--", "-dashed-part.json"});
+    std::filesystem::current_path(here);
+    INFO(separated.err);
+    REQUIRE(plain.code == 0);
+    CHECK(separated.code == 0);
+    CHECK(miner::parse_json(separated.out, "merged")["run_records"] == miner::parse_json(plain.out, "merged")["run_records"]);
+  }
   const std::string copy = dir() + "/shard-copy.json";
   std::filesystem::copy_file(parts[0], copy, std::filesystem::copy_options::overwrite_existing);
   const Run same_shard = miner_cli({"bench", "merge", parts[0], copy, parts[1]});
@@ -2387,6 +2407,24 @@ TEST_CASE("miner map scan writes a deterministic OctoMap and a map that referenc
   CHECK(i["voxels"]["unknown_policy"] == "occupied");
   const Run open = miner_cli({"map", "info", "--map", json, "--unknown", "free", "--json"});
   CHECK(miner::parse_json(open.out, "stdout")["grid"]["occupied_cells"] < i["grid"]["occupied_cells"]);
+  // Nineteenth campaign F10: --map-out through a link into another folder named the voxels
+  // relative to the link's folder, and the map did not load.
+  {
+    namespace fs = std::filesystem;
+    fs::remove_all(dir() + "/scan-link");
+    fs::create_directories(dir() + "/scan-link/a");
+    fs::create_directories(dir() + "/scan-link/far");
+    fs::create_symlink("../far/m.json", dir() + "/scan-link/a/m.json");
+    std::vector<std::string> linked = args;
+    linked[linked.size() - 3] = dir() + "/scan-link/a/s.bt";
+    linked.back() = dir() + "/scan-link/a/m.json";
+    const Run through = miner_cli(linked);
+    INFO(through.err);
+    REQUIRE(through.code == 0);
+    CHECK(fs::is_regular_file(dir() + "/scan-link/far/m.json"));
+    CHECK(miner_cli({"map", "info", "--map", dir() + "/scan-link/a/m.json"}).code == 0);
+    CHECK(miner_cli({"map", "info", "--map", dir() + "/scan-link/far/m.json"}).code == 0);
+  }
   // Bad settings name themselves.
   CHECK_THAT(miner_cli({"map", "scan", "--map", src, "--out", dir() + "/scan.json"}).err, Contains("must end in .bt"));
   CHECK_THAT(miner_cli({"map", "scan", "--map", src, "--fov", "400", "60", "--out", bt}).err,

@@ -570,12 +570,15 @@ std::string manifest_problem(const std::filesystem::path& folder, const std::str
   std::istringstream in(read_file_bytes(where));
   std::string line;
   for (std::size_t number = 1; std::getline(in, line); ++number) {
+    // sha256sum's own variants: a CRLF line end, "*" before a name hashed in binary mode
+    // (nineteenth campaign F1, F2).
+    if (!line.empty() && line.back() == '\r') line.pop_back();
     const bool hex = line.size() > 66 && std::all_of(line.begin(), line.begin() + 64, [](char c) {
                        return std::isdigit(static_cast<unsigned char>(c)) || (c >= 'a' && c <= 'f');
                      });
     const std::string name = hex ? line.substr(66) : std::string();
-    if (!hex || line.compare(64, 2, "  ") != 0 || name.find('/') != std::string::npos || name == "." || name == ".." ||
-        !listed.emplace(name, line.substr(0, 64)).second)
+    if (!hex || (line.compare(64, 2, "  ") != 0 && line.compare(64, 2, " *") != 0) ||
+        name.find('/') != std::string::npos || name == "." || name == ".." || !listed.emplace(name, line.substr(0, 64)).second)
       return where + ": line " + std::to_string(number) +
              " is not \"<64 hex digits>  <file name>\" naming a file once: not a manifest this command wrote: " +
              not_ours;
@@ -583,11 +586,15 @@ std::string manifest_problem(const std::filesystem::path& folder, const std::str
   for (const auto& entry : fs::directory_iterator(folder, ec)) {
     const std::string name = entry.path().filename().string();
     if (name == kFolderManifest) continue;
+    if (!entry.is_regular_file(ec) || entry.is_symlink(ec))
+      return folder.string() + ": the folder holds \"" + name + "\", which is not a plain file (a folder, link, FIFO " +
+             "or device; the command writes plain files only): " + not_ours;
     const auto it = listed.find(name);
-    if (!entry.is_regular_file(ec) || it == listed.end())
+    if (it == listed.end())
       return folder.string() + ": the folder holds \"" + name + "\", which the earlier output did not write (" +
              kFolderManifest + " does not list it; replacing the folder would delete it): " + not_ours;
-    if (sha256_hex(read_file_bytes(entry.path().string())) != it->second)
+    // Read in pieces: an output folder may hold files of gigabytes (nineteenth campaign F4).
+    if (sha256_file_hex(entry.path().string()) != it->second)
       return folder.string() + ": \"" + name + "\" changed since the earlier output wrote it (its SHA-256 is not the one " +
              kFolderManifest + " lists; replacing the folder would lose the change): " + not_ours;
   }
@@ -602,11 +609,14 @@ std::string foreign_entry_problem(const std::string& path, const FolderMarker& m
   const fs::path folder(path);
   const std::string not_ours =
       "it is not an earlier output of this command, so it is not replaced (remove it or choose another folder)";
-  // A marked folder with a manifest lists every byte it may lose; one without is an older
-  // miner's output, judged by names below.
-  if (!marker.file.empty() && fs::is_regular_file(folder / marker.file, ec) &&
-      fs::symlink_status(folder / kFolderManifest, ec).type() != fs::file_type::not_found)
-    return manifest_problem(folder, not_ours);
+  // A marked folder with a manifest lists every byte it may lose: each file must be listed
+  // there, unchanged, and also be one of the kind's names below (nineteenth campaign F3: a
+  // user's notes.txt the user had added to SHA256SUMS was deleted). One without a manifest is
+  // an older miner's output, judged by names alone.
+  const bool with_manifest = !marker.file.empty() && fs::is_regular_file(folder / marker.file, ec) &&
+                             fs::symlink_status(folder / kFolderManifest, ec).type() != fs::file_type::not_found;
+  if (with_manifest)
+    if (std::string problem = manifest_problem(folder, not_ours); !problem.empty()) return problem;
   const std::set<std::string> listed = listed_names(folder, marker);
   // The kind's names judge a folder that carries its marker; the names rule stays for one
   // without (refused by folder_marker_problem unless by_name_fallback, which then judges by
@@ -616,6 +626,7 @@ std::string foreign_entry_problem(const std::string& path, const FolderMarker& m
   for (const auto& entry : fs::directory_iterator(folder, ec)) {
     const std::string name = entry.path().filename().string();
     const bool plain = entry.is_regular_file(ec);
+    if (with_manifest && name == kFolderManifest) continue;
     if (plain && by_names &&
         (new_names.count(name) || name == marker.file || listed.count(name) || (marker.own_name && marker.own_name(name))))
       continue;
@@ -652,6 +663,12 @@ void write_folder_atomic(const std::string& path, const std::vector<std::pair<st
     if (!target.empty() && target.filename().empty() && target.has_relative_path()) target = target.parent_path();
     if (target.empty() || target.filename().empty() || target.filename() == "." || target.filename() == "..")
       throw Error(path + ": a link that cannot be followed to a folder name");
+    // As for files: a dangling link is written through only where the target's folder exists
+    // (nineteenth campaign F18: the missing folders were created, anywhere the link pointed).
+    const fs::path target_parent = target.has_parent_path() ? target.parent_path() : fs::path(".");
+    if (!fs::is_directory(target_parent, link_ec))
+      throw Error(path + ": a symbolic link to " + target.string() + ", whose folder " + target_parent.string() +
+                  " does not exist (outputs are written through links into their targets)");
   }
   const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");
   std::error_code ec;

@@ -2,7 +2,11 @@
 
 #include <array>
 #include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <vector>
 
+#include "miner/core/error.hpp"
 #include "miner/core/json_io.hpp"
 
 namespace miner {
@@ -49,27 +53,69 @@ void compress(std::array<std::uint32_t, 8>& h, const unsigned char* block) {
 
 }  // namespace
 
+namespace {
+/// SHA-256 over bytes given in pieces: whole 64-byte blocks are compressed as they come, the
+/// rest kept for the next piece or the padding.
+class Sha256 {
+ public:
+  void update(const unsigned char* data, std::size_t n) {
+    length_ += n;
+    std::size_t i = 0;
+    if (held_ > 0) {
+      while (held_ < 64 && i < n) block_[held_++] = data[i++];
+      if (held_ < 64) return;
+      compress(h_, block_.data());
+      held_ = 0;
+    }
+    for (; i + 64 <= n; i += 64) compress(h_, data + i);
+    while (i < n) block_[held_++] = data[i++];
+  }
+  std::string hex() {
+    // Padding: 0x80, zeros, the bit length big-endian in the last 8 bytes.
+    std::array<unsigned char, 128> tail{};
+    for (std::size_t j = 0; j < held_; ++j) tail[j] = block_[j];
+    tail[held_] = 0x80;
+    const std::size_t blocks = held_ + 9 <= 64 ? 1 : 2;
+    const std::uint64_t bits = length_ * 8;
+    for (int j = 0; j < 8; ++j) tail[64 * blocks - 1 - static_cast<std::size_t>(j)] = static_cast<unsigned char>(bits >> (8 * j));
+    for (std::size_t b = 0; b < blocks; ++b) compress(h_, tail.data() + 64 * b);
+    static const char* digits = "0123456789abcdef";
+    std::string out;
+    for (const std::uint32_t word : h_)
+      for (int s = 28; s >= 0; s -= 4) out.push_back(digits[(word >> s) & 0xf]);
+    return out;
+  }
+
+ private:
+  std::array<std::uint32_t, 8> h_ = {0x6a09e667, 0xbb67ae85, 0x3c6ef372, 0xa54ff53a,
+                                     0x510e527f, 0x9b05688c, 0x1f83d9ab, 0x5be0cd19};
+  std::array<unsigned char, 64> block_{};
+  std::size_t held_ = 0;
+  std::uint64_t length_ = 0;
+};
+}  // namespace
+
 std::string sha256_hex(const std::string& bytes) {
-  std::array<std::uint32_t, 8> h = {0x6a09e667, 0xbb67ae85, 0x3c6ef372, 0xa54ff53a,
-                                    0x510e527f, 0x9b05688c, 0x1f83d9ab, 0x5be0cd19};
-  const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
-  const std::size_t n = bytes.size();
-  std::size_t i = 0;
-  for (; i + 64 <= n; i += 64) compress(h, data + i);
-  // Padding: 0x80, zeros, the bit length big-endian in the last 8 bytes.
-  std::array<unsigned char, 128> tail{};
-  const std::size_t rest = n - i;
-  for (std::size_t j = 0; j < rest; ++j) tail[j] = data[i + j];
-  tail[rest] = 0x80;
-  const std::size_t blocks = rest + 9 <= 64 ? 1 : 2;
-  const std::uint64_t bits = static_cast<std::uint64_t>(n) * 8;
-  for (int j = 0; j < 8; ++j) tail[64 * blocks - 1 - j] = static_cast<unsigned char>(bits >> (8 * j));
-  for (std::size_t b = 0; b < blocks; ++b) compress(h, tail.data() + 64 * b);
-  static const char* hex = "0123456789abcdef";
-  std::string out;
-  for (const std::uint32_t word : h)
-    for (int s = 28; s >= 0; s -= 4) out.push_back(hex[(word >> s) & 0xf]);
-  return out;
+  Sha256 sha;
+  sha.update(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size());
+  return sha.hex();
+}
+
+std::string sha256_file_hex(const std::string& path) {
+  require_path_without_nul(path, "file");
+  std::error_code ec;
+  if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
+    throw Error(path + ": cannot hash: not a regular file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path + ": cannot open file");
+  Sha256 sha;
+  std::vector<char> chunk(1 << 20);
+  while (in) {
+    in.read(chunk.data(), static_cast<std::streamsize>(chunk.size()));
+    sha.update(reinterpret_cast<const unsigned char*>(chunk.data()), static_cast<std::size_t>(in.gcount()));
+  }
+  if (in.bad()) throw Error(path + ": read failed");
+  return sha.hex();
 }
 
 std::uint64_t fnv1a64(const void* data, std::size_t size, std::uint64_t h) {

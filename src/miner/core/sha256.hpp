@@ -11,6 +11,9 @@
 namespace miner {
 
 std::string sha256_hex(const std::string& bytes);
+/// The SHA-256 of a file's bytes, read in 1 MiB pieces (memory bounded whatever its size).
+/// Throws miner::Error naming the path when it cannot be read or is no regular file.
+std::string sha256_file_hex(const std::string& path);
 
 class JsonField;
 /// A recorded SHA-256 read from a file: 64 lower-case hex digits (as `sha256sum` prints them),

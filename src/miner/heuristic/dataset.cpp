@@ -402,12 +402,15 @@ void validate(const DatasetOptions& o) {
   long long files = 0;
   for (const long long n : {static_cast<long long>(o.count) - val, val, static_cast<long long>(o.test_count)})
     files = std::max(files, (n + o.shard_size - 1) / o.shard_size);
-  if (o.shard_index >= files)
+  // Judged on N, not i: with more parts than files some part of the split holds nothing and the
+  // split never merges, so every part is refused, the first ones too (nineteenth campaign F20).
+  if (o.shard_count > files)
     throw Error("dataset: --shard " + std::to_string(o.shard_index) + "/" + std::to_string(o.shard_count) +
                     ": the largest split has " + std::to_string(files) + " shard file(s) of --shard-size " +
-                    std::to_string(o.shard_size) + ", and part " + std::to_string(o.shard_index) +
-                    " takes the files j with j % " + std::to_string(o.shard_count) + " == " +
-                    std::to_string(o.shard_index) + ": it would hold no sample (use at most " + std::to_string(files) +
+                    std::to_string(o.shard_size) + ", and part i takes the files j with j % " +
+                    std::to_string(o.shard_count) + " == i: part" + (o.shard_count - files > 1 ? "s " : " ") +
+                    std::to_string(files) + (o.shard_count - files > 1 ? "-" + std::to_string(o.shard_count - 1) : "") +
+                    " would hold no sample (use at most " + std::to_string(files) +
                     (files == 1 ? " part" : " parts") + (o.shard_size > 1 ? ", or a smaller --shard-size)" : ")"),
                 ExitCode::kUsage);
   if (!(o.min_separation >= 0.0 && o.min_separation < 1.0)) throw Error("dataset: min_separation must be in [0, 1)");

@@ -536,6 +536,12 @@ void Map::save(const std::string& path) const {
   // issue 20: a ".ot" path got JSON that load() then read as an OctoMap and refused.
   if (path.size() >= 3 && path.compare(path.size() - 3, 3, ".ot") == 0)
     throw Error(path + ": MINER writes OctoMaps as .bt (binary occupancy) only, not .ot: name the output .bt or .json");
+  // The name's suffix says what is written; a link is written through into its target, which
+  // must carry the same suffix (REQ-CORE-004; nineteenth campaign F5: JSON went into a .bt).
+  if (const std::string real = link_target(path);
+      std::filesystem::path(real).extension() != std::filesystem::path(path).extension())
+    throw Error(path + ": a symbolic link to " + real + ", whose suffix is not the link's: the file written there would " +
+                "hold what " + path + " asks for under another kind's name (give the target's own name)");
   if (ends_with(path, ".bt")) {
     save_octomap(path);
   } else if (source_ && source_->file.empty()) {

@@ -54,10 +54,12 @@ std::vector<std::string> words(const std::string& line) {
 std::size_t count_of(const std::string& text, const std::string& what, const std::string& origin) {
   if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos)
     fail(origin, what + " \"" + text + "\" is not a count");
-  // A count of many digits is too large, not malformed (eighteenth campaign F15).
-  const std::size_t n = text.size() > 12 ? kMaxCloudPoints + 1 : std::stoull(text);
+  // A count of many digits is too large, not malformed (eighteenth campaign F15); leading zeros
+  // do not count (nineteenth campaign F8: "0...02 exceeds").
+  const std::string digits = text.find_first_not_of('0') == std::string::npos ? "0" : text.substr(text.find_first_not_of('0'));
+  const std::size_t n = digits.size() > 12 ? kMaxCloudPoints + 1 : std::stoull(digits);
   if (n > kMaxCloudPoints) {
-    if (text.size() > 12)
+    if (digits.size() > 12)
       fail(origin, what + " " + (text.size() > 24 ? text.substr(0, 24) + "..." : text) + " exceeds the " +
                        std::to_string(kMaxCloudPoints) + " points a cloud may hold");
     std::ostringstream os;

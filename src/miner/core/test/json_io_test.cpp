@@ -385,6 +385,25 @@ TEST_CASE("A marked folder lists what it wrote in SHA256SUMS, and only those byt
   fs::remove(dir / "run" / "log.csv");
   miner::write_folder_atomic(run, first, marker);
   CHECK(read_all(run + "/log.csv") == "t\n");
+  // Nineteenth campaign F3: a file the kind never writes, listed in SHA256SUMS by the user, was
+  // deleted: the manifest adds to the names rule, it does not replace it.
+  std::ofstream(dir / "run" / "notes.txt") << "mine";
+  std::ofstream(dir / "run" / "SHA256SUMS", std::ios::app) << miner::sha256_hex("mine") << "  notes.txt\n";
+  CHECK_THROWS_WITH(miner::write_folder_atomic(run, first, marker), Contains("\"notes.txt\", a file this command never writes"));
+  CHECK(read_all(run + "/notes.txt") == "mine");
+  fs::remove(dir / "run" / "notes.txt");
+  // sha256sum's CRLF lines and binary "*" marker are its own format (nineteenth campaign F1, F2).
+  {
+    const std::string manifest = read_all(run + "/SHA256SUMS");
+    std::string crlf;
+    for (const char c : manifest) crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
+    std::string star = manifest;
+    for (std::size_t at = star.find("  "); at != std::string::npos; at = star.find("  ", at + 2)) star.replace(at, 2, " *");
+    for (const std::string& variant : {crlf, star}) {
+      std::ofstream(dir / "run" / "SHA256SUMS", std::ios::binary | std::ios::trunc) << variant;
+      CHECK_NOTHROW(miner::write_folder_atomic(run, first, marker));
+    }
+  }
   // A manifest that is not one (a user's own SHA256SUMS) is refused, naming its line.
   std::ofstream(dir / "run" / "SHA256SUMS") << "my checksums\n";
   CHECK_THROWS_WITH(miner::write_folder_atomic(run, first, marker), Contains("SHA256SUMS: line 1 is not"));
@@ -436,6 +455,15 @@ TEST_CASE("An output that is a dangling link is written into the link's target",
   fs::create_symlink("loop-b.json", dir / "loop-a.json");
   fs::create_symlink("loop-a.json", dir / "loop-b.json");
   CHECK_THROWS_WITH(miner::write_file_atomic((dir / "loop-a.json").string(), "{}"), Contains("more than 40 symbolic links"));
+  // The same for a folder: a dangling link is written through where the target's folder
+  // exists, and nothing is created elsewhere (nineteenth campaign F18: nodir/ds was made).
+  fs::create_directory_symlink("sub/run", dir / "run-link");
+  miner::write_folder_atomic((dir / "run-link").string(), {{"a.txt", "1"}});
+  CHECK(read_all((dir / "sub" / "run" / "a.txt").string()) == "1");
+  fs::create_directory_symlink("nodir/run", dir / "nowhere-run");
+  CHECK_THROWS_WITH(miner::write_folder_atomic((dir / "nowhere-run").string(), {{"a.txt", "1"}}),
+                    Contains("whose folder") && Contains("nodir does not exist"));
+  CHECK_FALSE(fs::exists(dir / "nodir"));
   CHECK(miner::link_target((dir / "sub").string()) == (dir / "sub").string());
 }
 

@@ -347,6 +347,15 @@ TEST_CASE("A part that would hold no shard file is refused before any sample is 
                     Contains("--shard 2/3: the largest split has 2 shard file(s)") && Contains("no sample") &&
                         Contains("(use at most 2 parts, or a smaller --shard-size)"));
   CHECK_FALSE(std::filesystem::exists(out));
+  // Nineteenth campaign F20: parts 0 and 1 of that split were written, though the split could
+  // never merge; every part of it is refused.
+  for (int i : {0, 1}) {
+    auto first = o;
+    first.shard_index = i;
+    CHECK_THROWS_WITH(heuristic::write_dataset(first, out, nullptr),
+                      Contains("--shard " + std::to_string(i) + "/3") && Contains("part 2 would hold no sample"));
+  }
+  CHECK_FALSE(std::filesystem::exists(out));
   // The advice is one that can be followed (fifteenth campaign F13: "use at most 1 parts", and a
   // smaller --shard-size at 1).
   {
@@ -359,7 +368,8 @@ TEST_CASE("A part that would hold no shard file is refused before any sample is 
     one.shard_index = 1;
     CHECK_THROWS_WITH(heuristic::write_dataset(one, out, nullptr), EndsWith("(use at most 1 part)"));
   }
-  o.shard_index = 1;  // the last part that holds a file is written
+  o.shard_count = 2;  // a split into as many parts as files: every part holds one
+  o.shard_index = 1;
   CHECK_NOTHROW(heuristic::write_dataset(o, out, nullptr));
 }
 

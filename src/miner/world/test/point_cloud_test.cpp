@@ -252,6 +252,11 @@ TEST_CASE("Malformed point clouds are refused naming the fault, never crash", "[
   refuses(with_i + "32768 0\n", true, "is outside the field's range");
   refuses(with_i + "1 1e39\n", true, "is beyond the range of a 4-byte float");
   refuses(with_i + "1 0x10\n", true, "is not a number");
+  // Nineteenth campaign F8: leading zeros made 2 "exceed" the limit.
+  CHECK(parse_point_cloud("ply\nformat ascii 1.0\nelement vertex 00000000000000000002\nproperty float x\nproperty float y\n"
+                          "property float z\nend_header\n0 0 1\n1 0 1\n",
+                          true, "zeros")
+            .points.size() == 2);
   refuses("ply\nformat ascii 1.0\nelement vertex 1000000000000\nproperty float x\nproperty float y\nproperty float z\n"
           "end_header\n",
           true, "element vertex 1000000000000 exceeds the 134217728 points a cloud may hold");

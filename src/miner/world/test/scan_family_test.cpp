@@ -167,6 +167,11 @@ TEST_CASE("A scan saved again never replaces voxels that other map files name, a
   CHECK_THROWS_WITH(loaded.save((dir / "again.json").string()), Catch::Contains("voxels.file: " + named));
   CHECK_FALSE(fs::exists(dir / "again.json"));
   CHECK_NOTHROW(loaded.save((dir / "again.bt").string()));  // the voxels themselves: still in memory
+  // Nineteenth campaign F5: a .json name linked to a .bt file got JSON written into the .bt.
+  fs::create_symlink("x.bt", dir / "b.json");
+  CHECK_THROWS_WITH(first.save((dir / "b.json").string()), Catch::Contains("b.json: a symbolic link to") &&
+                                                               Catch::Contains("whose suffix is not the link's"));
+  CHECK_FALSE(fs::exists(dir / "x.bt"));
   fs::remove_all(dir);
 }
 

@@ -133,11 +133,14 @@ const CLI::Validator kOutputFile(
       if (fs::is_directory(p, ec)) return text + " is a folder, not a file";
       if (std::string problem = output_file_problem(text); !problem.empty()) return problem;
       // Written through a link into its target, dangling or not (REQ-CORE-004): the target's folder.
-      const fs::path real(link_target(text));
+      fs::path real;
+      try {
+        real = output_target(text);
+      } catch (const Error& e) {
+        return e.what();
+      }
       const fs::path parent = real.parent_path().empty() ? fs::path(".") : real.parent_path();
-      if (!fs::is_directory(parent, ec))
-        return "the folder " + parent.string() + " does not exist" +
-               (real != p ? " (" + text + " is a symbolic link to " + real.string() + ")" : std::string());
+      if (!fs::is_directory(parent, ec)) return "the folder " + parent.string() + " does not exist";
       return probe_writable(parent);
     },
     "OUTPUT FILE");
@@ -147,24 +150,13 @@ const CLI::Validator kOutputFolder(
       namespace fs = std::filesystem;
       if (text.empty()) return "an output folder needs a name";
       std::error_code ec;
-      // The writer's own rule, before the work (nineteenth campaign F19: `--out .` was refused
-      // after a whole dataset run): "run/" names run, ".", "./" and "x/.." name no folder.
-      fs::path named = fs::path(text).lexically_normal();
-      if (!named.empty() && named.filename().empty() && named.has_relative_path()) named = named.parent_path();
-      if (named.empty() || named.filename().empty() || named.filename() == "." || named.filename() == "..")
-        return text + " is not a folder name (the output folder is replaced whole: name it, e.g. ../" +
-               fs::current_path(ec).filename().string() + " for this one)";
-      // A dangling link is written through only where its target's folder exists (F18).
-      if (fs::is_symlink(fs::symlink_status(named, ec))) {
-        fs::path real;
-        try {
-          real = fs::path(link_target(named.string())).lexically_normal();
-        } catch (const Error& e) {
-          return e.what();
-        }
-        const fs::path real_parent = real.has_parent_path() ? real.parent_path() : fs::path(".");
-        if (!fs::is_directory(real_parent, ec))
-          return text + " is a symbolic link to " + real.string() + ", whose folder " + real_parent.string() + " does not exist";
+      // The writer's own rules, before the work (nineteenth campaign F19: `--out .` was refused
+      // after a whole dataset run; F18: a dangling link's missing folders were created).
+      if (std::string problem = folder_name_problem(text); !problem.empty()) return problem;
+      try {
+        (void)output_target(named_folder(text).string());
+      } catch (const Error& e) {
+        return e.what();
       }
       fs::path p = fs::absolute(fs::path(text), ec);
       if (fs::exists(p, ec) && !fs::is_directory(p, ec)) return text + " is a file, not a folder";
@@ -516,6 +508,19 @@ std::string dash_lookalike_hint(const std::string& word) {
   return {};
 }
 
+/// "unexpected argument(s) "a", "b": the command takes none", each word quoted alone, with the
+/// "--" note when the line has one (seventeenth campaign F30) and the first dash look-alike's
+/// hint (dash_lookalike_hint).
+std::string unexpected_arguments_text(const std::vector<std::string>& words, bool separator) {
+  std::string line, hint;
+  for (const std::string& w : words) {
+    line += (line.empty() ? "\"" : ", \"") + w + "\"";
+    if (hint.empty() && !dash_lookalike_hint(w).empty()) hint = "; " + dash_lookalike_hint(w);
+  }
+  return std::string("unexpected argument") + (words.size() > 1 ? "s " : " ") + line + ": the command takes none" +
+         (separator ? " (after \"--\" every word is an argument, not an option)" : "") + hint;
+}
+
 /// CLI11's count messages in plain words (issue 20, third campaign: "--radius: At Most 1
 /// required but received 2", "--planners: 1 required TEXT:PLANNER missing").
 std::string plain_usage_text(const std::string& text, bool separator) {
@@ -536,17 +541,8 @@ std::string plain_usage_text(const std::string& text, bool separator) {
   static const std::regex extras(R"(^The following arguments? (?:was|were) not expected: (.*)$)");
   if (std::regex_match(text, m, extras)) {
     std::istringstream words(m[1].str());
-    std::vector<std::string> list{std::istream_iterator<std::string>(words), std::istream_iterator<std::string>()};
-    // Each word quoted alone, and "--" not blamed when the line has none (seventeenth campaign
-    // F30); a word led by a dash look-alike (an autocorrected en dash, em dash or minus sign) is
-    // shown as the option it was meant to be.
-    std::string line, hint;
-    for (auto it = list.rbegin(); it != list.rend(); ++it) {
-      line += (line.empty() ? "\"" : ", \"") + *it + "\"";
-      if (hint.empty() && !dash_lookalike_hint(*it).empty()) hint = "; " + dash_lookalike_hint(*it);
-    }
-    return std::string("unexpected argument") + (list.size() > 1 ? "s " : " ") + line + ": the command takes none" +
-           (separator ? " (after \"--\" every word is an argument, not an option)" : "") + hint;
+    const std::vector<std::string> list{std::istream_iterator<std::string>(words), std::istream_iterator<std::string>()};
+    return unexpected_arguments_text({list.rbegin(), list.rend()}, separator);
   }
   return text;
 }
@@ -659,12 +655,8 @@ std::string unknown_option(CLI::App* cmd, const std::string& path, const std::ve
 std::string stray_option_word(CLI::App* cmd, const std::vector<std::string>& args) {
   const bool positional = !cmd->get_options([](const CLI::Option* o) { return o->get_positional(); }).empty();
   const auto separator = std::find(args.begin(), args.end(), "--");
-  if (separator != args.end() && separator + 1 != args.end() && !positional) {
-    std::string line;
-    for (auto it = separator + 1; it != args.end(); ++it) line += (line.empty() ? "\"" : ", \"") + *it + "\"";
-    return std::string("unexpected argument") + (args.end() - separator > 2 ? "s " : " ") + line +
-           ": the command takes none (after \"--\" every word is an argument, not an option)";
-  }
+  if (separator != args.end() && separator + 1 != args.end() && !positional)
+    return unexpected_arguments_text({separator + 1, args.end()}, true);
   for (auto a = args.begin(); a != separator; ++a) {
     // "--out=" is an option given an empty value, not one waiting for the next word (eighteenth
     // campaign F24: "--out: needs a value, got the option --json").
@@ -838,13 +830,13 @@ int parse_line(CLI::App& app, const std::vector<std::string>& args, std::ostream
     CLI::App* cmd = addressed_command(&app, args, path, unknown_command);
     // An unknown command is named, with the commands there are and the nearest one (CLI11
     // alone says only "A subcommand is required").
+    std::vector<std::string> names;  // the commands below cmd
+    std::string list;
+    for (CLI::App* sub : cmd->get_subcommands([](CLI::App*) { return true; })) {
+      names.push_back(sub->get_name());
+      list += (list.empty() ? "" : ", ") + sub->get_name();
+    }
     if (!unknown_command.empty()) {
-      std::vector<std::string> names;
-      std::string list;
-      for (CLI::App* sub : cmd->get_subcommands([](CLI::App*) { return true; })) {
-        names.push_back(sub->get_name());
-        list += (list.empty() ? "" : ", ") + sub->get_name();
-      }
       const std::string nearest = nearest_name(unknown_command, names);
       err << "miner: usage error: unknown command \"" << unknown_command << "\" for `" << path << "`"
           << (nearest.empty() ? "" : ", did you mean \"" + nearest + "\"?") << " (commands: " << list << ")\n"
@@ -864,10 +856,7 @@ int parse_line(CLI::App& app, const std::vector<std::string>& args, std::ostream
     }
     // A group without its command (`miner map`) is named with the commands it has (eighteenth
     // campaign F24: CLI11's "A subcommand is required").
-    if (cmd != &app && !cmd->get_subcommands([](CLI::App*) { return true; }).empty()) {
-      std::string list;
-      for (CLI::App* sub : cmd->get_subcommands([](CLI::App*) { return true; }))
-        list += (list.empty() ? "" : ", ") + sub->get_name();
+    if (cmd != &app && !names.empty()) {
       err << "miner: usage error: `" << path << "` needs a command (commands: " << list << ")\n"
           << "run '" << path << " --help' for usage\n";
       return static_cast<int>(ExitCode::kUsage);

@@ -428,21 +428,13 @@ void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& 
     // (issue 20: `--out /dev/null` as root replaced the device with a plain file), and a
     // symbolic link is written through (its target is replaced, the link kept).
     fs::path final_target = target;
-    if (fs::is_symlink(fs::symlink_status(target, ec))) {
-      try {
-        final_target = fs::path(link_target(path)).lexically_normal();
-      } catch (const Error&) {
-        discard();
-        throw;
-      }
-      // A dangling link is written through too, into its target (eighteenth campaign F2: it was
-      // replaced by a file), when the target's folder exists.
-      const fs::path target_dir = final_target.has_parent_path() ? final_target.parent_path() : fs::path(".");
-      if (!fs::is_directory(target_dir, ec)) {
-        discard();
-        throw Error(path + ": a symbolic link to " + final_target.string() + ", whose folder " + target_dir.string() +
-                    " does not exist (outputs are written through links into their targets)");
-      }
+    // A dangling link is written through too, into its target, when the target's folder
+    // exists (eighteenth campaign F2: it was replaced by a file).
+    try {
+      final_target = output_target(path);
+    } catch (const Error&) {
+      discard();
+      throw;
     }
     if (const auto st = fs::status(final_target, ec); fs::exists(st) && !fs::is_regular_file(st)) {
       discard();
@@ -555,6 +547,33 @@ std::string link_target(const std::string& path) {
   return target.string();
 }
 
+std::string output_target(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::is_symlink(fs::symlink_status(path, ec))) return path;
+  fs::path real = fs::path(link_target(path)).lexically_normal();
+  if (real.filename().empty() && real.has_relative_path()) real = real.parent_path();  // a link to "run/"
+  const fs::path dir = real.has_parent_path() ? real.parent_path() : fs::path(".");
+  if (!fs::is_directory(dir, ec))
+    throw Error(path + ": a symbolic link to " + real.string() + ", whose folder " + dir.string() +
+                " does not exist (outputs are written through links into their targets)");
+  return real.string();
+}
+
+std::filesystem::path named_folder(const std::string& path) {
+  std::filesystem::path p = std::filesystem::path(path).lexically_normal();
+  if (!p.empty() && p.filename().empty() && p.has_relative_path()) p = p.parent_path();
+  return p;
+}
+
+std::string folder_name_problem(const std::string& path) {
+  const std::filesystem::path p = named_folder(path);
+  if (!p.empty() && !p.filename().empty() && p.filename() != "." && p.filename() != "..") return {};
+  std::error_code ec;
+  return path + " is not a folder name (the output folder is replaced whole: name it, e.g. ../" +
+         std::filesystem::current_path(ec).filename().string() + " for this one)";
+}
+
 namespace {
 /// The manifest rule of foreign_entry_problem for a folder carrying kFolderManifest: empty when
 /// every entry is the manifest or a plain file it lists with the same SHA-256.
@@ -649,27 +668,16 @@ void write_folder_atomic(const std::string& path, const std::vector<std::pair<st
     files.emplace_back(kFolderManifest, folder_manifest(given));
   }
   require_path_without_nul(path, "output folder");
-  fs::path target = fs::path(path).lexically_normal();
   // "run/" names the folder run, as the shell's completion writes it (sixteenth campaign F20:
   // refused as "not a folder name").
-  if (!target.empty() && target.filename().empty() && target.has_relative_path()) target = target.parent_path();
-  if (target.empty() || target.filename().empty() || target.filename() == "." || target.filename() == "..")
-    throw Error(path + ": not a folder name");
+  if (const std::string problem = folder_name_problem(path); !problem.empty()) throw Error(problem);
   // A symbolic link is followed, as for files (fourteenth campaign C6: `dataset --out LINK`
-  // replaced the user's link with a new folder and left the folder it named as it was).
-  std::error_code link_ec;
-  if (fs::is_symlink(fs::symlink_status(target, link_ec))) {
-    target = fs::path(link_target(target.string())).lexically_normal();
-    if (!target.empty() && target.filename().empty() && target.has_relative_path()) target = target.parent_path();
-    if (target.empty() || target.filename().empty() || target.filename() == "." || target.filename() == "..")
-      throw Error(path + ": a link that cannot be followed to a folder name");
-    // As for files: a dangling link is written through only where the target's folder exists
-    // (nineteenth campaign F18: the missing folders were created, anywhere the link pointed).
-    const fs::path target_parent = target.has_parent_path() ? target.parent_path() : fs::path(".");
-    if (!fs::is_directory(target_parent, link_ec))
-      throw Error(path + ": a symbolic link to " + target.string() + ", whose folder " + target_parent.string() +
-                  " does not exist (outputs are written through links into their targets)");
-  }
+  // replaced the user's link with a new folder and left the folder it named as it was), only
+  // where the target's folder exists (nineteenth campaign F18: the missing folders were
+  // created, anywhere the link pointed).
+  fs::path target = named_folder(output_target(named_folder(path).string()));
+  if (const std::string problem = folder_name_problem(target.string()); !problem.empty())
+    throw Error(path + ": a link to " + problem);
   const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");
   std::error_code ec;
   fs::create_directories(parent, ec);
@@ -727,8 +735,6 @@ void write_folder_atomic(const std::string& path, const std::vector<std::pair<st
       if (const auto st = fs::symlink_status(target / name, ec); fs::is_regular_file(st))
         fs::permissions(partial / name, st.permissions(), ec);
     fs::permissions(partial, fs::status(target, ec).permissions(), ec);
-  }
-  if (had_old) {
     fs::rename(target, old, ec);
     if (ec) {
       fs::remove_all(partial, ec);

@@ -5,6 +5,7 @@
 /// REQ-CORE-004).
 
 #include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <optional>
 #include <set>
@@ -176,13 +177,28 @@ std::string folder_manifest(const std::vector<std::pair<std::string, std::string
 inline constexpr int kMaxLinkHops = 40;
 std::string link_target(const std::string& path);
 
+/// Where an output written at `path` lands: `path` itself, or for a symbolic link the end of its
+/// chain (link_target), lexically normal. Throws naming the link when the chain loops or the
+/// target's folder does not exist: a dangling link is written through only where that folder
+/// exists (eighteenth campaign F2, nineteenth F18). The atomic writers and the CLI's output
+/// checks all follow links through it.
+std::string output_target(const std::string& path);
+
+/// The folder an output folder path names, lexically normal: "run/", "run//" and "run/." are
+/// run (sixteenth campaign F20); "./" is ".". Empty for an empty path.
+std::filesystem::path named_folder(const std::string& path);
+/// Why `path` names no folder an output may replace whole (".", "..", "/", "x/.."), empty when
+/// it names one: checked by write_folder_atomic and, before the work, by the CLI (nineteenth
+/// campaign F19).
+std::string folder_name_problem(const std::string& path);
+
 /// Why the existing folder `path` holds something that is not part of an earlier output of the
 /// command `marker` describes (empty when all of it is), naming the first such entry: anything
 /// but a plain file; in a folder holding marker.file, with marker.own_name or marker.listed, a
 /// file that is none of the command's names (own_name, the marker's list, `new_names`); else a
 /// file whose extension is not in `extensions` (the names rule). Where the folder carries
-/// kFolderManifest too, the manifest rules instead of names: each file must be listed there
-/// with the same SHA-256 (a malformed manifest is refused). The marker's own content is judged
+/// kFolderManifest too, each file must also be listed there with the same SHA-256 (the manifest
+/// adds to the names rule, never replaces it; a malformed manifest is refused). The marker's own content is judged
 /// by folder_marker_problem.
 std::string foreign_entry_problem(const std::string& path, const FolderMarker& marker,
                                   const std::set<std::string>& new_names, const std::set<std::string>& extensions);

@@ -55,7 +55,7 @@ void require_complete_parts(const std::vector<Json>& tags, const std::vector<std
   }
   if (static_cast<int>(tags.size()) != n)
     throw Error(job + " has " + std::to_string(n) + " parts, got " + std::to_string(tags.size()));
-  std::vector<bool> seen(static_cast<std::size_t>(n), false);
+  // Duplicates are named above; here the parts that are not of this split.
   for (std::size_t p = 0; p < tags.size(); ++p) {
     const int index = tags[p].at("index").get<int>();
     const int count = tags[p].at("count").get<int>();
@@ -67,9 +67,6 @@ void require_complete_parts(const std::vector<Json>& tags, const std::vector<std
       // Plain words (fifth campaign: "splits dataset merge: the dataset differently").
       throw Error(names[p] + ": is part " + std::to_string(index) + " of " + std::to_string(tags[p].at("count").get<int>()) +
                   ", but " + names.front() + " is a part of " + std::to_string(n) + ": the parts come from different splits");
-    if (seen[static_cast<std::size_t>(index)])
-      throw Error(names[p] + ": part " + std::to_string(index) + "/" + std::to_string(n) + " appears twice");
-    seen[static_cast<std::size_t>(index)] = true;
   }
 }
 

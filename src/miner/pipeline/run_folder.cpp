@@ -16,8 +16,7 @@ FolderMarker run_folder_marker() {
 }
 
 std::string run_folder_name(const std::string& dir) {
-  std::filesystem::path p = std::filesystem::path(dir).lexically_normal();
-  if (p.has_relative_path() && p.filename().empty()) p = p.parent_path();
+  const std::filesystem::path p = named_folder(dir);
   // "." normalises to itself, "./" to "."; an empty result is not a folder name, left to the writer.
   return p.empty() ? dir : p.string();
 }

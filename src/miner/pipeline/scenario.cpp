@@ -574,8 +574,9 @@ constexpr double kLimitSlack = 1e-6;
 /// reference it had just built).
 /// v and a are exact_extremes(): a 1 ms sampling of a 0.4 s reference missed its peaks by
 /// ~1e-5 relative, more than kLimitSlack, and the peak sampled after a time stretch differed.
+bool over_limit(double peak, double limit) { return peak > limit * (1 + kLimitSlack); }
 bool exceeds_limits(double v, double a, const traj::Limits& limits) {
-  return v > limits.v_max * (1 + kLimitSlack) || a > limits.a_max * (1 + kLimitSlack);
+  return over_limit(v, limits.v_max) || over_limit(a, limits.a_max);
 }
 
 /// Start/end states must match to this (m, m/s, m/s^2).
@@ -716,8 +717,8 @@ ReferencePlan build_reference(const Scenario& s) {
                "without it the limit is " + short_number(fallback) + " " + unit + ")";
       };
       std::string why;
-      if (v > s.limits.v_max * (1 + kLimitSlack)) why = over("maximum speed", v, "v_max", s.limits.v_max, defaults.v_max, "m/s");
-      if (a > s.limits.a_max * (1 + kLimitSlack))
+      if (over_limit(v, s.limits.v_max)) why = over("maximum speed", v, "v_max", s.limits.v_max, defaults.v_max, "m/s");
+      if (over_limit(a, s.limits.a_max))
         why += (why.empty() ? "" : ", and its ") + over("maximum acceleration", a, "a_max", s.limits.a_max, defaults.a_max, "m/s^2");
       throw Error(s.origin + ": trajectory file: its " + why);
     }

@@ -57,16 +57,10 @@ std::size_t count_of(const std::string& text, const std::string& what, const std
   // A count of many digits is too large, not malformed (eighteenth campaign F15); leading zeros
   // do not count (nineteenth campaign F8: "0...02 exceeds").
   const std::string digits = text.find_first_not_of('0') == std::string::npos ? "0" : text.substr(text.find_first_not_of('0'));
-  const std::size_t n = digits.size() > 12 ? kMaxCloudPoints + 1 : std::stoull(digits);
-  if (n > kMaxCloudPoints) {
-    if (digits.size() > 12)
-      fail(origin, what + " " + (text.size() > 24 ? text.substr(0, 24) + "..." : text) + " exceeds the " +
-                       std::to_string(kMaxCloudPoints) + " points a cloud may hold");
-    std::ostringstream os;
-    os << what << " " << n << " exceeds the " << kMaxCloudPoints << " points a cloud may hold";
-    fail(origin, os.str());
-  }
-  return n;
+  if (digits.size() > 12 || std::stoull(digits) > kMaxCloudPoints)
+    fail(origin, what + " " + (digits.size() > 24 ? digits.substr(0, 24) + "..." : digits) + " exceeds the " +
+                     std::to_string(kMaxCloudPoints) + " points a cloud may hold");
+  return std::stoull(digits);
 }
 
 /// One scalar field of a binary record: byte offset, size, kind ('f' float, 'i' signed, 'u' unsigned).
@@ -120,15 +114,26 @@ bool decimal_or_special(const std::string& token) {
   return token.find_first_not_of("0123456789+-.eE") == std::string::npos;
 }
 
+/// A cloud text's number: a decimal, or nan/inf (a missing return); not hex, and not written
+/// beyond the largest double, an error in the file rather than a missing return (fifth
+/// campaign: "1e400" was skipped as non-finite). Sets `v`; returns why `token` is none ("is not
+/// a number", kBeyondDouble), empty when it is one.
+constexpr const char* kBeyondDouble = "is beyond the largest double";
+std::string number_problem(const std::string& token, double& v) {
+  char* end = nullptr;
+  v = std::strtod(token.c_str(), &end);
+  if (end == token.c_str() || *end != '\0' || !decimal_or_special(token)) return "is not a number";
+  if (std::isinf(v) && token.find_first_of("0123456789") != std::string::npos) return kBeyondDouble;
+  return "";
+}
+
 /// Why the ASCII value `token` is no value of field `f`'s type, or "" when it is one: a float
-/// field takes a decimal (or nan/inf) within its range, an integer field a whole number within
-/// its size (eighteenth campaign F15: a uchar "abc" or 300 was never read).
+/// field takes a number (number_problem) within its range, an integer field a whole number
+/// within its size (eighteenth campaign F15: a uchar "abc" or 300 was never read).
 std::string ascii_value_problem(const std::string& token, const Field& f) {
   if (f.kind == 'f') {
-    char* end = nullptr;
-    const double v = std::strtod(token.c_str(), &end);
-    if (end == token.c_str() || *end != '\0' || !decimal_or_special(token)) return "is not a number";
-    if (std::isinf(v) && token.find_first_of("0123456789") != std::string::npos) return "is beyond the largest double";
+    double v = 0.0;
+    if (std::string why = number_problem(token, v); !why.empty()) return why;
     if (f.size == 4 && std::isfinite(v) && std::abs(v) > static_cast<double>(std::numeric_limits<float>::max()))
       return "is beyond the range of a 4-byte float";
     return "";
@@ -145,19 +150,10 @@ std::string ascii_value_problem(const std::string& token, const Field& f) {
 }
 
 double parse_number(const std::string& token, const std::string& origin, std::size_t point) {
-  char* end = nullptr;
-  const double v = std::strtod(token.c_str(), &end);
-  if (end == token.c_str() || *end != '\0' || !decimal_or_special(token)) {
+  double v = 0.0;
+  if (const std::string why = number_problem(token, v); !why.empty()) {
     std::ostringstream os;
-    os << "point " << point << ": \"" << token << "\" is not a number";
-    fail(origin, os.str());
-  }
-  // A written number beyond the largest double is an error in the file, not a missing return
-  // (those are written nan or inf): refused like the JSON readers do (fifth campaign: "1e400"
-  // was skipped as non-finite).
-  if (std::isinf(v) && token.find_first_of("0123456789") != std::string::npos) {
-    std::ostringstream os;
-    os << "point " << point << ": the number " << token << " is beyond the largest double";
+    os << "point " << point << ": " << (why == kBeyondDouble ? "the number " + token : "\"" + token + "\"") << " " << why;
     fail(origin, os.str());
   }
   return v;
